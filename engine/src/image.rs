@@ -1,0 +1,85 @@
+//! CPU-side images: what a backend reads back from a texture.
+
+use crate::backend::desc::TextureFormat;
+
+/// Texel storage: 8-bit formats stay `u8`, everything else (f16 included) is widened to `f32`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ImageData {
+    /// One byte per channel.
+    U8(Vec<u8>),
+    /// One f32 per channel (f16 converted exactly).
+    F32(Vec<f32>),
+}
+
+/// A tightly packed image, top row first, `format.channels()` values per pixel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Format of the texture it came from.
+    pub format: TextureFormat,
+    /// Texel values.
+    pub data: ImageData,
+}
+
+impl Image {
+    /// Channels per pixel.
+    pub fn channels(&self) -> usize {
+        self.format.channels()
+    }
+
+    /// Channel values of pixel (x, y) (y = 0 is the top row), as f32 (8-bit values stay 0..255).
+    pub fn pixel(&self, x: u32, y: u32) -> Vec<f32> {
+        let c = self.channels();
+        let start = (y as usize * self.width as usize + x as usize) * c;
+        match &self.data {
+            ImageData::U8(v) => v[start..start + c].iter().map(|&b| b as f32).collect(),
+            ImageData::F32(v) => v[start..start + c].to_vec(),
+        }
+    }
+
+    /// The 8-bit data, if this is an 8-bit image.
+    pub fn as_u8(&self) -> Option<&[u8]> {
+        match &self.data {
+            ImageData::U8(v) => Some(v),
+            ImageData::F32(_) => None,
+        }
+    }
+
+    /// The float data, if this is a float image.
+    pub fn as_f32(&self) -> Option<&[f32]> {
+        match &self.data {
+            ImageData::F32(v) => Some(v),
+            ImageData::U8(_) => None,
+        }
+    }
+
+    /// Converts raw texel bytes of `format` (tightly packed, top row first) into an image.
+    pub fn from_texel_bytes(width: u32, height: u32, format: TextureFormat, bytes: &[u8]) -> Self {
+        let data = match format {
+            TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb => ImageData::U8(bytes.to_vec()),
+            TextureFormat::Rgba16Float => ImageData::F32(
+                bytes
+                    .chunks_exact(2)
+                    .map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32())
+                    .collect(),
+            ),
+            TextureFormat::Rgba32Float | TextureFormat::R32Float | TextureFormat::Depth32Float => {
+                ImageData::F32(
+                    bytes
+                        .chunks_exact(4)
+                        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                        .collect(),
+                )
+            }
+        };
+        Self {
+            width,
+            height,
+            format,
+            data,
+        }
+    }
+}

@@ -1,0 +1,15 @@
+//! The renderer: backends, shaders and (growing) the deferred pipeline.
+//!
+//! - [`backend`]: the [`Backend`](backend::Backend) trait and its implementations (`gl`,
+//!   `wgpu-vulkan`, `wgpu-gl`), chosen at run time by name.
+//! - [`shaders`]: the WGSL sources, validated and translated to GLSL with naga.
+//! - [`image`]: read-back images.
+//! - [`lit_cube`]: the first end-to-end scene, rendered identically on every backend.
+
+pub mod backend;
+pub mod image;
+pub mod lit_cube;
+pub mod shaders;
+
+pub use backend::{Backend, BackendKind};
+pub use image::{Image, ImageData};

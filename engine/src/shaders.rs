@@ -1,0 +1,219 @@
+//! The single source of every shader: WGSL files under `engine/shaders/`, embedded at build time.
+//!
+//! wgpu consumes WGSL directly. The GL backend gets GLSL 4.50 core from naga, with explicit
+//! `layout(binding = n)`: WGSL `@group(0) @binding(n)` becomes UBO binding `n` for uniform
+//! buffers and texture unit `n` for textures; a sampler is bound (with `glBindSampler`) to the
+//! unit of the texture it is used with, found from naga's reflection info.
+
+use naga::back::glsl;
+use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
+
+/// A WGSL shader file compiled into the crate.
+#[derive(Clone, Copy, Debug)]
+pub struct ShaderSource {
+    /// File name under `engine/shaders/`.
+    pub name: &'static str,
+    /// WGSL text.
+    pub wgsl: &'static str,
+}
+
+macro_rules! shader {
+    ($file:literal) => {
+        ShaderSource {
+            name: $file,
+            wgsl: include_str!(concat!("../shaders/", $file)),
+        }
+    };
+}
+
+/// The first end-to-end scene: a lit, textured cube.
+pub const LIT_CUBE: ShaderSource = shader!("lit_cube.wgsl");
+/// Orientation probe: a marker texture and a corner triangle.
+pub const ORIENTATION: ShaderSource = shader!("orientation.wgsl");
+/// Copies a depth texture into an R32F target (depth readback where copies are not allowed).
+pub const DEPTH_COPY: ShaderSource = shader!("depth_copy.wgsl");
+
+/// Every shader in `engine/shaders/` (a test checks the folder and this list agree).
+pub const ALL: &[ShaderSource] = &[LIT_CUBE, ORIENTATION, DEPTH_COPY];
+
+/// A shader that failed to parse, validate or translate.
+#[derive(Debug, thiserror::Error)]
+pub enum ShaderError {
+    /// WGSL syntax or type error.
+    #[error("{name}: WGSL parse error:\n{message}")]
+    Parse {
+        /// File name.
+        name: String,
+        /// naga's diagnostic.
+        message: String,
+    },
+    /// naga validation failed.
+    #[error("{name}: validation error:\n{message}")]
+    Validate {
+        /// File name.
+        name: String,
+        /// naga's diagnostic.
+        message: String,
+    },
+    /// GLSL generation failed for an entry point.
+    #[error("{name}: GLSL translation of `{entry}` failed: {message}")]
+    Translate {
+        /// File name.
+        name: String,
+        /// Entry point.
+        entry: String,
+        /// naga's message.
+        message: String,
+    },
+}
+
+/// A parsed and validated module.
+pub struct ValidatedModule {
+    /// File name, for messages.
+    pub name: String,
+    /// naga IR.
+    pub module: naga::Module,
+    /// Validation results (needed by naga's backends).
+    pub info: ModuleInfo,
+}
+
+/// Parses and validates WGSL.
+pub fn validate(name: &str, wgsl: &str) -> Result<ValidatedModule, ShaderError> {
+    let module = naga::front::wgsl::parse_str(wgsl).map_err(|e| ShaderError::Parse {
+        name: name.to_owned(),
+        message: e.emit_to_string_with_path(wgsl, name),
+    })?;
+    let info = Validator::new(ValidationFlags::all(), Capabilities::default())
+        .validate(&module)
+        .map_err(|e| ShaderError::Validate {
+            name: name.to_owned(),
+            message: e.emit_to_string_with_path(wgsl, name),
+        })?;
+    Ok(ValidatedModule {
+        name: name.to_owned(),
+        module,
+        info,
+    })
+}
+
+/// GLSL for one entry point, with what the GL backend needs to bind resources.
+pub struct GlslStage {
+    /// `#version 450 core` source.
+    pub source: String,
+    /// For each combined texture-sampler uniform: the texture's binding (its unit) and the
+    /// binding of the sampler used with it.
+    pub sampler_units: Vec<(u32, Option<u32>)>,
+}
+
+/// Translates one entry point to GLSL 4.50 core with explicit bindings.
+pub fn to_glsl(
+    module: &ValidatedModule,
+    stage: naga::ShaderStage,
+    entry: &str,
+) -> Result<GlslStage, ShaderError> {
+    let err = |message: String| ShaderError::Translate {
+        name: module.name.clone(),
+        entry: entry.to_owned(),
+        message,
+    };
+    let options = glsl::Options {
+        version: glsl::Version::Desktop(450),
+        // No y-flip or depth remap here: the GL backend sets glClipControl(UPPER_LEFT,
+        // ZERO_TO_ONE), which gives wgpu's conventions in fixed function.
+        writer_flags: glsl::WriterFlags::empty(),
+        binding_map: identity_binding_map(&module.module),
+        zero_initialize_workgroup_memory: true,
+    };
+    let pipeline_options = glsl::PipelineOptions {
+        shader_stage: stage,
+        entry_point: entry.to_owned(),
+        multiview: None,
+    };
+    let mut source = String::new();
+    let mut writer = glsl::Writer::new(
+        &mut source,
+        &module.module,
+        &module.info,
+        &options,
+        &pipeline_options,
+        naga::proc::BoundsCheckPolicies::default(),
+    )
+    .map_err(|e| err(e.to_string()))?;
+    let reflection = writer.write().map_err(|e| err(e.to_string()))?;
+    let binding_of = |var: naga::Handle<naga::GlobalVariable>| {
+        module.module.global_variables[var]
+            .binding
+            .as_ref()
+            .map(|b| b.binding)
+    };
+    let mut sampler_units = Vec::new();
+    for mapping in reflection.texture_mapping.values() {
+        let unit = binding_of(mapping.texture)
+            .ok_or_else(|| err("texture without @binding".to_owned()))?;
+        sampler_units.push((unit, mapping.sampler.and_then(binding_of)));
+    }
+    sampler_units.sort();
+    Ok(GlslStage {
+        source,
+        sampler_units,
+    })
+}
+
+/// Maps every `@group(0) @binding(n)` resource to GL binding point `n`.
+fn identity_binding_map(module: &naga::Module) -> glsl::BindingMap {
+    module
+        .global_variables
+        .iter()
+        .filter_map(|(_, var)| var.binding.clone())
+        .filter_map(|rb| u8::try_from(rb.binding).ok().map(|slot| (rb, slot)))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every shader parses, validates, and every entry point translates to GLSL 4.50 core.
+    #[test]
+    fn every_shader_validates_and_translates_to_glsl() {
+        for source in ALL {
+            let module = validate(source.name, source.wgsl).unwrap_or_else(|e| panic!("{e}"));
+            assert!(
+                !module.module.entry_points.is_empty(),
+                "{} has no entry points",
+                source.name
+            );
+            for ep in &module.module.entry_points {
+                let glsl = to_glsl(&module, ep.stage, &ep.name).unwrap_or_else(|e| panic!("{e}"));
+                assert!(
+                    glsl.source.starts_with("#version 450 core"),
+                    "{}::{} did not produce GLSL 450 core",
+                    source.name,
+                    ep.name
+                );
+                assert!(glsl.source.contains("void main()"));
+            }
+        }
+    }
+
+    /// The embedded list and the shader folder agree, so no file is left unvalidated.
+    #[test]
+    fn shader_folder_matches_embedded_list() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/shaders");
+        let mut on_disk: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .filter(|n| n.ends_with(".wgsl"))
+            .collect();
+        on_disk.sort();
+        let mut listed: Vec<String> = ALL.iter().map(|s| s.name.to_owned()).collect();
+        listed.sort();
+        assert_eq!(on_disk, listed, "engine/shaders/ and shaders::ALL differ");
+    }
+
+    #[test]
+    fn broken_wgsl_is_reported_with_the_file_name() {
+        let err = validate("broken.wgsl", "fn main( {").err().expect("must fail");
+        assert!(err.to_string().contains("broken.wgsl"), "{err}");
+    }
+}
