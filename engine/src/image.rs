@@ -59,7 +59,9 @@ impl Image {
     /// Converts raw texel bytes of `format` (tightly packed, top row first) into an image.
     pub fn from_texel_bytes(width: u32, height: u32, format: TextureFormat, bytes: &[u8]) -> Self {
         let data = match format {
-            TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb => ImageData::U8(bytes.to_vec()),
+            TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb => {
+                ImageData::U8(bytes.to_vec())
+            }
             TextureFormat::Rgba16Float => ImageData::F32(
                 bytes
                     .chunks_exact(2)

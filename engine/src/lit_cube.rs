@@ -1,1 +1,336 @@
-//! placeholder
+//! The first end-to-end scene: a textured cube lit by a directional light, drawn in one pass into
+//! an HDR RGBA16F target and a tone-mapped sRGB RGBA8 target with a D32F depth buffer.
+//!
+//! It exercises what every later pass relies on (vertex and index buffers, a uniform buffer, a
+//! sampled sRGB texture, several color attachments, depth testing, back-face culling, readback)
+//! and is the scene the backends are compared on.
+
+use glam::{Mat4, Vec3};
+
+use crate::backend::*;
+use crate::image::Image;
+use crate::shaders;
+
+/// What one render of the lit cube produces.
+pub struct LitCubeImages {
+    /// Linear radiance, RGBA16F.
+    pub hdr: Image,
+    /// Reinhard-tone-mapped, sRGB-encoded RGBA8.
+    pub ldr: Image,
+    /// Depth, D32F (1.0 where nothing was drawn).
+    pub depth: Image,
+    /// GPU time of the pass.
+    pub timings: Vec<PassTiming>,
+}
+
+/// Interleaved vertex: position, normal, uv.
+const VERTEX_FLOATS: usize = 8;
+
+/// A unit cube (-1..1) with outward normals, counter-clockwise faces and per-face UVs.
+pub fn cube_mesh() -> (Vec<f32>, Vec<u16>) {
+    let faces = [
+        Vec3::X,
+        Vec3::NEG_X,
+        Vec3::Y,
+        Vec3::NEG_Y,
+        Vec3::Z,
+        Vec3::NEG_Z,
+    ];
+    let mut vertices = Vec::with_capacity(24 * VERTEX_FLOATS);
+    let mut indices = Vec::with_capacity(36);
+    for (face, n) in faces.into_iter().enumerate() {
+        let v = if n.y.abs() > 0.5 {
+            Vec3::new(0.0, 0.0, -n.y)
+        } else {
+            Vec3::Y
+        };
+        let u = v.cross(n);
+        let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
+        for (a, b) in corners {
+            let p = n + u * a + v * b;
+            vertices.extend_from_slice(&[
+                p.x,
+                p.y,
+                p.z,
+                n.x,
+                n.y,
+                n.z,
+                (a + 1.0) / 2.0,
+                (1.0 - b) / 2.0,
+            ]);
+        }
+        let base = face as u16 * 4;
+        indices.extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+    }
+    (vertices, indices)
+}
+
+/// A 64x64 sRGB checkerboard (8x8 squares, warm and cool) with a white 8x8 marker in the top-left
+/// texel corner, so that orientation errors show up in the picture.
+pub fn checker_texture() -> (u32, Vec<u8>) {
+    let size = 64u32;
+    let mut texels = Vec::with_capacity((size * size * 4) as usize);
+    for y in 0..size {
+        for x in 0..size {
+            let texel: [u8; 4] = if x < 8 && y < 8 {
+                [255, 255, 255, 255]
+            } else if (x / 8 + y / 8) % 2 == 0 {
+                [200, 90, 40, 255]
+            } else {
+                [40, 110, 190, 255]
+            };
+            texels.extend_from_slice(&texel);
+        }
+    }
+    (size, texels)
+}
+
+/// Uniform block matching `Globals` in `lit_cube.wgsl`.
+fn globals() -> Vec<f32> {
+    let eye = Vec3::new(2.6, 2.1, 3.4);
+    let view = Mat4::look_at_rh(eye, Vec3::ZERO, Vec3::Y);
+    let projection = Mat4::perspective_rh(45f32.to_radians(), 1.0, 0.1, 20.0);
+    let model = Mat4::from_rotation_y(25f32.to_radians()) * Mat4::from_scale(Vec3::splat(0.9));
+    let light = Vec3::new(0.6, 1.0, 0.35).normalize();
+    let mut data = Vec::with_capacity(48);
+    data.extend_from_slice(&(projection * view).to_cols_array());
+    data.extend_from_slice(&model.to_cols_array());
+    data.extend_from_slice(&[light.x, light.y, light.z, 0.0]);
+    // An HDR light: lit faces exceed 1.0 in the RGBA16F target.
+    data.extend_from_slice(&[3.0, 2.9, 2.7, 0.0]);
+    data.extend_from_slice(&[0.06, 0.07, 0.09, 0.0]);
+    data.extend_from_slice(&[eye.x, eye.y, eye.z, 0.0]);
+    data
+}
+
+/// Renders the lit cube at `size` x `size` pixels and reads back all three targets. Every
+/// resource it creates is destroyed before it returns, also on error.
+pub fn render(backend: &mut dyn Backend, size: u32) -> Result<LitCubeImages> {
+    let mut created = Created::default();
+    let result = render_with(backend, size, &mut created);
+    created.destroy(backend);
+    result
+}
+
+/// Handles to destroy after a render.
+#[derive(Default)]
+struct Created {
+    textures: Vec<Handle<Texture>>,
+    buffers: Vec<Handle<Buffer>>,
+    samplers: Vec<Handle<Sampler>>,
+    shaders: Vec<Handle<Shader>>,
+    pipelines: Vec<Handle<Pipeline>>,
+}
+
+impl Created {
+    fn destroy(self, backend: &mut dyn Backend) {
+        // Errors here would only repeat an error already being returned.
+        self.pipelines
+            .into_iter()
+            .for_each(|h| drop(backend.destroy_pipeline(h)));
+        self.shaders
+            .into_iter()
+            .for_each(|h| drop(backend.destroy_shader(h)));
+        self.samplers
+            .into_iter()
+            .for_each(|h| drop(backend.destroy_sampler(h)));
+        self.buffers
+            .into_iter()
+            .for_each(|h| drop(backend.destroy_buffer(h)));
+        self.textures
+            .into_iter()
+            .for_each(|h| drop(backend.destroy_texture(h)));
+    }
+}
+
+fn render_with(
+    backend: &mut dyn Backend,
+    size: u32,
+    created: &mut Created,
+) -> Result<LitCubeImages> {
+    let (vertices, indices) = cube_mesh();
+    let vertex_buffer = backend.create_buffer_with_data(
+        "cube vertices",
+        BufferUsage::Vertex,
+        bytemuck::cast_slice(&vertices),
+    )?;
+    created.buffers.push(vertex_buffer);
+    let index_buffer = backend.create_buffer_with_data(
+        "cube indices",
+        BufferUsage::Index,
+        bytemuck::cast_slice(&indices),
+    )?;
+    created.buffers.push(index_buffer);
+    let uniforms = backend.create_buffer_with_data(
+        "globals",
+        BufferUsage::Uniform,
+        bytemuck::cast_slice(&globals()),
+    )?;
+    created.buffers.push(uniforms);
+
+    let (tex_size, texels) = checker_texture();
+    let albedo = backend.create_texture(&TextureDesc::d2(
+        "checker",
+        tex_size,
+        tex_size,
+        TextureFormat::Rgba8UnormSrgb,
+    ))?;
+    created.textures.push(albedo);
+    backend.write_texture(albedo, Subresource::default(), &texels)?;
+    let sampler = backend.create_sampler(&SamplerDesc::linear("checker", AddressMode::Repeat))?;
+    created.samplers.push(sampler);
+
+    let hdr = backend.create_texture(&TextureDesc::d2(
+        "hdr",
+        size,
+        size,
+        TextureFormat::Rgba16Float,
+    ))?;
+    created.textures.push(hdr);
+    let ldr = backend.create_texture(&TextureDesc::d2(
+        "ldr",
+        size,
+        size,
+        TextureFormat::Rgba8UnormSrgb,
+    ))?;
+    created.textures.push(ldr);
+    let depth = backend.create_texture(&TextureDesc::d2(
+        "depth",
+        size,
+        size,
+        TextureFormat::Depth32Float,
+    ))?;
+    created.textures.push(depth);
+
+    let shader = backend.create_shader(&ShaderDesc {
+        name: shaders::LIT_CUBE.name.to_owned(),
+        wgsl: shaders::LIT_CUBE.wgsl.to_owned(),
+    })?;
+    created.shaders.push(shader);
+    let float = |location, format, offset| VertexAttribute {
+        location,
+        format,
+        offset,
+    };
+    let pipeline = backend.create_pipeline(&PipelineDesc {
+        label: "lit cube".to_owned(),
+        shader,
+        vertex_entry: "vs_main".to_owned(),
+        fragment_entry: Some("fs_main".to_owned()),
+        vertex_buffers: vec![VertexBufferLayout {
+            stride: (VERTEX_FLOATS * 4) as u32,
+            attributes: vec![
+                float(0, VertexFormat::Float32x3, 0),
+                float(1, VertexFormat::Float32x3, 12),
+                float(2, VertexFormat::Float32x2, 24),
+            ],
+        }],
+        bindings: vec![
+            BindingLayout {
+                binding: 0,
+                kind: BindingKind::UniformBuffer,
+            },
+            BindingLayout {
+                binding: 1,
+                kind: BindingKind::Texture {
+                    sample_type: TextureSampleType::Float,
+                    view: TextureViewKind::D2,
+                },
+            },
+            BindingLayout {
+                binding: 2,
+                kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
+            },
+        ],
+        color_targets: vec![
+            ColorTarget {
+                format: TextureFormat::Rgba16Float,
+                blend: None,
+            },
+            ColorTarget {
+                format: TextureFormat::Rgba8UnormSrgb,
+                blend: None,
+            },
+        ],
+        depth: Some(DepthState {
+            format: TextureFormat::Depth32Float,
+            write: true,
+            compare: CompareFunction::Less,
+        }),
+        topology: Topology::TriangleList,
+        cull: CullMode::Back,
+    })?;
+    created.pipelines.push(pipeline);
+
+    let background = [0.02, 0.02, 0.03, 1.0];
+    let timings = backend.submit(&[RenderPass {
+        name: "lit_cube".to_owned(),
+        color_attachments: vec![
+            ColorAttachment {
+                texture: hdr,
+                subresource: Subresource::default(),
+                load: LoadOp::Clear(background),
+            },
+            ColorAttachment {
+                texture: ldr,
+                subresource: Subresource::default(),
+                load: LoadOp::Clear(background),
+            },
+        ],
+        depth_attachment: Some(DepthAttachment {
+            texture: depth,
+            subresource: Subresource::default(),
+            load: LoadOp::Clear(1.0),
+        }),
+        viewport: None,
+        draws: vec![Draw {
+            pipeline,
+            bindings: vec![
+                Binding {
+                    binding: 0,
+                    resource: BindingResource::Buffer(uniforms),
+                },
+                Binding {
+                    binding: 1,
+                    resource: BindingResource::Texture(albedo),
+                },
+                Binding {
+                    binding: 2,
+                    resource: BindingResource::Sampler(sampler),
+                },
+            ],
+            vertex_buffers: vec![vertex_buffer],
+            index_buffer: Some((index_buffer, IndexFormat::U16)),
+            count: indices.len() as u32,
+        }],
+    }])?;
+    Ok(LitCubeImages {
+        hdr: backend.read_texture(hdr, Subresource::default())?,
+        ldr: backend.read_texture(ldr, Subresource::default())?,
+        depth: backend.read_texture(depth, Subresource::default())?,
+        timings,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cube_faces_wind_counter_clockwise_seen_from_outside() {
+        let (vertices, indices) = cube_mesh();
+        let position = |i: u16| {
+            let v = &vertices[i as usize * VERTEX_FLOATS..];
+            (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]))
+        };
+        for tri in indices.chunks_exact(3) {
+            let (a, n) = position(tri[0]);
+            let (b, _) = position(tri[1]);
+            let (c, _) = position(tri[2]);
+            assert!(
+                (b - a).cross(c - a).dot(n) > 0.0,
+                "triangle {tri:?} winds clockwise"
+            );
+        }
+    }
+}

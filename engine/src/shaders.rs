@@ -30,7 +30,7 @@ macro_rules! shader {
 pub const LIT_CUBE: ShaderSource = shader!("lit_cube.wgsl");
 /// Orientation probe: a marker texture and a corner triangle.
 pub const ORIENTATION: ShaderSource = shader!("orientation.wgsl");
-/// Copies a depth texture into an R32F target (depth readback where copies are not allowed).
+/// Packs a depth texture's f32 bits into an RGBA8 target (exact depth readback on wgpu).
 pub const DEPTH_COPY: ShaderSource = shader!("depth_copy.wgsl");
 
 /// Every shader in `engine/shaders/` (a test checks the folder and this list agree).
@@ -164,7 +164,7 @@ fn identity_binding_map(module: &naga::Module) -> glsl::BindingMap {
     module
         .global_variables
         .iter()
-        .filter_map(|(_, var)| var.binding.clone())
+        .filter_map(|(_, var)| var.binding)
         .filter_map(|rb| u8::try_from(rb.binding).ok().map(|slot| (rb, slot)))
         .collect()
 }
@@ -213,7 +213,9 @@ mod tests {
 
     #[test]
     fn broken_wgsl_is_reported_with_the_file_name() {
-        let err = validate("broken.wgsl", "fn main( {").err().expect("must fail");
+        let err = validate("broken.wgsl", "fn main( {")
+            .err()
+            .expect("must fail");
         assert!(err.to_string().contains("broken.wgsl"), "{err}");
     }
 }

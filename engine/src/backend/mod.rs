@@ -205,7 +205,12 @@ pub trait Backend {
     /// Creates a texture (contents undefined until written or rendered).
     fn create_texture(&mut self, desc: &TextureDesc) -> Result<Handle<Texture>>;
     /// Uploads one mip of one layer: tightly packed texels, top row first.
-    fn write_texture(&mut self, texture: Handle<Texture>, at: Subresource, data: &[u8]) -> Result<()>;
+    fn write_texture(
+        &mut self,
+        texture: Handle<Texture>,
+        at: Subresource,
+        data: &[u8],
+    ) -> Result<()>;
     /// Destroys a texture.
     fn destroy_texture(&mut self, texture: Handle<Texture>) -> Result<()>;
 
@@ -241,7 +246,7 @@ pub trait Backend {
     fn live_resources(&self) -> usize;
 }
 
-impl dyn Backend {
+impl<'a> dyn Backend + 'a {
     /// Creates a buffer and fills it.
     pub fn create_buffer_with_data(
         &mut self,
@@ -266,7 +271,9 @@ impl dyn Backend {
 pub fn create(kind: BackendKind) -> Result<Box<dyn Backend>> {
     match kind {
         BackendKind::Gl => Ok(Box::new(gl::GlBackend::new()?)),
-        BackendKind::WgpuVulkan | BackendKind::WgpuGl => Ok(Box::new(wgpu::WgpuBackend::new(kind)?)),
+        BackendKind::WgpuVulkan | BackendKind::WgpuGl => {
+            Ok(Box::new(wgpu::WgpuBackend::new(kind)?))
+        }
     }
 }
 
@@ -310,6 +317,43 @@ pub fn probe(kind: BackendKind) -> BackendStatus {
             info: None,
         },
     }
+}
+
+/// Checks a texture descriptor has a size and at least one mip.
+pub(crate) fn check_texture_desc(desc: &TextureDesc) -> Result<()> {
+    if desc.width == 0 || desc.height == 0 || desc.mip_levels == 0 {
+        return Err(BackendError::InvalidData(format!(
+            "texture `{}`: zero size or no mips",
+            desc.label
+        )));
+    }
+    Ok(())
+}
+
+/// Checks a buffer descriptor's size (positive, a multiple of 4).
+pub(crate) fn check_buffer_desc(desc: &BufferDesc) -> Result<()> {
+    if desc.size == 0 || !desc.size.is_multiple_of(4) {
+        return Err(BackendError::InvalidData(format!(
+            "buffer `{}`: size {} is not a positive multiple of 4",
+            desc.label, desc.size
+        )));
+    }
+    Ok(())
+}
+
+/// Checks that a write of `len` bytes at `offset` is 4-byte aligned and fits a buffer of `size`.
+pub(crate) fn check_buffer_write(
+    usage: BufferUsage,
+    size: u64,
+    offset: u64,
+    len: usize,
+) -> Result<()> {
+    if !offset.is_multiple_of(4) || !len.is_multiple_of(4) || offset + len as u64 > size {
+        return Err(BackendError::InvalidData(format!(
+            "{usage:?} buffer write of {len} bytes at {offset} does not fit its {size} bytes (4-byte aligned)"
+        )));
+    }
+    Ok(())
 }
 
 /// Checks that `data` holds exactly one tightly packed image of `desc` at mip `at.mip`.

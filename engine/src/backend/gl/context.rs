@@ -9,7 +9,8 @@ use crate::backend::{BackendError, BackendKind};
 
 /// `EGL_PLATFORM_SURFACELESS_MESA` (EGL_MESA_platform_surfaceless).
 const PLATFORM_SURFACELESS_MESA: egl::Enum = 0x31DD;
-const FIX: &str = "install Mesa's EGL and llvmpipe: apt-get install -y libegl1 libegl-mesa0 libgl1-mesa-dri";
+const FIX: &str =
+    "install Mesa's EGL and llvmpipe: apt-get install -y libegl1 libegl-mesa0 libgl1-mesa-dri";
 
 type Egl = egl::DynamicInstance<egl::EGL1_5>;
 
@@ -20,7 +21,8 @@ fn egl_library() -> Result<&'static Egl, String> {
     EGL.get_or_init(|| {
         // SAFETY: loads the system libEGL (libEGL.so.1) and resolves the EGL 1.5 entry points;
         // khronos-egl checks every required symbol is present before returning it.
-        unsafe { Egl::load_required() }.map_err(|e| format!("cannot load libEGL.so.1 with EGL 1.5: {e}"))
+        unsafe { Egl::load_required() }
+            .map_err(|e| format!("cannot load libEGL.so.1 with EGL 1.5: {e}"))
     })
     .as_ref()
     .map_err(Clone::clone)
@@ -51,7 +53,11 @@ impl EglContext {
         // SAFETY: EGL_DEFAULT_DISPLAY with an empty attribute list is valid for the surfaceless
         // platform; failure returns an error rather than an invalid display.
         let display = unsafe {
-            egl.get_platform_display(PLATFORM_SURFACELESS_MESA, egl::DEFAULT_DISPLAY, &[egl::ATTRIB_NONE])
+            egl.get_platform_display(
+                PLATFORM_SURFACELESS_MESA,
+                egl::DEFAULT_DISPLAY,
+                &[egl::ATTRIB_NONE],
+            )
         }
         .or_else(|_| {
             // SAFETY: as above, for the implementation's default display (non-Mesa EGL).
@@ -62,10 +68,26 @@ impl EglContext {
             .map_err(|e| unavailable(format!("eglInitialize failed: {e}")))?;
         egl.bind_api(egl::OPENGL_API)
             .map_err(|e| unavailable(format!("EGL has no desktop OpenGL API: {e}")))?;
-        let config = egl
-            .choose_first_config(display, &[egl::RENDERABLE_TYPE, egl::OPENGL_BIT, egl::NONE])
-            .map_err(|e| unavailable(format!("eglChooseConfig failed: {e}")))?
-            .ok_or_else(|| unavailable("EGL offers no OpenGL-renderable config".to_owned()))?;
+        let extensions = egl
+            .query_string(Some(display), egl::EXTENSIONS)
+            .map(|e| e.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let config = if extensions
+            .split(' ')
+            .any(|e| e == "EGL_KHR_no_config_context")
+        {
+            // SAFETY: EGL_NO_CONFIG_KHR is the null config, valid for eglCreateContext when the
+            // display has EGL_KHR_no_config_context (checked above); there is no surface.
+            unsafe { egl::Config::from_ptr(std::ptr::null_mut()) }
+        } else {
+            egl.choose_first_config(display, &[egl::RENDERABLE_TYPE, egl::OPENGL_BIT, egl::NONE])
+                .map_err(|e| unavailable(format!("eglChooseConfig failed: {e}")))?
+                .ok_or_else(|| {
+                    unavailable(
+                        "EGL has neither EGL_KHR_no_config_context nor an OpenGL config".to_owned(),
+                    )
+                })?
+        };
         let mut failures = Vec::new();
         for (major, minor) in [(4, 6), (4, 5)] {
             let mut attributes = vec![

@@ -17,7 +17,9 @@ pub(super) fn internal_format(f: TextureFormat) -> u32 {
 /// (format, type) of client data for uploads, matching [`TextureFormat::texel_size`].
 pub(super) fn upload_format(f: TextureFormat) -> (u32, u32) {
     match f {
-        TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb => (glow::RGBA, glow::UNSIGNED_BYTE),
+        TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb => {
+            (glow::RGBA, glow::UNSIGNED_BYTE)
+        }
         TextureFormat::Rgba16Float => (glow::RGBA, glow::HALF_FLOAT),
         TextureFormat::Rgba32Float => (glow::RGBA, glow::FLOAT),
         TextureFormat::R32Float => (glow::RED, glow::FLOAT),
@@ -28,7 +30,9 @@ pub(super) fn upload_format(f: TextureFormat) -> (u32, u32) {
 /// (format, type) for `glReadPixels`: 8-bit stays 8-bit, everything else reads as f32.
 pub(super) fn readback_format(f: TextureFormat) -> (u32, u32) {
     match f {
-        TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb => (glow::RGBA, glow::UNSIGNED_BYTE),
+        TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb => {
+            (glow::RGBA, glow::UNSIGNED_BYTE)
+        }
         TextureFormat::Rgba16Float | TextureFormat::Rgba32Float => (glow::RGBA, glow::FLOAT),
         TextureFormat::R32Float => (glow::RED, glow::FLOAT),
         TextureFormat::Depth32Float => (glow::DEPTH_COMPONENT, glow::FLOAT),

@@ -74,11 +74,13 @@ impl GlBackend {
         let context = EglContext::new(debug)?;
         let mut gl = context.load_gl();
         let debug_errors = Arc::new(Mutex::new(Vec::new()));
-        let clip_control = context.clip_control().ok_or_else(|| BackendError::Unavailable {
-            backend: BackendKind::Gl.name(),
-            reason: "glClipControl is missing (needs OpenGL 4.5)".to_owned(),
-            fix: "use Mesa 20 or newer".to_owned(),
-        })?;
+        let clip_control = context
+            .clip_control()
+            .ok_or_else(|| BackendError::Unavailable {
+                backend: BackendKind::Gl.name(),
+                reason: "glClipControl is missing (needs OpenGL 4.5)".to_owned(),
+                fix: "use Mesa 20 or newer".to_owned(),
+            })?;
         // SAFETY: the context was made current by EglContext::new; these calls only query
         // strings and set global state.
         let info = unsafe {
@@ -86,7 +88,10 @@ impl GlBackend {
             if !version.is_embedded && (version.major, version.minor) < (4, 5) {
                 return Err(BackendError::Unavailable {
                     backend: BackendKind::Gl.name(),
-                    reason: format!("driver gave OpenGL {}.{}, 4.5 core is required", version.major, version.minor),
+                    reason: format!(
+                        "driver gave OpenGL {}.{}, 4.5 core is required",
+                        version.major, version.minor
+                    ),
                     fix: "use Mesa 20 or newer (llvmpipe)".to_owned(),
                 });
             }
@@ -98,7 +103,9 @@ impl GlBackend {
                     if ty == glow::DEBUG_TYPE_ERROR {
                         log::error!("gl: {message}");
                         sink.lock().expect("debug sink").push(message.to_owned());
-                    } else if severity == glow::DEBUG_SEVERITY_HIGH || severity == glow::DEBUG_SEVERITY_MEDIUM {
+                    } else if severity == glow::DEBUG_SEVERITY_HIGH
+                        || severity == glow::DEBUG_SEVERITY_MEDIUM
+                    {
                         log::warn!("gl: {message}");
                     } else {
                         log::debug!("gl: {message}");
@@ -141,7 +148,12 @@ impl GlBackend {
 
     /// Turns pending GL errors (glGetError and debug output) into a driver error for `what`.
     fn check_errors(&self, what: &str) -> Result<()> {
-        let mut messages: Vec<String> = self.debug_errors.lock().expect("debug sink").drain(..).collect();
+        let mut messages: Vec<String> = self
+            .debug_errors
+            .lock()
+            .expect("debug sink")
+            .drain(..)
+            .collect();
         loop {
             // SAFETY: see module docs; glGetError has no preconditions.
             let code = unsafe { self.gl.get_error() };
@@ -160,7 +172,10 @@ impl GlBackend {
     fn compile(&self, stage: u32, name: &str, source: &str) -> Result<glow::Shader> {
         // SAFETY: see module docs.
         unsafe {
-            let shader = self.gl.create_shader(stage).map_err(|e| driver_error(name, e))?;
+            let shader = self
+                .gl
+                .create_shader(stage)
+                .map_err(|e| driver_error(name, e))?;
             self.gl.shader_source(shader, source);
             self.gl.compile_shader(shader);
             if !self.gl.get_shader_compile_status(shader) {
@@ -169,7 +184,9 @@ impl GlBackend {
                 return Err(BackendError::Shader {
                     backend: BackendKind::Gl.name(),
                     name: name.to_owned(),
-                    message: format!("GLSL compile failed: {log}\n--- generated GLSL ---\n{source}"),
+                    message: format!(
+                        "GLSL compile failed: {log}\n--- generated GLSL ---\n{source}"
+                    ),
                 });
             }
             Ok(shader)
@@ -177,7 +194,13 @@ impl GlBackend {
     }
 
     /// Attaches one mip/layer of `texture` to `attachment` of the bound `target` framebuffer.
-    fn attach(&self, target: u32, attachment: u32, texture: Handle<Texture>, at: Subresource) -> Result<(u32, u32)> {
+    fn attach(
+        &self,
+        target: u32,
+        attachment: u32,
+        texture: Handle<Texture>,
+        at: Subresource,
+    ) -> Result<(u32, u32)> {
         let tex = self.textures.get(texture)?;
         if at.mip >= tex.desc.mip_levels || at.layer >= tex.desc.kind.layers() {
             return Err(BackendError::InvalidData(format!(
@@ -244,13 +267,17 @@ impl GlBackend {
                 CullMode::None => gl.disable(glow::CULL_FACE),
                 CullMode::Front | CullMode::Back => {
                     gl.enable(glow::CULL_FACE);
-                    gl.cull_face(if desc.cull == CullMode::Front { glow::FRONT } else { glow::BACK });
+                    gl.cull_face(if desc.cull == CullMode::Front {
+                        glow::FRONT
+                    } else {
+                        glow::BACK
+                    });
                 }
             }
-            // Counter-clockwise in normalized device coordinates is front-facing, as in wgpu;
-            // GL_UPPER_LEFT flips window y, and GL evaluates winding in window space, so the
-            // counter-clockwise NDC triangle is clockwise there.
-            gl.front_face(glow::CW);
+            // Counter-clockwise in normalized device coordinates is front-facing, as in wgpu.
+            // glClipControl(GL_UPPER_LEFT) flips window y but also flips the facing rule, so
+            // the NDC winding keeps its meaning (pinned by the orientation test).
+            gl.front_face(glow::CCW);
             for (index, target) in desc.color_targets.iter().enumerate() {
                 let index = index as u32;
                 gl.color_mask_draw_buffer(index, true, true, true, true);
@@ -281,9 +308,11 @@ impl GlBackend {
                         ))
                     })?;
                 match bound.resource {
-                    BindingResource::Buffer(b) => {
-                        gl.bind_buffer_base(glow::UNIFORM_BUFFER, layout.binding, Some(self.buffers.get(b)?.raw))
-                    }
+                    BindingResource::Buffer(b) => gl.bind_buffer_base(
+                        glow::UNIFORM_BUFFER,
+                        layout.binding,
+                        Some(self.buffers.get(b)?.raw),
+                    ),
                     BindingResource::Texture(t) => {
                         let tex = self.textures.get(t)?;
                         gl.active_texture(glow::TEXTURE0 + layout.binding);
@@ -310,13 +339,26 @@ impl GlBackend {
                 };
                 gl.bind_sampler(unit, sampler);
             }
-            for (slot, (buffer, layout)) in draw.vertex_buffers.iter().zip(&desc.vertex_buffers).enumerate() {
-                gl.bind_vertex_buffer(slot as u32, Some(self.buffers.get(*buffer)?.raw), 0, layout.stride as i32);
+            for (slot, (buffer, layout)) in draw
+                .vertex_buffers
+                .iter()
+                .zip(&desc.vertex_buffers)
+                .enumerate()
+            {
+                gl.bind_vertex_buffer(
+                    slot as u32,
+                    Some(self.buffers.get(*buffer)?.raw),
+                    0,
+                    layout.stride as i32,
+                );
             }
             let mode = conv::topology(desc.topology);
             match draw.index_buffer {
                 Some((buffer, format)) => {
-                    gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(self.buffers.get(buffer)?.raw));
+                    gl.bind_buffer(
+                        glow::ELEMENT_ARRAY_BUFFER,
+                        Some(self.buffers.get(buffer)?.raw),
+                    );
                     gl.draw_elements(mode, draw.count as i32, conv::index_type(format), 0);
                 }
                 None => gl.draw_arrays(mode, 0, draw.count as i32),
@@ -326,10 +368,15 @@ impl GlBackend {
     }
 
     /// Runs one pass into a temporary framebuffer.
-    fn execute_pass(&self, pass: &RenderPass, queries: Option<(glow::Query, glow::Query)>) -> Result<()> {
+    fn execute_pass(
+        &self,
+        pass: &RenderPass,
+        queries: Option<(glow::Query, glow::Query)>,
+    ) -> Result<()> {
         let gl = &self.gl;
         // SAFETY: see module docs.
-        let framebuffer = unsafe { gl.create_framebuffer() }.map_err(|e| driver_error(&pass.name, e))?;
+        let framebuffer =
+            unsafe { gl.create_framebuffer() }.map_err(|e| driver_error(&pass.name, e))?;
         let result = (|| {
             // SAFETY: see module docs; `framebuffer` was just created.
             unsafe { gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, Some(framebuffer)) };
@@ -344,7 +391,12 @@ impl GlBackend {
                 size.get_or_insert(s);
             }
             if let Some(depth) = &pass.depth_attachment {
-                let s = self.attach(glow::DRAW_FRAMEBUFFER, glow::DEPTH_ATTACHMENT, depth.texture, depth.subresource)?;
+                let s = self.attach(
+                    glow::DRAW_FRAMEBUFFER,
+                    glow::DEPTH_ATTACHMENT,
+                    depth.texture,
+                    depth.subresource,
+                )?;
                 size.get_or_insert(s);
             }
             let (width, height) = size.ok_or_else(|| {
@@ -362,7 +414,10 @@ impl GlBackend {
                 }
                 let status = gl.check_framebuffer_status(glow::DRAW_FRAMEBUFFER);
                 if status != glow::FRAMEBUFFER_COMPLETE {
-                    return Err(driver_error(&pass.name, format!("framebuffer incomplete (0x{status:04x})")));
+                    return Err(driver_error(
+                        &pass.name,
+                        format!("framebuffer incomplete (0x{status:04x})"),
+                    ));
                 }
                 if let Some((begin, _)) = queries {
                     gl.query_counter(begin, glow::TIMESTAMP);
@@ -422,14 +477,14 @@ impl Backend for GlBackend {
 
     fn create_texture(&mut self, desc: &TextureDesc) -> Result<Handle<Texture>> {
         self.context.make_current()?;
-        if desc.width == 0 || desc.height == 0 || desc.mip_levels == 0 {
-            return Err(BackendError::InvalidData(format!("texture `{}`: zero size or no mips", desc.label)));
-        }
+        check_texture_desc(desc)?;
         let target = conv::target(desc.kind);
         let gl = &self.gl;
         // SAFETY: see module docs.
         let raw = unsafe {
-            let raw = gl.create_texture().map_err(|e| driver_error(&desc.label, e))?;
+            let raw = gl
+                .create_texture()
+                .map_err(|e| driver_error(&desc.label, e))?;
             gl.bind_texture(target, Some(raw));
             let format = conv::internal_format(desc.format);
             match desc.kind {
@@ -459,10 +514,18 @@ impl Backend for GlBackend {
             raw
         };
         self.check_errors(&format!("texture `{}`", desc.label))?;
-        Ok(self.textures.insert(GlTexture { raw, desc: desc.clone() }))
+        Ok(self.textures.insert(GlTexture {
+            raw,
+            desc: desc.clone(),
+        }))
     }
 
-    fn write_texture(&mut self, texture: Handle<Texture>, at: Subresource, data: &[u8]) -> Result<()> {
+    fn write_texture(
+        &mut self,
+        texture: Handle<Texture>,
+        at: Subresource,
+        data: &[u8],
+    ) -> Result<()> {
         self.context.make_current()?;
         let tex = self.textures.get(texture)?;
         let (w, h) = check_upload(&tex.desc, at, data)?;
@@ -474,7 +537,15 @@ impl Backend for GlBackend {
             self.gl.bind_texture(target, Some(tex.raw));
             match tex.desc.kind {
                 TextureKind::D2 => self.gl.tex_sub_image_2d(
-                    target, at.mip as i32, 0, 0, w as i32, h as i32, format, ty, pixels,
+                    target,
+                    at.mip as i32,
+                    0,
+                    0,
+                    w as i32,
+                    h as i32,
+                    format,
+                    ty,
+                    pixels,
                 ),
                 TextureKind::Cube => self.gl.tex_sub_image_2d(
                     glow::TEXTURE_CUBE_MAP_POSITIVE_X + at.layer,
@@ -516,20 +587,23 @@ impl Backend for GlBackend {
 
     fn create_buffer(&mut self, desc: &BufferDesc) -> Result<Handle<Buffer>> {
         self.context.make_current()?;
-        if desc.size == 0 || desc.size % 4 != 0 {
-            return Err(BackendError::InvalidData(format!(
-                "buffer `{}`: size {} is not a positive multiple of 4",
-                desc.label, desc.size
-            )));
-        }
+        check_buffer_desc(desc)?;
         let target = conv::buffer_target(desc.usage);
         // SAFETY: see module docs. An index buffer is bound to ARRAY_BUFFER for creation so that
         // no vertex array's element binding is touched.
         let raw = unsafe {
-            let raw = self.gl.create_buffer().map_err(|e| driver_error(&desc.label, e))?;
-            let bind_target = if target == glow::ELEMENT_ARRAY_BUFFER { glow::ARRAY_BUFFER } else { target };
+            let raw = self
+                .gl
+                .create_buffer()
+                .map_err(|e| driver_error(&desc.label, e))?;
+            let bind_target = if target == glow::ELEMENT_ARRAY_BUFFER {
+                glow::ARRAY_BUFFER
+            } else {
+                target
+            };
             self.gl.bind_buffer(bind_target, Some(raw));
-            self.gl.buffer_data_size(bind_target, desc.size as i32, glow::DYNAMIC_DRAW);
+            self.gl
+                .buffer_data_size(bind_target, desc.size as i32, glow::DYNAMIC_DRAW);
             let zeros = vec![0u8; desc.size as usize];
             self.gl.buffer_sub_data_u8_slice(bind_target, 0, &zeros);
             self.gl.bind_buffer(bind_target, None);
@@ -546,18 +620,12 @@ impl Backend for GlBackend {
     fn write_buffer(&mut self, buffer: Handle<Buffer>, offset: u64, data: &[u8]) -> Result<()> {
         self.context.make_current()?;
         let buf = self.buffers.get(buffer)?;
-        if offset % 4 != 0 || data.len() % 4 != 0 || offset + data.len() as u64 > buf.size {
-            return Err(BackendError::InvalidData(format!(
-                "{:?} buffer write of {} bytes at {offset} does not fit its {} bytes (4-byte aligned)",
-                buf.usage,
-                data.len(),
-                buf.size
-            )));
-        }
+        check_buffer_write(buf.usage, buf.size, offset, data.len())?;
         // SAFETY: see module docs; the range was checked against the buffer's size.
         unsafe {
             self.gl.bind_buffer(glow::COPY_WRITE_BUFFER, Some(buf.raw));
-            self.gl.buffer_sub_data_u8_slice(glow::COPY_WRITE_BUFFER, offset as i32, data);
+            self.gl
+                .buffer_sub_data_u8_slice(glow::COPY_WRITE_BUFFER, offset as i32, data);
             self.gl.bind_buffer(glow::COPY_WRITE_BUFFER, None);
         }
         self.check_errors("buffer write")
@@ -576,12 +644,18 @@ impl Backend for GlBackend {
         let gl = &self.gl;
         // SAFETY: see module docs.
         let raw = unsafe {
-            let raw = gl.create_sampler().map_err(|e| driver_error(&desc.label, e))?;
+            let raw = gl
+                .create_sampler()
+                .map_err(|e| driver_error(&desc.label, e))?;
             let wrap = conv::address(desc.address_mode);
             gl.sampler_parameter_i32(raw, glow::TEXTURE_WRAP_S, wrap);
             gl.sampler_parameter_i32(raw, glow::TEXTURE_WRAP_T, wrap);
             gl.sampler_parameter_i32(raw, glow::TEXTURE_WRAP_R, wrap);
-            gl.sampler_parameter_i32(raw, glow::TEXTURE_MAG_FILTER, conv::mag_filter(desc.mag_filter));
+            gl.sampler_parameter_i32(
+                raw,
+                glow::TEXTURE_MAG_FILTER,
+                conv::mag_filter(desc.mag_filter),
+            );
             gl.sampler_parameter_i32(
                 raw,
                 glow::TEXTURE_MIN_FILTER,
@@ -590,8 +664,16 @@ impl Backend for GlBackend {
             gl.sampler_parameter_f32(raw, glow::TEXTURE_MIN_LOD, 0.0);
             gl.sampler_parameter_f32(raw, glow::TEXTURE_MAX_LOD, 32.0);
             if let Some(compare) = desc.compare {
-                gl.sampler_parameter_i32(raw, glow::TEXTURE_COMPARE_MODE, glow::COMPARE_REF_TO_TEXTURE as i32);
-                gl.sampler_parameter_i32(raw, glow::TEXTURE_COMPARE_FUNC, conv::compare(compare) as i32);
+                gl.sampler_parameter_i32(
+                    raw,
+                    glow::TEXTURE_COMPARE_MODE,
+                    glow::COMPARE_REF_TO_TEXTURE as i32,
+                );
+                gl.sampler_parameter_i32(
+                    raw,
+                    glow::TEXTURE_COMPARE_FUNC,
+                    conv::compare(compare) as i32,
+                );
             }
             raw
         };
@@ -608,11 +690,12 @@ impl Backend for GlBackend {
     }
 
     fn create_shader(&mut self, desc: &ShaderDesc) -> Result<Handle<Shader>> {
-        let module = shaders::validate(&desc.name, &desc.wgsl).map_err(|e| BackendError::Shader {
-            backend: BackendKind::Gl.name(),
-            name: desc.name.clone(),
-            message: e.to_string(),
-        })?;
+        let module =
+            shaders::validate(&desc.name, &desc.wgsl).map_err(|e| BackendError::Shader {
+                backend: BackendKind::Gl.name(),
+                name: desc.name.clone(),
+                message: e.to_string(),
+            })?;
         Ok(self.shaders.insert(module))
     }
 
@@ -636,10 +719,16 @@ impl Backend for GlBackend {
             translate(naga::ShaderStage::Vertex, &desc.vertex_entry)?,
         )];
         if let Some(entry) = &desc.fragment_entry {
-            stages.push((glow::FRAGMENT_SHADER, entry, translate(naga::ShaderStage::Fragment, entry)?));
+            stages.push((
+                glow::FRAGMENT_SHADER,
+                entry,
+                translate(naga::ShaderStage::Fragment, entry)?,
+            ));
         }
-        let mut sampler_units: Vec<(u32, Option<u32>)> =
-            stages.iter().flat_map(|(_, _, s)| s.sampler_units.clone()).collect();
+        let mut sampler_units: Vec<(u32, Option<u32>)> = stages
+            .iter()
+            .flat_map(|(_, _, s)| s.sampler_units.clone())
+            .collect();
         sampler_units.sort();
         sampler_units.dedup();
         let mut compiled = Vec::new();
@@ -656,7 +745,9 @@ impl Backend for GlBackend {
         let gl = &self.gl;
         // SAFETY: see module docs; the shaders were compiled above and are deleted once linked.
         let (program, vao) = unsafe {
-            let program = gl.create_program().map_err(|e| driver_error(&desc.label, e))?;
+            let program = gl
+                .create_program()
+                .map_err(|e| driver_error(&desc.label, e))?;
             for &shader in &compiled {
                 gl.attach_shader(program, shader);
             }
@@ -675,7 +766,9 @@ impl Backend for GlBackend {
                 });
             }
             gl.object_label(glow::PROGRAM, program.0.get(), Some(&desc.label));
-            let vao = gl.create_vertex_array().map_err(|e| driver_error(&desc.label, e))?;
+            let vao = gl
+                .create_vertex_array()
+                .map_err(|e| driver_error(&desc.label, e))?;
             gl.bind_vertex_array(Some(vao));
             for (slot, layout) in desc.vertex_buffers.iter().enumerate() {
                 for attribute in &layout.attributes {
@@ -771,19 +864,29 @@ impl Backend for GlBackend {
         let label = self.textures.get(texture)?.desc.label.clone();
         let gl = &self.gl;
         // SAFETY: see module docs.
-        let framebuffer = unsafe { gl.create_framebuffer() }.map_err(|e| driver_error(&label, e))?;
+        let framebuffer =
+            unsafe { gl.create_framebuffer() }.map_err(|e| driver_error(&label, e))?;
         let result = (|| {
             // SAFETY: see module docs; `framebuffer` was just created.
             unsafe { gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(framebuffer)) };
-            let attachment = if format.is_depth() { glow::DEPTH_ATTACHMENT } else { glow::COLOR_ATTACHMENT0 };
+            let attachment = if format.is_depth() {
+                glow::DEPTH_ATTACHMENT
+            } else {
+                glow::COLOR_ATTACHMENT0
+            };
             let (w, h) = self.attach(glow::READ_FRAMEBUFFER, attachment, texture, at)?;
             let (gl_format, ty) = conv::readback_format(format);
             let bytes_per_value = if ty == glow::UNSIGNED_BYTE { 1 } else { 4 };
-            let mut bytes = vec![0u8; w as usize * h as usize * format.channels() * bytes_per_value];
+            let mut bytes =
+                vec![0u8; w as usize * h as usize * format.channels() * bytes_per_value];
             // SAFETY: see module docs; `bytes` is exactly w*h pixels of (gl_format, ty) with
             // PACK_ALIGNMENT 1. sRGB encoding is switched off so sRGB values come back raw.
             unsafe {
-                gl.read_buffer(if format.is_depth() { glow::NONE } else { glow::COLOR_ATTACHMENT0 });
+                gl.read_buffer(if format.is_depth() {
+                    glow::NONE
+                } else {
+                    glow::COLOR_ATTACHMENT0
+                });
                 let status = gl.check_framebuffer_status(glow::READ_FRAMEBUFFER);
                 if status != glow::FRAMEBUFFER_COMPLETE {
                     return Err(driver_error(
@@ -832,7 +935,11 @@ impl Backend for GlBackend {
     }
 
     fn live_resources(&self) -> usize {
-        self.textures.len() + self.buffers.len() + self.samplers.len() + self.shaders.len() + self.pipelines.len()
+        self.textures.len()
+            + self.buffers.len()
+            + self.samplers.len()
+            + self.shaders.len()
+            + self.pipelines.len()
     }
 }
 

@@ -33,7 +33,7 @@ struct PipelineResource {
     label: String,
 }
 
-/// Depth readback through a copy pass into R32F (created on first use).
+/// Depth readback through a copy pass packing f32 bits into RGBA8 (created on first use).
 struct DepthCopy {
     pipeline: wgpu::RenderPipeline,
     bind_group_layout: wgpu::BindGroupLayout,
@@ -65,7 +65,7 @@ impl WgpuBackend {
             ),
             BackendKind::WgpuGl => (
                 wgpu::Backends::GL,
-                "OpenGL ES",
+                "OpenGL",
                 "install EGL and Mesa: apt-get install -y libegl1 libegl-mesa0 libgl1-mesa-dri",
             ),
             BackendKind::Gl => unreachable!("the gl backend is GlBackend"),
@@ -90,7 +90,11 @@ impl WgpuBackend {
         }))
         .map_err(|e| unavailable(format!("no {api} adapter found ({e})")))?;
         let adapter_info = adapter.get_info();
-        let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::FLOAT32_FILTERABLE;
+        // Adapter-specific format features lift wgpu's downlevel limits where the driver can do
+        // more (R32F render targets on wgpu-gl, which GL 4.5 supports).
+        let wanted = wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::FLOAT32_FILTERABLE
+            | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
         let features = adapter.features() & wanted;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some(kind.name()),
@@ -100,7 +104,12 @@ impl WgpuBackend {
             memory_hints: wgpu::MemoryHints::Performance,
             trace: wgpu::Trace::Off,
         }))
-        .map_err(|e| unavailable(format!("{api} adapter `{}` refused a device: {e}", adapter_info.name)))?;
+        .map_err(|e| {
+            unavailable(format!(
+                "{api} adapter `{}` refused a device: {e}",
+                adapter_info.name
+            ))
+        })?;
         let backend_name = kind.name();
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
             log::error!("{backend_name}: uncaptured wgpu error: {e}");
@@ -108,8 +117,13 @@ impl WgpuBackend {
         let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
         let info = DriverInfo {
             backend: kind.name().to_owned(),
-            api: api.to_owned(),
-            api_version: format!("{api} ({})", adapter_info.driver_info),
+            // wgpu's GL backend takes a desktop core context where the driver offers one.
+            api: if kind == BackendKind::WgpuGl && !adapter_info.driver_info.contains("OpenGL ES") {
+                "OpenGL".to_owned()
+            } else {
+                api.to_owned()
+            },
+            api_version: adapter_info.driver_info.clone(),
             renderer: adapter_info.name.clone(),
             vendor: format!("0x{:04x}", adapter_info.vendor),
             driver: format!("{} {}", adapter_info.driver, adapter_info.driver_info)
@@ -216,7 +230,9 @@ impl WgpuBackend {
         for binding in &draw.bindings {
             let resource = match binding.resource {
                 BindingResource::Buffer(b) => self.buffers.get(b)?.buffer.as_entire_binding(),
-                BindingResource::Sampler(s) => wgpu::BindingResource::Sampler(self.samplers.get(s)?),
+                BindingResource::Sampler(s) => {
+                    wgpu::BindingResource::Sampler(self.samplers.get(s)?)
+                }
                 BindingResource::Texture(_) => {
                     let (_, view) = views
                         .iter()
@@ -265,10 +281,11 @@ impl WgpuBackend {
     fn depth_copy(&mut self) -> Result<&DepthCopy> {
         if self.depth_copy.is_none() {
             let module = self.scoped("depth copy shader", || {
-                self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some(shaders::DEPTH_COPY.name),
-                    source: wgpu::ShaderSource::Wgsl(Cow::Borrowed(shaders::DEPTH_COPY.wgsl)),
-                })
+                self.device
+                    .create_shader_module(wgpu::ShaderModuleDescriptor {
+                        label: Some(shaders::DEPTH_COPY.name),
+                        source: wgpu::ShaderSource::Wgsl(Cow::Borrowed(shaders::DEPTH_COPY.wgsl)),
+                    })
             })?;
             let bind_group_layout =
                 self.device
@@ -278,7 +295,7 @@ impl WgpuBackend {
                             binding: 0,
                             visibility: wgpu::ShaderStages::FRAGMENT,
                             ty: wgpu::BindingType::Texture {
-                                sample_type: wgpu::TextureSampleType::Depth,
+                                sample_type: wgpu::TextureSampleType::Float { filterable: false },
                                 view_dimension: wgpu::TextureViewDimension::D2,
                                 multisampled: false,
                             },
@@ -311,7 +328,7 @@ impl WgpuBackend {
                             entry_point: Some("fs_copy"),
                             compilation_options: Default::default(),
                             targets: &[Some(wgpu::ColorTargetState {
-                                format: wgpu::TextureFormat::R32Float,
+                                format: wgpu::TextureFormat::Rgba8Unorm,
                                 blend: None,
                                 write_mask: wgpu::ColorWrites::ALL,
                             })],
@@ -329,7 +346,12 @@ impl WgpuBackend {
     }
 
     /// Copies a color texture's subresource into a mappable buffer and returns its texels.
-    fn read_color(&self, texture: &wgpu::Texture, desc: &TextureDesc, at: Subresource) -> Result<Vec<u8>> {
+    fn read_color(
+        &self,
+        texture: &wgpu::Texture,
+        desc: &TextureDesc,
+        at: Subresource,
+    ) -> Result<Vec<u8>> {
         let (w, h) = desc.mip_size(at.mip);
         let row = w as usize * desc.format.texel_size();
         let padded_row = row.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as usize);
@@ -343,12 +365,18 @@ impl WgpuBackend {
         self.scoped(&context, || {
             let mut encoder = self
                 .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("readback"),
+                });
             encoder.copy_texture_to_buffer(
                 wgpu::TexelCopyTextureInfo {
                     texture,
                     mip_level: at.mip,
-                    origin: wgpu::Origin3d { x: 0, y: 0, z: at.layer },
+                    origin: wgpu::Origin3d {
+                        x: 0,
+                        y: 0,
+                        z: at.layer,
+                    },
                     aspect: wgpu::TextureAspect::All,
                 },
                 wgpu::TexelCopyBufferInfo {
@@ -386,12 +414,7 @@ impl Backend for WgpuBackend {
     }
 
     fn create_texture(&mut self, desc: &TextureDesc) -> Result<Handle<Texture>> {
-        if desc.width == 0 || desc.height == 0 || desc.mip_levels == 0 {
-            return Err(BackendError::InvalidData(format!(
-                "texture `{}`: zero size or no mips",
-                desc.label
-            )));
-        }
+        check_texture_desc(desc)?;
         let texture = self.scoped(&format!("texture `{}`", desc.label), || {
             self.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(&desc.label),
@@ -417,7 +440,12 @@ impl Backend for WgpuBackend {
         }))
     }
 
-    fn write_texture(&mut self, texture: Handle<Texture>, at: Subresource, data: &[u8]) -> Result<()> {
+    fn write_texture(
+        &mut self,
+        texture: Handle<Texture>,
+        at: Subresource,
+        data: &[u8],
+    ) -> Result<()> {
         let res = self.textures.get(texture)?;
         let (w, h) = check_upload(&res.desc, at, data)?;
         if res.desc.format.is_depth() {
@@ -432,7 +460,11 @@ impl Backend for WgpuBackend {
                 wgpu::TexelCopyTextureInfo {
                     texture: &res.texture,
                     mip_level: at.mip,
-                    origin: wgpu::Origin3d { x: 0, y: 0, z: at.layer },
+                    origin: wgpu::Origin3d {
+                        x: 0,
+                        y: 0,
+                        z: at.layer,
+                    },
                     aspect: wgpu::TextureAspect::All,
                 },
                 data,
@@ -456,12 +488,7 @@ impl Backend for WgpuBackend {
     }
 
     fn create_buffer(&mut self, desc: &BufferDesc) -> Result<Handle<Buffer>> {
-        if desc.size == 0 || desc.size % 4 != 0 {
-            return Err(BackendError::InvalidData(format!(
-                "buffer `{}`: size {} is not a positive multiple of 4",
-                desc.label, desc.size
-            )));
-        }
+        check_buffer_desc(desc)?;
         let buffer = self.scoped(&format!("buffer `{}`", desc.label), || {
             self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(&desc.label),
@@ -479,14 +506,7 @@ impl Backend for WgpuBackend {
 
     fn write_buffer(&mut self, buffer: Handle<Buffer>, offset: u64, data: &[u8]) -> Result<()> {
         let res = self.buffers.get(buffer)?;
-        if offset % 4 != 0 || data.len() % 4 != 0 || offset + data.len() as u64 > res.size {
-            return Err(BackendError::InvalidData(format!(
-                "{:?} buffer write of {} bytes at {offset} does not fit its {} bytes (4-byte aligned)",
-                res.usage,
-                data.len(),
-                res.size
-            )));
-        }
+        check_buffer_write(res.usage, res.size, offset, data.len())?;
         self.queue.write_buffer(&res.buffer, offset, data);
         Ok(())
     }
@@ -527,10 +547,11 @@ impl Backend for WgpuBackend {
             message: e.to_string(),
         })?;
         let module = self.scoped(&format!("shader `{}`", desc.name), || {
-            self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(&desc.name),
-                source: wgpu::ShaderSource::Wgsl(Cow::Borrowed(&desc.wgsl)),
-            })
+            self.device
+                .create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(&desc.name),
+                    source: wgpu::ShaderSource::Wgsl(Cow::Borrowed(&desc.wgsl)),
+                })
         })?;
         Ok(self.shaders.insert(module))
     }
@@ -632,12 +653,15 @@ impl Backend for WgpuBackend {
                         bias: Default::default(),
                     }),
                     multisample: wgpu::MultisampleState::default(),
-                    fragment: desc.fragment_entry.as_ref().map(|entry| wgpu::FragmentState {
-                        module,
-                        entry_point: Some(entry),
-                        compilation_options: Default::default(),
-                        targets: &targets,
-                    }),
+                    fragment: desc
+                        .fragment_entry
+                        .as_ref()
+                        .map(|entry| wgpu::FragmentState {
+                            module,
+                            entry_point: Some(entry),
+                            compilation_options: Default::default(),
+                            targets: &targets,
+                        }),
                     multiview_mask: None,
                     cache: None,
                 });
@@ -712,7 +736,9 @@ impl Backend for WgpuBackend {
         self.scoped(&context, || -> Result<()> {
             let mut encoder = self
                 .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("frame"),
+                });
             for (index, (pass, views)) in passes.iter().zip(&prepared).enumerate() {
                 let color_attachments: Vec<_> = pass
                     .color_attachments
@@ -725,12 +751,14 @@ impl Backend for WgpuBackend {
                             resolve_target: None,
                             ops: wgpu::Operations {
                                 load: match a.load {
-                                    LoadOp::Clear([r, g, b, a]) => wgpu::LoadOp::Clear(wgpu::Color {
-                                        r: r as f64,
-                                        g: g as f64,
-                                        b: b as f64,
-                                        a: a as f64,
-                                    }),
+                                    LoadOp::Clear([r, g, b, a]) => {
+                                        wgpu::LoadOp::Clear(wgpu::Color {
+                                            r: r as f64,
+                                            g: g as f64,
+                                            b: b as f64,
+                                            a: a as f64,
+                                        })
+                                    }
                                     LoadOp::Load => wgpu::LoadOp::Load,
                                 },
                                 store: wgpu::StoreOp::Store,
@@ -738,8 +766,11 @@ impl Backend for WgpuBackend {
                         })
                     })
                     .collect();
-                let depth_stencil_attachment = pass.depth_attachment.as_ref().zip(views.depth.as_ref()).map(
-                    |(d, view)| wgpu::RenderPassDepthStencilAttachment {
+                let depth_stencil_attachment = pass
+                    .depth_attachment
+                    .as_ref()
+                    .zip(views.depth.as_ref())
+                    .map(|(d, view)| wgpu::RenderPassDepthStencilAttachment {
                         view,
                         depth_ops: Some(wgpu::Operations {
                             load: match d.load {
@@ -749,16 +780,17 @@ impl Backend for WgpuBackend {
                             store: wgpu::StoreOp::Store,
                         }),
                         stencil_ops: None,
-                    },
-                );
+                    });
                 let mut render_pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some(&pass.name),
                     color_attachments: &color_attachments,
                     depth_stencil_attachment,
-                    timestamp_writes: queries.as_ref().map(|(set, _, _)| wgpu::RenderPassTimestampWrites {
-                        query_set: set,
-                        beginning_of_pass_write_index: Some(2 * index as u32),
-                        end_of_pass_write_index: Some(2 * index as u32 + 1),
+                    timestamp_writes: queries.as_ref().map(|(set, _, _)| {
+                        wgpu::RenderPassTimestampWrites {
+                            query_set: set,
+                            beginning_of_pass_write_index: Some(2 * index as u32),
+                            end_of_pass_write_index: Some(2 * index as u32 + 1),
+                        }
                     }),
                     occlusion_query_set: None,
                     multiview_mask: None,
@@ -770,7 +802,10 @@ impl Backend for WgpuBackend {
                     render_pass.set_pipeline(&self.pipelines.get(draw.pipeline)?.pipeline);
                     render_pass.set_bind_group(0, bind_group, &[]);
                     for (slot, buffer) in draw.vertex_buffers.iter().enumerate() {
-                        render_pass.set_vertex_buffer(slot as u32, self.buffers.get(*buffer)?.buffer.slice(..));
+                        render_pass.set_vertex_buffer(
+                            slot as u32,
+                            self.buffers.get(*buffer)?.buffer.slice(..),
+                        );
                     }
                     match draw.index_buffer {
                         Some((buffer, format)) => {
@@ -828,39 +863,45 @@ impl Backend for WgpuBackend {
             let bytes = self.read_color(&self.textures.get(texture)?.texture, &desc, at)?;
             return Ok(Image::from_texel_bytes(w, h, desc.format, &bytes));
         }
-        // Depth: draw it into an R32F texture, then read that.
+        // Depth: pack it into an RGBA8 texture (see depth_copy.wgsl), then read that.
         let source = self.target_view(texture, at)?;
-        let scratch = self.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("depth readback"),
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let scratch_view = scratch.create_view(&Default::default());
         let context = format!("depth readback of `{}`", desc.label);
+        let scratch = self.scoped(&context, || {
+            self.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("depth readback"),
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba8Unorm,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            })
+        })?;
+        let scratch_view = scratch.create_view(&Default::default());
         let copy = self.depth_copy()?;
         let copy_pipeline = copy.pipeline.clone();
         let copy_layout = copy.bind_group_layout.clone();
-        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("depth copy"),
-            layout: &copy_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&source),
-            }],
-        });
+        let bind_group = self.scoped(&context, || {
+            self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("depth copy"),
+                layout: &copy_layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&source),
+                }],
+            })
+        })?;
         self.scoped(&context, || {
             let mut encoder = self
                 .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("depth copy") });
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("depth copy"),
+                });
             {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("depth copy"),
@@ -884,10 +925,16 @@ impl Backend for WgpuBackend {
             }
             self.queue.submit([encoder.finish()]);
         })?;
-        let scratch_desc = TextureDesc::d2("depth readback", w, h, TextureFormat::R32Float);
+        // Each RGBA8 texel holds the little-endian bytes of one f32 depth.
+        let scratch_desc = TextureDesc::d2("depth readback", w, h, TextureFormat::Rgba8Unorm);
         let bytes = self.read_color(&scratch, &scratch_desc, Subresource::default())?;
         scratch.destroy();
-        Ok(Image::from_texel_bytes(w, h, TextureFormat::Depth32Float, &bytes))
+        Ok(Image::from_texel_bytes(
+            w,
+            h,
+            TextureFormat::Depth32Float,
+            &bytes,
+        ))
     }
 
     fn live_resources(&self) -> usize {

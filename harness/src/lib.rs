@@ -1,0 +1,5 @@
+//! The harness library: image comparison, cross-backend checks, and (growing) goldens, bless and
+//! reports. The `harness` binary is a thin command line over it.
+
+pub mod compare;
+pub mod first_scene;

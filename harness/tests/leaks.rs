@@ -1,0 +1,74 @@
+//! No GPU object leaks: creating and dropping a backend with resources 50 times keeps process
+//! memory flat. Its own test binary, so no other test's allocations disturb the measurement.
+
+mod common;
+
+use engine::backend::*;
+
+/// Resident set size of this process, in bytes.
+fn resident_bytes() -> u64 {
+    let status = std::fs::read_to_string("/proc/self/status").expect("/proc/self/status");
+    let kib: u64 = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmRSS:"))
+        .and_then(|v| v.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .expect("VmRSS in /proc/self/status");
+    kib * 1024
+}
+
+/// One cycle: a backend, a full render (which frees its own resources), and resources left
+/// alive for the backend's Drop to free.
+fn cycle(kind: BackendKind) {
+    let mut backend = create(kind).unwrap();
+    engine::lit_cube::render(backend.as_mut(), 64).unwrap();
+    let texture = backend
+        .create_texture(&TextureDesc::d2(
+            "left alive",
+            256,
+            256,
+            TextureFormat::Rgba16Float,
+        ))
+        .unwrap();
+    backend
+        .write_texture(texture, Subresource::default(), &vec![0u8; 256 * 256 * 8])
+        .unwrap();
+    backend
+        .create_buffer(&BufferDesc {
+            label: "left alive".into(),
+            size: 1 << 20,
+            usage: BufferUsage::Vertex,
+        })
+        .unwrap();
+}
+
+#[test]
+fn creating_and_dropping_backends_keeps_memory_flat() {
+    const WARM_UP: usize = 10;
+    const CYCLES: usize = 50;
+    /// Allowed growth over 50 cycles. One leaked cycle holds at least 1.5 MiB (the texture and
+    /// buffer above), so a per-cycle leak shows up as 75 MiB or more.
+    const BOUND: u64 = 24 << 20;
+    for kind in common::available_backends() {
+        for _ in 0..WARM_UP {
+            cycle(kind);
+        }
+        let before = resident_bytes();
+        for _ in 0..CYCLES {
+            cycle(kind);
+        }
+        let after = resident_bytes();
+        let growth = after.saturating_sub(before);
+        eprintln!(
+            "{kind}: RSS {} KiB -> {} KiB over {CYCLES} cycles (+{} KiB)",
+            before >> 10,
+            after >> 10,
+            growth >> 10
+        );
+        assert!(
+            growth <= BOUND,
+            "{kind}: memory grew by {} KiB over {CYCLES} create/drop cycles",
+            growth >> 10
+        );
+    }
+}
