@@ -9,6 +9,14 @@ use crate::backend::{BackendError, BackendKind};
 
 /// `EGL_PLATFORM_SURFACELESS_MESA` (EGL_MESA_platform_surfaceless).
 const PLATFORM_SURFACELESS_MESA: egl::Enum = 0x31DD;
+/// `EGL_PLATFORM_DEVICE_EXT` (EGL_EXT_platform_device).
+const PLATFORM_DEVICE_EXT: egl::Enum = 0x313F;
+/// `eglQueryDevicesEXT` (EGL_EXT_device_enumeration), which khronos-egl does not wrap.
+type QueryDevicesFn = unsafe extern "system" fn(
+    max_devices: egl::Int,
+    devices: *mut *mut std::ffi::c_void,
+    num_devices: *mut egl::Int,
+) -> egl::Boolean;
 const FIX: &str =
     "install Mesa's EGL and llvmpipe: apt-get install -y libegl1 libegl-mesa0 libgl1-mesa-dri";
 
@@ -50,20 +58,32 @@ impl EglContext {
     /// Creates the context and makes it current on this thread.
     pub(super) fn new(debug: bool) -> Result<Self, BackendError> {
         let egl = egl_library().map_err(unavailable)?;
-        // SAFETY: EGL_DEFAULT_DISPLAY with an empty attribute list is valid for the surfaceless
-        // platform; failure returns an error rather than an invalid display.
-        let display = unsafe {
-            egl.get_platform_display(
-                PLATFORM_SURFACELESS_MESA,
-                egl::DEFAULT_DISPLAY,
-                &[egl::ATTRIB_NONE],
-            )
-        }
-        .or_else(|_| {
-            // SAFETY: as above, for the implementation's default display (non-Mesa EGL).
-            unsafe { egl.get_display(egl::DEFAULT_DISPLAY) }.ok_or(egl::Error::BadDisplay)
-        })
-        .map_err(|e| unavailable(format!("no EGL display (surfaceless or default): {e}")))?;
+        // Our own display: the first EGL device (Mesa's software device on a CPU-only machine).
+        // The surfaceless display is process-wide and shared with wgpu's GL backend, which calls
+        // eglTerminate on it when its last instance drops, destroying our contexts with it.
+        let display = match device_display(egl) {
+            Some(display) => display,
+            None => {
+                // SAFETY: EGL_DEFAULT_DISPLAY with an empty attribute list is valid for the
+                // surfaceless platform; failure returns an error, not an invalid display.
+                unsafe {
+                    egl.get_platform_display(
+                        PLATFORM_SURFACELESS_MESA,
+                        egl::DEFAULT_DISPLAY,
+                        &[egl::ATTRIB_NONE],
+                    )
+                }
+                .or_else(|_| {
+                    // SAFETY: as above, for the implementation's default display (non-Mesa EGL).
+                    unsafe { egl.get_display(egl::DEFAULT_DISPLAY) }.ok_or(egl::Error::BadDisplay)
+                })
+                .map_err(|e| {
+                    unavailable(format!(
+                        "no EGL display (device, surfaceless or default): {e}"
+                    ))
+                })?
+            }
+        };
         egl.initialize(display)
             .map_err(|e| unavailable(format!("eglInitialize failed: {e}")))?;
         egl.bind_api(egl::OPENGL_API)
@@ -156,6 +176,32 @@ impl EglContext {
             unsafe { std::mem::transmute::<extern "system" fn(), ClipControlFn>(f) }
         })
     }
+}
+
+/// The EGL_EXT_platform_device display of the first enumerated device, if the extensions exist.
+fn device_display(egl: &Egl) -> Option<egl::Display> {
+    let client_extensions = egl
+        .query_string(None, egl::EXTENSIONS)
+        .ok()?
+        .to_string_lossy()
+        .into_owned();
+    let has = |name: &str| client_extensions.split(' ').any(|e| e == name);
+    if !has("EGL_EXT_platform_device") || !has("EGL_EXT_device_enumeration") {
+        return None;
+    }
+    let query = egl.get_proc_address("eglQueryDevicesEXT")?;
+    // SAFETY: eglQueryDevicesEXT's C signature is `EGLBoolean (EGLint, EGLDeviceEXT *, EGLint *)`,
+    // which is `QueryDevicesFn`; the pointer came from EGL and the extension is advertised.
+    let query = unsafe { std::mem::transmute::<extern "system" fn(), QueryDevicesFn>(query) };
+    let mut devices = [std::ptr::null_mut(); 16];
+    let mut count: egl::Int = 0;
+    // SAFETY: `devices` has room for the 16 entries passed as the maximum; `count` is written.
+    let ok = unsafe { query(devices.len() as egl::Int, devices.as_mut_ptr(), &mut count) };
+    if ok != egl::TRUE || count < 1 {
+        return None;
+    }
+    // SAFETY: the device handle came from eglQueryDevicesEXT; no attributes are passed.
+    unsafe { egl.get_platform_display(PLATFORM_DEVICE_EXT, devices[0], &[egl::ATTRIB_NONE]) }.ok()
 }
 
 impl Drop for EglContext {

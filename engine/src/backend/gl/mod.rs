@@ -536,19 +536,12 @@ impl Backend for GlBackend {
         unsafe {
             self.gl.bind_texture(target, Some(tex.raw));
             match tex.desc.kind {
-                TextureKind::D2 => self.gl.tex_sub_image_2d(
-                    target,
-                    at.mip as i32,
-                    0,
-                    0,
-                    w as i32,
-                    h as i32,
-                    format,
-                    ty,
-                    pixels,
-                ),
-                TextureKind::Cube => self.gl.tex_sub_image_2d(
-                    glow::TEXTURE_CUBE_MAP_POSITIVE_X + at.layer,
+                TextureKind::D2 | TextureKind::Cube => self.gl.tex_sub_image_2d(
+                    if tex.desc.kind == TextureKind::Cube {
+                        glow::TEXTURE_CUBE_MAP_POSITIVE_X + at.layer
+                    } else {
+                        target
+                    },
                     at.mip as i32,
                     0,
                     0,
