@@ -4,6 +4,7 @@
 use engine::backend::{self, BackendKind, BackendStatus};
 use engine::image::Image;
 use engine::lit_cube::{self, LitCubeImages};
+use image::ImageEncoder;
 
 use crate::compare::{relative_difference, u8_difference, RelativeDifference, U8Difference};
 
@@ -98,5 +99,3 @@ pub fn png_bytes(image: &Image) -> Result<Vec<u8>, image::ImageError> {
     )?;
     Ok(out)
 }
-
-use image::ImageEncoder;

@@ -356,8 +356,8 @@ pub(crate) fn check_buffer_write(
     Ok(())
 }
 
-/// Checks that `data` holds exactly one tightly packed image of `desc` at mip `at.mip`.
-pub(crate) fn check_upload(desc: &TextureDesc, at: Subresource, data: &[u8]) -> Result<(u32, u32)> {
+/// Checks that `at` names an existing mip level and layer of `desc`.
+pub(crate) fn check_subresource(desc: &TextureDesc, at: Subresource) -> Result<()> {
     if at.mip >= desc.mip_levels || at.layer >= desc.kind.layers() {
         return Err(BackendError::InvalidData(format!(
             "texture `{}` has {} mips and {} layers; mip {} layer {} requested",
@@ -368,6 +368,12 @@ pub(crate) fn check_upload(desc: &TextureDesc, at: Subresource, data: &[u8]) -> 
             at.layer
         )));
     }
+    Ok(())
+}
+
+/// Checks that `data` holds exactly one tightly packed image of `desc` at mip `at.mip`.
+pub(crate) fn check_upload(desc: &TextureDesc, at: Subresource, data: &[u8]) -> Result<(u32, u32)> {
+    check_subresource(desc, at)?;
     let (w, h) = desc.mip_size(at.mip);
     let expected = w as usize * h as usize * desc.format.texel_size();
     if data.len() != expected {

@@ -202,12 +202,7 @@ impl GlBackend {
         at: Subresource,
     ) -> Result<(u32, u32)> {
         let tex = self.textures.get(texture)?;
-        if at.mip >= tex.desc.mip_levels || at.layer >= tex.desc.kind.layers() {
-            return Err(BackendError::InvalidData(format!(
-                "texture `{}` has no mip {} layer {}",
-                tex.desc.label, at.mip, at.layer
-            )));
-        }
+        check_subresource(&tex.desc, at)?;
         // SAFETY: see module docs; a framebuffer is bound to `target` by the caller.
         unsafe {
             match tex.desc.kind {
@@ -853,8 +848,8 @@ impl Backend for GlBackend {
 
     fn read_texture(&mut self, texture: Handle<Texture>, at: Subresource) -> Result<Image> {
         self.context.make_current()?;
-        let format = self.textures.get(texture)?.desc.format;
-        let label = self.textures.get(texture)?.desc.label.clone();
+        let desc = &self.textures.get(texture)?.desc;
+        let (format, label) = (desc.format, desc.label.clone());
         let gl = &self.gl;
         // SAFETY: see module docs.
         let framebuffer =

@@ -182,12 +182,7 @@ impl WgpuBackend {
     /// A view of one mip/layer of a texture, for rendering or copying.
     fn target_view(&self, texture: Handle<Texture>, at: Subresource) -> Result<wgpu::TextureView> {
         let res = self.textures.get(texture)?;
-        if at.mip >= res.desc.mip_levels || at.layer >= res.desc.kind.layers() {
-            return Err(BackendError::InvalidData(format!(
-                "texture `{}` has no mip {} layer {}",
-                res.desc.label, at.mip, at.layer
-            )));
-        }
+        check_subresource(&res.desc, at)?;
         Ok(res.texture.create_view(&wgpu::TextureViewDescriptor {
             label: Some(&res.desc.label),
             dimension: Some(wgpu::TextureViewDimension::D2),
@@ -857,9 +852,8 @@ impl Backend for WgpuBackend {
     fn read_texture(&mut self, texture: Handle<Texture>, at: Subresource) -> Result<Image> {
         let desc = self.textures.get(texture)?.desc.clone();
         let (w, h) = desc.mip_size(at.mip);
+        check_subresource(&desc, at)?;
         if !desc.format.is_depth() {
-            let view_check = self.target_view(texture, at)?;
-            drop(view_check);
             let bytes = self.read_color(&self.textures.get(texture)?.texture, &desc, at)?;
             return Ok(Image::from_texel_bytes(w, h, desc.format, &bytes));
         }
