@@ -9,6 +9,10 @@
 pub mod backend;
 pub mod image;
 pub mod lit_cube;
+pub mod mesh;
+pub mod plan;
+pub mod renderer;
+pub mod scene;
 pub mod shaders;
 
 pub use backend::{Backend, BackendKind};

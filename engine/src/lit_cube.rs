@@ -106,161 +106,124 @@ fn globals() -> Vec<f32> {
 /// Renders the lit cube at `size` x `size` pixels and reads back all three targets. Every
 /// resource it creates is destroyed before it returns, also on error.
 pub fn render(backend: &mut dyn Backend, size: u32) -> Result<LitCubeImages> {
-    let mut created = Created::default();
-    let result = render_with(backend, size, &mut created);
-    created.destroy(backend);
+    let mut scope = ResourceScope::default();
+    let result = render_with(backend, size, &mut scope);
+    scope.destroy(backend);
     result
-}
-
-/// Handles to destroy after a render.
-#[derive(Default)]
-struct Created {
-    textures: Vec<Handle<Texture>>,
-    buffers: Vec<Handle<Buffer>>,
-    samplers: Vec<Handle<Sampler>>,
-    shaders: Vec<Handle<Shader>>,
-    pipelines: Vec<Handle<Pipeline>>,
-}
-
-impl Created {
-    fn destroy(self, backend: &mut dyn Backend) {
-        // Errors here would only repeat an error already being returned.
-        self.pipelines
-            .into_iter()
-            .for_each(|h| drop(backend.destroy_pipeline(h)));
-        self.shaders
-            .into_iter()
-            .for_each(|h| drop(backend.destroy_shader(h)));
-        self.samplers
-            .into_iter()
-            .for_each(|h| drop(backend.destroy_sampler(h)));
-        self.buffers
-            .into_iter()
-            .for_each(|h| drop(backend.destroy_buffer(h)));
-        self.textures
-            .into_iter()
-            .for_each(|h| drop(backend.destroy_texture(h)));
-    }
 }
 
 fn render_with(
     backend: &mut dyn Backend,
     size: u32,
-    created: &mut Created,
+    scope: &mut ResourceScope,
 ) -> Result<LitCubeImages> {
     let (vertices, indices) = cube_mesh();
-    let vertex_buffer = backend.create_buffer_with_data(
+    let vertex_buffer = scope.buffer(
+        backend,
         "cube vertices",
         BufferUsage::Vertex,
         bytemuck::cast_slice(&vertices),
     )?;
-    created.buffers.push(vertex_buffer);
-    let index_buffer = backend.create_buffer_with_data(
+    let index_buffer = scope.buffer(
+        backend,
         "cube indices",
         BufferUsage::Index,
         bytemuck::cast_slice(&indices),
     )?;
-    created.buffers.push(index_buffer);
-    let uniforms = backend.create_buffer_with_data(
+    let uniforms = scope.buffer(
+        backend,
         "globals",
         BufferUsage::Uniform,
         bytemuck::cast_slice(&globals()),
     )?;
-    created.buffers.push(uniforms);
 
     let (tex_size, texels) = checker_texture();
-    let albedo = backend.create_texture(&TextureDesc::d2(
-        "checker",
-        tex_size,
-        tex_size,
-        TextureFormat::Rgba8UnormSrgb,
-    ))?;
-    created.textures.push(albedo);
+    let albedo = scope.texture(
+        backend,
+        &TextureDesc::d2("checker", tex_size, tex_size, TextureFormat::Rgba8UnormSrgb),
+    )?;
     backend.write_texture(albedo, Subresource::default(), &texels)?;
-    let sampler = backend.create_sampler(&SamplerDesc::linear("checker", AddressMode::Repeat))?;
-    created.samplers.push(sampler);
+    let sampler = scope.sampler(
+        backend,
+        &SamplerDesc::linear("checker", AddressMode::Repeat),
+    )?;
 
-    let hdr = backend.create_texture(&TextureDesc::d2(
-        "hdr",
-        size,
-        size,
-        TextureFormat::Rgba16Float,
-    ))?;
-    created.textures.push(hdr);
-    let ldr = backend.create_texture(&TextureDesc::d2(
-        "ldr",
-        size,
-        size,
-        TextureFormat::Rgba8UnormSrgb,
-    ))?;
-    created.textures.push(ldr);
-    let depth = backend.create_texture(&TextureDesc::d2(
-        "depth",
-        size,
-        size,
-        TextureFormat::Depth32Float,
-    ))?;
-    created.textures.push(depth);
+    let hdr = scope.texture(
+        backend,
+        &TextureDesc::d2("hdr", size, size, TextureFormat::Rgba16Float),
+    )?;
+    let ldr = scope.texture(
+        backend,
+        &TextureDesc::d2("ldr", size, size, TextureFormat::Rgba8UnormSrgb),
+    )?;
+    let depth = scope.texture(
+        backend,
+        &TextureDesc::d2("depth", size, size, TextureFormat::Depth32Float),
+    )?;
 
-    let shader = backend.create_shader(&ShaderDesc {
-        name: shaders::LIT_CUBE.name.to_owned(),
-        wgsl: shaders::LIT_CUBE.wgsl.to_owned(),
-    })?;
-    created.shaders.push(shader);
+    let shader = scope.shader(
+        backend,
+        &ShaderDesc {
+            name: shaders::LIT_CUBE.name.to_owned(),
+            wgsl: shaders::LIT_CUBE.wgsl.to_owned(),
+        },
+    )?;
     let float = |location, format, offset| VertexAttribute {
         location,
         format,
         offset,
     };
-    let pipeline = backend.create_pipeline(&PipelineDesc {
-        label: "lit cube".to_owned(),
-        shader,
-        vertex_entry: "vs_main".to_owned(),
-        fragment_entry: Some("fs_main".to_owned()),
-        vertex_buffers: vec![VertexBufferLayout {
-            stride: (VERTEX_FLOATS * 4) as u32,
-            attributes: vec![
-                float(0, VertexFormat::Float32x3, 0),
-                float(1, VertexFormat::Float32x3, 12),
-                float(2, VertexFormat::Float32x2, 24),
-            ],
-        }],
-        bindings: vec![
-            BindingLayout {
-                binding: 0,
-                kind: BindingKind::UniformBuffer,
-            },
-            BindingLayout {
-                binding: 1,
-                kind: BindingKind::Texture {
-                    sample_type: TextureSampleType::Float,
-                    view: TextureViewKind::D2,
+    let pipeline = scope.pipeline(
+        backend,
+        &PipelineDesc {
+            label: "lit cube".to_owned(),
+            shader,
+            vertex_entry: "vs_main".to_owned(),
+            fragment_entry: Some("fs_main".to_owned()),
+            vertex_buffers: vec![VertexBufferLayout {
+                stride: (VERTEX_FLOATS * 4) as u32,
+                attributes: vec![
+                    float(0, VertexFormat::Float32x3, 0),
+                    float(1, VertexFormat::Float32x3, 12),
+                    float(2, VertexFormat::Float32x2, 24),
+                ],
+            }],
+            bindings: vec![
+                BindingLayout {
+                    binding: 0,
+                    kind: BindingKind::UniformBuffer,
                 },
-            },
-            BindingLayout {
-                binding: 2,
-                kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
-            },
-        ],
-        color_targets: vec![
-            ColorTarget {
-                format: TextureFormat::Rgba16Float,
-                blend: None,
-            },
-            ColorTarget {
-                format: TextureFormat::Rgba8UnormSrgb,
-                blend: None,
-            },
-        ],
-        depth: Some(DepthState {
-            format: TextureFormat::Depth32Float,
-            write: true,
-            compare: CompareFunction::Less,
-        }),
-        topology: Topology::TriangleList,
-        cull: CullMode::Back,
-    })?;
-    created.pipelines.push(pipeline);
+                BindingLayout {
+                    binding: 1,
+                    kind: BindingKind::Texture {
+                        sample_type: TextureSampleType::Float,
+                        view: TextureViewKind::D2,
+                    },
+                },
+                BindingLayout {
+                    binding: 2,
+                    kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
+                },
+            ],
+            color_targets: vec![
+                ColorTarget {
+                    format: TextureFormat::Rgba16Float,
+                    blend: None,
+                },
+                ColorTarget {
+                    format: TextureFormat::Rgba8UnormSrgb,
+                    blend: None,
+                },
+            ],
+            depth: Some(DepthState {
+                format: TextureFormat::Depth32Float,
+                write: true,
+                compare: CompareFunction::Less,
+            }),
+            topology: Topology::TriangleList,
+            cull: CullMode::Back,
+        },
+    )?;
 
     let background = [0.02, 0.02, 0.03, 1.0];
     let timings = backend.submit(&[RenderPass {

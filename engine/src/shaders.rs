@@ -33,8 +33,28 @@ pub const ORIENTATION: ShaderSource = shader!("orientation.wgsl");
 /// Packs a depth texture's f32 bits into an RGBA8 target (exact depth readback on wgpu).
 pub const DEPTH_COPY: ShaderSource = shader!("depth_copy.wgsl");
 
+/// Deferred renderer: geometry pass into the G-buffer and shader-mask pass.
+pub const GBUFFER: ShaderSource = shader!("gbuffer.wgsl");
+/// Deferred renderer: one full-screen lighting pass per lighting model.
+pub const LIGHTING: ShaderSource = shader!("lighting.wgsl");
+/// Deferred renderer: environment behind the objects.
+pub const SKYBOX: ShaderSource = shader!("skybox.wgsl");
+/// Deferred renderer: HDR light buffer to the sRGB final image.
+pub const TONEMAP: ShaderSource = shader!("tonemap.wgsl");
+/// Deferred renderer: axes and light markers over the final image.
+pub const GIZMO: ShaderSource = shader!("gizmo.wgsl");
+
 /// Every shader in `engine/shaders/` (a test checks the folder and this list agree).
-pub const ALL: &[ShaderSource] = &[LIT_CUBE, ORIENTATION, DEPTH_COPY];
+pub const ALL: &[ShaderSource] = &[
+    LIT_CUBE,
+    ORIENTATION,
+    DEPTH_COPY,
+    GBUFFER,
+    LIGHTING,
+    SKYBOX,
+    TONEMAP,
+    GIZMO,
+];
 
 /// A shader that failed to parse, validate or translate.
 #[derive(Debug, thiserror::Error)]

@@ -3,3 +3,5 @@
 
 pub mod compare;
 pub mod first_scene;
+pub mod reference;
+pub mod test_scenes;

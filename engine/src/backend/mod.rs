@@ -10,6 +10,7 @@
 pub mod desc;
 pub mod gl;
 mod pool;
+mod scope;
 pub mod wgpu;
 
 use std::collections::BTreeMap;
@@ -17,6 +18,7 @@ use std::fmt;
 use std::str::FromStr;
 
 pub use desc::*;
+pub use scope::ResourceScope;
 
 use crate::image::Image;
 

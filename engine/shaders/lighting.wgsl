@@ -1,0 +1,290 @@
+// Lighting passes of the deferred renderer: one full-screen draw per lighting model (and per
+// batch of up to 16 lights), each shading only the pixels whose shader-mask channel is set, added
+// into the HDR light buffer (RGBA16F) with additive blending. Light colors arrive pre-multiplied
+// by intensity and exposure, so the light buffer holds exposed radiance and stays inside fp16.
+//
+// PBR follows Filament (surface_brdf.fs): f_r = (f_d k_d + f_s)(1 - F_c) + f_c with Lambert f_d,
+// k_d = (1 - F)(1 - metallic), f_s = D_GGX F_Schlick V_SmithGGXCorrelated (anisotropic D and V
+// when anisotropy != 0), clearcoat f_c = D_GGX V_Kelemen F_c with F0 = 0.04, F_c = F_Schlick *
+// clearcoat, alpha = roughness^2 + 0.001, F0 = 0.16 specular^2 (1 - metallic) + base metallic.
+
+const PI: f32 = 3.14159265358979;
+const MAX_LIGHTS: u32 = 16u;
+// Largest value written to the RGBA16F light buffer (fp16 max is 65504).
+const FP16_SAFE_MAX: f32 = 65000.0;
+const MIN_N_DOT_V: f32 = 1e-4;
+
+struct LightData {
+    // w = 0: xyz is the unit direction towards a directional light.
+    // w = 1: xyz is a point light's camera-relative position.
+    position: vec4<f32>,
+    // rgb = color * intensity * exposure, a = radius (point lights).
+    color: vec4<f32>,
+    // x = 1 / falloff (point lights).
+    params: vec4<f32>,
+}
+
+struct LightingUniforms {
+    // One-hot selector of this model's channel in the bound mask target.
+    mask_select: vec4<f32>,
+    // rgb = uniform ambient radiance * exposure (zero after the first batch).
+    ambient: vec4<f32>,
+    // x = number of lights in this batch; y = 1 to emit unlit albedo (first batch only).
+    counts: vec4<u32>,
+    lights: array<LightData, 16>,
+}
+
+@group(0) @binding(0) var<uniform> u: LightingUniforms;
+@group(0) @binding(1) var gbuffer_position: texture_2d<f32>;
+@group(0) @binding(2) var gbuffer_normal: texture_2d<f32>;
+@group(0) @binding(3) var gbuffer_tangent: texture_2d<f32>;
+@group(0) @binding(4) var gbuffer_albedo: texture_2d<f32>;
+@group(0) @binding(5) var gbuffer_material: texture_2d<f32>;
+@group(0) @binding(6) var shader_mask: texture_2d<f32>;
+
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
+    let corner = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u));
+    return vec4<f32>(corner * 2.0 - 1.0, 0.0, 1.0);
+}
+
+struct Surface {
+    position: vec3<f32>,
+    roughness: f32,
+    normal: vec3<f32>,
+    specular: f32,
+    tangent: vec3<f32>,
+    base_color: vec3<f32>,
+    anisotropy: f32,
+    metallic: f32,
+    clearcoat: f32,
+    clearcoat_roughness: f32,
+    specular_exponent: f32,
+}
+
+// Reads the G-buffer at a pixel, or returns false when the pixel is not this model's.
+fn masked(pixel: vec2<i32>) -> bool {
+    return dot(textureLoad(shader_mask, pixel, 0), u.mask_select) < 0.5;
+}
+
+fn load_surface(pixel: vec2<i32>) -> Surface {
+    let p = textureLoad(gbuffer_position, pixel, 0);
+    let n = textureLoad(gbuffer_normal, pixel, 0);
+    let t = textureLoad(gbuffer_tangent, pixel, 0);
+    let a = textureLoad(gbuffer_albedo, pixel, 0);
+    let m = textureLoad(gbuffer_material, pixel, 0);
+    var s: Surface;
+    s.position = p.xyz;
+    s.roughness = clamp(p.w, 0.0, 1.0);
+    s.normal = normalize(n.xyz);
+    s.specular = n.w;
+    s.tangent = t.xyz;
+    s.base_color = a.rgb;
+    s.anisotropy = clamp(a.a, -1.0, 1.0);
+    s.metallic = m.x;
+    s.clearcoat = m.y;
+    s.clearcoat_roughness = clamp(m.z, 0.0, 1.0);
+    s.specular_exponent = m.w;
+    return s;
+}
+
+// Direction to the light (xyz) and the light's radiance at the surface (rgb in the second value).
+struct Incoming {
+    direction: vec3<f32>,
+    radiance: vec3<f32>,
+}
+
+fn incoming(light: LightData, s: Surface) -> Incoming {
+    var result: Incoming;
+    if light.position.w < 0.5 {
+        result.direction = light.position.xyz;
+        result.radiance = light.color.rgb;
+        return result;
+    }
+    let to_light = light.position.xyz - s.position;
+    let distance = length(to_light);
+    // A light exactly at the surface lights it head-on instead of dividing by zero.
+    result.direction = select(s.normal, to_light / distance, distance > 1e-6);
+    let ratio = min(distance / max(light.color.a, 1e-6), 1.0);
+    let attenuation = max(0.0, 1.0 - pow(ratio, light.params.x));
+    result.radiance = light.color.rgb * attenuation;
+    return result;
+}
+
+fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
+    let length_squared = dot(v, v);
+    return select(fallback, v * inverseSqrt(length_squared), length_squared > 1e-20);
+}
+
+fn pow5(x: f32) -> f32 {
+    let x2 = x * x;
+    return x2 * x2 * x;
+}
+
+// GGX normal distribution; 1 - NoH^2 from |n x h|^2 keeps precision near the highlight's peak.
+fn d_ggx(n: vec3<f32>, h: vec3<f32>, n_dot_h: f32, alpha: f32) -> f32 {
+    let n_cross_h = cross(n, h);
+    let a = n_dot_h * alpha;
+    let k = alpha / (dot(n_cross_h, n_cross_h) + a * a);
+    return k * k * (1.0 / PI);
+}
+
+fn v_smith_ggx_correlated(n_dot_v: f32, n_dot_l: f32, alpha: f32) -> f32 {
+    let a2 = alpha * alpha;
+    let lambda_v = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2);
+    let lambda_l = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2);
+    return 0.5 / (lambda_v + lambda_l);
+}
+
+fn d_ggx_anisotropic(at: f32, ab: f32, t_dot_h: f32, b_dot_h: f32, n_dot_h: f32) -> f32 {
+    let a2 = at * ab;
+    let d = vec3<f32>(ab * t_dot_h, at * b_dot_h, a2 * n_dot_h);
+    let d2 = dot(d, d);
+    let b2 = a2 / d2;
+    return a2 * b2 * b2 * (1.0 / PI);
+}
+
+fn v_smith_ggx_correlated_anisotropic(
+    at: f32, ab: f32, t_dot_v: f32, b_dot_v: f32, t_dot_l: f32, b_dot_l: f32,
+    n_dot_v: f32, n_dot_l: f32,
+) -> f32 {
+    let lambda_v = n_dot_l * length(vec3<f32>(at * t_dot_v, ab * b_dot_v, n_dot_v));
+    let lambda_l = n_dot_v * length(vec3<f32>(at * t_dot_l, ab * b_dot_l, n_dot_l));
+    return 0.5 / (lambda_v + lambda_l);
+}
+
+fn pbr_brdf_times_cosine(s: Surface, v: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
+    let n = s.normal;
+    let n_dot_l = clamp(dot(n, l), 0.0, 1.0);
+    if n_dot_l <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let n_dot_v = max(dot(n, v), MIN_N_DOT_V);
+    let h = safe_normalize(v + l, n);
+    let n_dot_h = clamp(dot(n, h), 0.0, 1.0);
+    let l_dot_h = clamp(dot(l, h), 0.0, 1.0);
+
+    let alpha = s.roughness * s.roughness + 0.001;
+    let f0 = vec3<f32>(0.16 * s.specular * s.specular * (1.0 - s.metallic)) + s.base_color * s.metallic;
+    let fresnel = f0 + (vec3<f32>(1.0) - f0) * pow5(1.0 - l_dot_h);
+
+    var d: f32;
+    var vis: f32;
+    if s.anisotropy != 0.0 {
+        let t = s.tangent;
+        let b = cross(n, t);
+        let at = max(alpha * (1.0 + s.anisotropy), 0.001);
+        let ab = max(alpha * (1.0 - s.anisotropy), 0.001);
+        d = d_ggx_anisotropic(at, ab, dot(t, h), dot(b, h), n_dot_h);
+        vis = v_smith_ggx_correlated_anisotropic(
+            at, ab, dot(t, v), dot(b, v), dot(t, l), dot(b, l), n_dot_v, n_dot_l);
+    } else {
+        d = d_ggx(n, h, n_dot_h, alpha);
+        vis = v_smith_ggx_correlated(n_dot_v, n_dot_l, alpha);
+    }
+    let specular = fresnel * (d * vis);
+    let k_d = (vec3<f32>(1.0) - fresnel) * (1.0 - s.metallic);
+    let diffuse = s.base_color * k_d * (1.0 / PI);
+
+    let clearcoat_alpha = s.clearcoat_roughness * s.clearcoat_roughness + 0.001;
+    let clearcoat_fresnel = (0.04 + 0.96 * pow5(1.0 - l_dot_h)) * s.clearcoat;
+    let clearcoat_d = d_ggx(n, h, n_dot_h, clearcoat_alpha);
+    let clearcoat_v = 0.25 / max(l_dot_h * l_dot_h, 1e-4);
+    let clearcoat = clearcoat_d * clearcoat_v * clearcoat_fresnel;
+
+    return ((diffuse + specular) * (1.0 - clearcoat_fresnel) + vec3<f32>(clearcoat)) * n_dot_l;
+}
+
+fn blinn_phong_times_cosine(s: Surface, v: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
+    let n_dot_l = dot(s.normal, l);
+    if n_dot_l <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let h = safe_normalize(v + l, s.normal);
+    let n_dot_h = max(dot(s.normal, h), 0.0);
+    let specular = s.specular * pow(n_dot_h, max(s.specular_exponent, 0.0));
+    return s.base_color * n_dot_l + vec3<f32>(specular);
+}
+
+fn toon_times_cosine(s: Surface, l: vec3<f32>) -> vec3<f32> {
+    let n_dot_l = dot(s.normal, l);
+    let band = select(select(0.0, 0.35, n_dot_l > 0.0), select(0.7, 1.0, n_dot_l > 0.8), n_dot_l > 0.4);
+    return s.base_color * band;
+}
+
+fn finish(radiance: vec3<f32>) -> vec4<f32> {
+    return vec4<f32>(min(max(radiance, vec3<f32>(0.0)), vec3<f32>(FP16_SAFE_MAX)), 1.0);
+}
+
+@fragment
+fn fs_pbr(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let pixel = vec2<i32>(frag.xy);
+    if masked(pixel) {
+        discard;
+    }
+    let s = load_surface(pixel);
+    let v = safe_normalize(-s.position, s.normal);
+    // Uniform ambient: diffuse only (the IBL pass adds specular from an environment).
+    var radiance = s.base_color * (1.0 - s.metallic) * u.ambient.rgb;
+    for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
+        let light = incoming(u.lights[i], s);
+        radiance += pbr_brdf_times_cosine(s, v, light.direction) * light.radiance;
+    }
+    return finish(radiance);
+}
+
+@fragment
+fn fs_blinn_phong(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let pixel = vec2<i32>(frag.xy);
+    if masked(pixel) {
+        discard;
+    }
+    let s = load_surface(pixel);
+    let v = safe_normalize(-s.position, s.normal);
+    var radiance = s.base_color * u.ambient.rgb;
+    for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
+        let light = incoming(u.lights[i], s);
+        radiance += blinn_phong_times_cosine(s, v, light.direction) * light.radiance;
+    }
+    return finish(radiance);
+}
+
+@fragment
+fn fs_lambert(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let pixel = vec2<i32>(frag.xy);
+    if masked(pixel) {
+        discard;
+    }
+    let s = load_surface(pixel);
+    var radiance = s.base_color * u.ambient.rgb;
+    for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
+        let light = incoming(u.lights[i], s);
+        radiance += s.base_color * (max(dot(s.normal, light.direction), 0.0) / PI) * light.radiance;
+    }
+    return finish(radiance);
+}
+
+@fragment
+fn fs_toon(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let pixel = vec2<i32>(frag.xy);
+    if masked(pixel) {
+        discard;
+    }
+    let s = load_surface(pixel);
+    var radiance = s.base_color * u.ambient.rgb;
+    for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
+        let light = incoming(u.lights[i], s);
+        radiance += toon_times_cosine(s, light.direction) * light.radiance;
+    }
+    return finish(radiance);
+}
+
+@fragment
+fn fs_unlit(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let pixel = vec2<i32>(frag.xy);
+    if masked(pixel) {
+        discard;
+    }
+    let s = load_surface(pixel);
+    return finish(s.base_color * f32(u.counts.y));
+}

@@ -1,0 +1,303 @@
+//! The render plan: the passes and targets a scene needs, and nothing more. Built from a
+//! [`Scene`] before anything touches a backend, printable (its `Display` is what the insta
+//! snapshots hold), and executed by [`crate::renderer`].
+//!
+//! What is left out, and when: no shader-mask channel for a lighting model no object uses (and a
+//! second mask target only past four models), no lighting pass for an unused model, no skybox
+//! without an environment, no gizmos unless the quality settings ask for them.
+
+use std::fmt;
+
+use crate::backend::TextureFormat;
+use crate::scene::{LightingModel, Scene};
+
+/// Lights handled by one lighting draw (the size of the uniform array in `lighting.wgsl`).
+pub const MAX_LIGHTS_PER_DRAW: usize = 16;
+
+/// A render target the plan allocates; every one can be read back by its name.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TargetSpec {
+    /// Name used for readback, goldens and the CLI's `--pass`.
+    pub name: String,
+    /// Texel format.
+    pub format: TextureFormat,
+    /// What the channels hold.
+    pub contents: String,
+}
+
+/// What a pass does.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PassKind {
+    /// Draws every object into the G-buffer and depth.
+    Geometry,
+    /// Draws every object's one-hot lighting-model channel into the mask targets.
+    ShaderMask,
+    /// Fills uncovered pixels of the light buffer from the environment.
+    Skybox,
+    /// Shades one lighting model's pixels into the light buffer.
+    Lighting(LightingModel),
+    /// Exposed HDR light buffer to the sRGB final image.
+    ToneMap,
+    /// Lines over the final image.
+    Gizmos,
+}
+
+/// One pass of the plan.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassSpec {
+    /// Pass name (also the name of its GPU timing).
+    pub name: String,
+    /// What it does.
+    pub kind: PassKind,
+    /// Targets it reads.
+    pub reads: Vec<String>,
+    /// Targets it writes.
+    pub writes: Vec<String>,
+    /// Draw count and other facts worth reviewing.
+    pub detail: String,
+}
+
+/// Where a lighting model's pixels are flagged.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MaskChannel {
+    /// The model.
+    pub model: LightingModel,
+    /// Mask target index (0 for `mask`, 1 for `mask_1`).
+    pub target: usize,
+    /// Channel within the target (0 = R .. 3 = A).
+    pub channel: usize,
+}
+
+/// The passes and targets of one scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderPlan {
+    /// Scene name.
+    pub scene: String,
+    /// Output width.
+    pub width: u32,
+    /// Output height.
+    pub height: u32,
+    /// Targets, in allocation order.
+    pub targets: Vec<TargetSpec>,
+    /// Passes, in execution order.
+    pub passes: Vec<PassSpec>,
+    /// Lighting model to mask channel assignment.
+    pub mask_channels: Vec<MaskChannel>,
+}
+
+/// Names of the G-buffer targets, in attachment order.
+pub const GBUFFER_TARGETS: [&str; 5] = [
+    "gbuffer_position",
+    "gbuffer_normal",
+    "gbuffer_tangent",
+    "gbuffer_albedo",
+    "gbuffer_material",
+];
+
+/// Name of the depth target.
+pub const DEPTH: &str = "depth";
+/// Name of the HDR light buffer.
+pub const LIGHT: &str = "light";
+/// Name of the tone-mapped output.
+pub const FINAL: &str = "final";
+
+/// Name of mask target `index`.
+pub fn mask_target_name(index: usize) -> String {
+    if index == 0 {
+        "mask".to_owned()
+    } else {
+        format!("mask_{index}")
+    }
+}
+
+impl RenderPlan {
+    /// Builds the plan for a scene.
+    pub fn new(scene: &Scene) -> Self {
+        let models = scene.lighting_models();
+        let mask_channels: Vec<MaskChannel> = models
+            .iter()
+            .enumerate()
+            .map(|(i, &model)| MaskChannel {
+                model,
+                target: i / 4,
+                channel: i % 4,
+            })
+            .collect();
+        let mask_targets = models.len().div_ceil(4);
+        let gbuffer_contents = [
+            "xyz camera-relative position, w roughness",
+            "xyz normal (normal-mapped), w specular",
+            "xyz tangent, w handedness",
+            "rgb base color, a anisotropy",
+            "r metallic, g clearcoat, b clearcoat roughness, a specular exponent",
+        ];
+        let mut targets: Vec<TargetSpec> = GBUFFER_TARGETS
+            .iter()
+            .zip(gbuffer_contents)
+            .map(|(name, contents)| TargetSpec {
+                name: (*name).to_owned(),
+                format: TextureFormat::Rgba16Float,
+                contents: contents.to_owned(),
+            })
+            .collect();
+        targets.push(TargetSpec {
+            name: DEPTH.to_owned(),
+            format: TextureFormat::Depth32Float,
+            contents: "depth, 0 near .. 1 far".to_owned(),
+        });
+        for index in 0..mask_targets {
+            let channels: Vec<String> = mask_channels
+                .iter()
+                .filter(|c| c.target == index)
+                .map(|c| format!("{} {}", ["r", "g", "b", "a"][c.channel], c.model))
+                .collect();
+            targets.push(TargetSpec {
+                name: mask_target_name(index),
+                format: TextureFormat::Rgba8Unorm,
+                contents: channels.join(", "),
+            });
+        }
+        targets.push(TargetSpec {
+            name: LIGHT.to_owned(),
+            format: TextureFormat::Rgba16Float,
+            contents: format!("exposed radiance (exposure {})", scene.quality.exposure),
+        });
+        targets.push(TargetSpec {
+            name: FINAL.to_owned(),
+            format: TextureFormat::Rgba8UnormSrgb,
+            contents: format!("{} tone-mapped, sRGB", scene.quality.tone_map.name()),
+        });
+
+        let masks: Vec<String> = (0..mask_targets).map(mask_target_name).collect();
+        let gbuffer: Vec<String> = GBUFFER_TARGETS.iter().map(|s| (*s).to_owned()).collect();
+        let mut passes = Vec::new();
+        let objects = scene.objects.len();
+        let triangles: usize = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
+        passes.push(PassSpec {
+            name: "geometry".to_owned(),
+            kind: PassKind::Geometry,
+            reads: vec![],
+            writes: gbuffer.iter().cloned().chain([DEPTH.to_owned()]).collect(),
+            detail: format!("{objects} objects, {triangles} triangles"),
+        });
+        passes.push(PassSpec {
+            name: "mask".to_owned(),
+            kind: PassKind::ShaderMask,
+            reads: vec![DEPTH.to_owned()],
+            writes: masks.clone(),
+            detail: format!(
+                "{} models: {}",
+                models.len(),
+                models
+                    .iter()
+                    .map(|m| m.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        });
+        if let Some(environment) = &scene.environment {
+            passes.push(PassSpec {
+                name: "skybox".to_owned(),
+                kind: PassKind::Skybox,
+                reads: masks.clone(),
+                writes: vec![LIGHT.to_owned()],
+                detail: format!(
+                    "{}x{} equirectangular, rotation {} deg, intensity {}",
+                    environment.image.width,
+                    environment.image.height,
+                    environment.rotation_degrees,
+                    environment.intensity
+                ),
+            });
+        }
+        let batches = scene.lights.len().div_ceil(MAX_LIGHTS_PER_DRAW).max(1);
+        for channel in &mask_channels {
+            let mut reads = gbuffer.clone();
+            reads.push(mask_target_name(channel.target));
+            passes.push(PassSpec {
+                name: format!("lighting_{}", channel.model.name().replace('-', "_")),
+                kind: PassKind::Lighting(channel.model),
+                reads,
+                writes: vec![LIGHT.to_owned()],
+                detail: if channel.model == LightingModel::Unlit {
+                    "1 draw, no lights".to_owned()
+                } else {
+                    format!(
+                        "{} lights in {batches} draw(s), additive",
+                        scene.lights.len()
+                    )
+                },
+            });
+        }
+        passes.push(PassSpec {
+            name: "tonemap".to_owned(),
+            kind: PassKind::ToneMap,
+            reads: vec![LIGHT.to_owned()],
+            writes: vec![FINAL.to_owned()],
+            detail: scene.quality.tone_map.name().to_owned(),
+        });
+        if scene.quality.gizmos {
+            passes.push(PassSpec {
+                name: "gizmos".to_owned(),
+                kind: PassKind::Gizmos,
+                reads: vec![],
+                writes: vec![FINAL.to_owned()],
+                detail: "axes, light directions, point-light markers; no depth test".to_owned(),
+            });
+        }
+        Self {
+            scene: scene.name.clone(),
+            width: scene.quality.width,
+            height: scene.quality.height,
+            targets,
+            passes,
+            mask_channels,
+        }
+    }
+
+    /// The target with this name.
+    pub fn target(&self, name: &str) -> Option<&TargetSpec> {
+        self.targets.iter().find(|t| t.name == name)
+    }
+
+    /// Names of every target, in allocation order.
+    pub fn target_names(&self) -> Vec<&str> {
+        self.targets.iter().map(|t| t.name.as_str()).collect()
+    }
+}
+
+fn format_name(format: TextureFormat) -> &'static str {
+    match format {
+        TextureFormat::Rgba8Unorm => "rgba8",
+        TextureFormat::Rgba8UnormSrgb => "rgba8-srgb",
+        TextureFormat::Rgba16Float => "rgba16f",
+        TextureFormat::Rgba32Float => "rgba32f",
+        TextureFormat::R32Float => "r32f",
+        TextureFormat::Depth32Float => "depth32f",
+    }
+}
+
+impl fmt::Display for RenderPlan {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "scene {} at {}x{}", self.scene, self.width, self.height)?;
+        writeln!(f, "targets:")?;
+        for t in &self.targets {
+            writeln!(
+                f,
+                "  {:<17} {:<10} {}",
+                t.name,
+                format_name(t.format),
+                t.contents
+            )?;
+        }
+        writeln!(f, "passes:")?;
+        for (i, p) in self.passes.iter().enumerate() {
+            writeln!(f, "  {}. {:<19} {}", i + 1, p.name, p.detail)?;
+            if !p.reads.is_empty() {
+                writeln!(f, "       reads  {}", p.reads.join(", "))?;
+            }
+            writeln!(f, "       writes {}", p.writes.join(", "))?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,150 @@
+//! Uniform blocks of the renderer's shaders, laid out as the WGSL structs expect (std140-safe:
+//! only vec4 and mat4 members). Everything positional is made camera-relative here, in f64.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DVec3, Mat4};
+
+use super::{object_matrices, CameraMatrices};
+use crate::plan::{MaskChannel, MAX_LIGHTS_PER_DRAW};
+use crate::scene::{Light, Object, Scene, Transform};
+
+/// `LightData` in `lighting.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct LightData {
+    /// Directional: unit direction towards the light, w = 0. Point: camera-relative position,
+    /// w = 1.
+    pub position: [f32; 4],
+    /// rgb = color * intensity * exposure; a = radius.
+    pub color: [f32; 4],
+    /// x = 1 / falloff.
+    pub params: [f32; 4],
+}
+
+/// The scene's lights as the lighting pass sees them (camera-relative, exposure applied).
+pub fn light_uniforms(scene: &Scene) -> Vec<LightData> {
+    let exposure = scene.quality.exposure;
+    let origin = scene.camera.position;
+    scene
+        .lights
+        .iter()
+        .map(|light| match light {
+            Light::Directional {
+                direction,
+                color,
+                intensity,
+                ..
+            } => {
+                let d = direction.normalize().as_vec3();
+                LightData {
+                    position: [d.x, d.y, d.z, 0.0],
+                    color: scaled(color, intensity * exposure, 0.0),
+                    params: [0.0; 4],
+                }
+            }
+            Light::Point {
+                position,
+                color,
+                intensity,
+                radius,
+                falloff,
+                ..
+            } => {
+                let p = (*position - origin).as_vec3();
+                LightData {
+                    position: [p.x, p.y, p.z, 1.0],
+                    color: scaled(color, intensity * exposure, *radius),
+                    params: [1.0 / falloff, 0.0, 0.0, 0.0],
+                }
+            }
+        })
+        .collect()
+}
+
+fn scaled(color: &[f32; 3], factor: f32, w: f32) -> [f32; 4] {
+    [color[0] * factor, color[1] * factor, color[2] * factor, w]
+}
+
+/// `ObjectUniforms` in `gbuffer.wgsl`, as floats.
+pub(super) fn object_uniforms(
+    object: &Object,
+    transform: &Transform,
+    camera_position: DVec3,
+    view_projection: Mat4,
+    channel: MaskChannel,
+) -> Vec<f32> {
+    let (model, normal) = object_matrices(transform, camera_position);
+    let m = &object.material;
+    let flag = |present: Option<usize>| if present.is_some() { 1.0 } else { 0.0 };
+    let mut one_hot = [[0.0f32; 4]; 2];
+    one_hot[channel.target.min(1)][channel.channel] = 1.0;
+    let mut data = Vec::with_capacity(16 * 3 + 4 * 7);
+    data.extend_from_slice(&model.to_cols_array());
+    data.extend_from_slice(&Mat4::from_mat3(normal).to_cols_array());
+    data.extend_from_slice(&view_projection.to_cols_array());
+    data.extend_from_slice(&[
+        m.base_color[0],
+        m.base_color[1],
+        m.base_color[2],
+        m.anisotropy,
+    ]);
+    data.extend_from_slice(&[m.roughness, m.metallic, m.specular, m.clearcoat]);
+    data.extend_from_slice(&[m.clearcoat_roughness, m.specular_exponent, 0.0, 0.0]);
+    data.extend_from_slice(&[
+        flag(m.base_color_map),
+        flag(m.normal_map),
+        flag(m.roughness_map),
+        flag(m.metallic_map),
+    ]);
+    data.extend_from_slice(&[flag(m.clearcoat_map), flag(m.specular_map), 0.0, 0.0]);
+    data.extend_from_slice(&one_hot[0]);
+    data.extend_from_slice(&one_hot[1]);
+    data
+}
+
+/// `LightingUniforms` in `lighting.wgsl`, as bytes.
+pub(super) fn lighting_uniforms(
+    scene: &Scene,
+    channel: MaskChannel,
+    batch: &[LightData],
+    first_batch: bool,
+) -> Vec<u8> {
+    let mut select = [0.0f32; 4];
+    select[channel.channel] = 1.0;
+    let exposure = scene.quality.exposure;
+    let ambient = if first_batch {
+        [
+            scene.ambient[0] * exposure,
+            scene.ambient[1] * exposure,
+            scene.ambient[2] * exposure,
+            0.0,
+        ]
+    } else {
+        [0.0; 4]
+    };
+    let counts = [batch.len() as u32, u32::from(first_batch), 0, 0];
+    let mut lights = [LightData::default(); MAX_LIGHTS_PER_DRAW];
+    lights[..batch.len()].copy_from_slice(batch);
+    let mut bytes = Vec::new();
+    bytes.extend_from_slice(bytemuck::cast_slice(&select));
+    bytes.extend_from_slice(bytemuck::cast_slice(&ambient));
+    bytes.extend_from_slice(bytemuck::cast_slice(&counts));
+    bytes.extend_from_slice(bytemuck::cast_slice(&lights));
+    bytes
+}
+
+/// `SkyboxUniforms` in `skybox.wgsl`, as floats.
+pub(super) fn skybox_uniforms(scene: &Scene, camera: &CameraMatrices) -> Vec<f32> {
+    let inverse = camera.view_projection().inverse().as_mat4();
+    let (rotation, intensity) = scene.environment.as_ref().map_or((0.0, 0.0), |e| {
+        (e.rotation_degrees.to_radians(), e.intensity)
+    });
+    let mut data = inverse.to_cols_array().to_vec();
+    data.extend_from_slice(&[
+        scene.quality.width as f32,
+        scene.quality.height as f32,
+        rotation,
+        intensity * scene.quality.exposure,
+    ]);
+    data
+}

@@ -1,0 +1,417 @@
+//! The scene model: an immutable snapshot of everything a frame depends on (camera, objects,
+//! lights, environment, quality settings). Rendering a [`Scene`] is a pure function of it.
+//!
+//! World positions are `f64` ([`DVec3`]): the renderer subtracts the camera position in double
+//! precision before anything reaches the GPU, so a scene 10 km from the origin renders like the
+//! same scene at the origin.
+
+use std::fmt;
+use std::str::FromStr;
+use std::sync::Arc;
+
+use glam::{DMat4, DQuat, DVec3};
+use serde::{Deserialize, Serialize};
+
+use crate::mesh::MeshData;
+
+/// A decoded RGBA8 texture with its full mip chain (top row first).
+#[derive(Clone, Debug)]
+pub struct TextureImage {
+    /// Where it came from (file path or generator name), for messages.
+    pub label: String,
+    /// Whether the texels are sRGB-encoded color or linear data.
+    pub srgb: bool,
+    /// Width of mip 0.
+    pub width: u32,
+    /// Height of mip 0.
+    pub height: u32,
+    /// RGBA8 texels per mip level, level 0 first.
+    pub mips: Vec<Vec<u8>>,
+}
+
+/// An equirectangular HDR environment: linear RGBA f32 texels, top row first.
+#[derive(Clone, Debug)]
+pub struct EnvironmentImage {
+    /// Where it came from, for messages.
+    pub label: String,
+    /// Width in texels (longitude).
+    pub width: u32,
+    /// Height in texels (latitude, north at the top).
+    pub height: u32,
+    /// Texels.
+    pub texels: Vec<[f32; 4]>,
+}
+
+/// A perspective camera.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position in world space.
+    pub position: DVec3,
+    /// Point looked at.
+    pub target: DVec3,
+    /// Up direction.
+    pub up: DVec3,
+    /// Vertical field of view in degrees.
+    pub fov_y_degrees: f64,
+    /// Near plane distance.
+    pub near: f64,
+    /// Far plane distance.
+    pub far: f64,
+}
+
+impl Camera {
+    /// World-to-view rotation with the camera at the origin (camera-relative view matrix).
+    pub fn view_rotation(&self) -> DMat4 {
+        DMat4::look_at_rh(DVec3::ZERO, self.target - self.position, self.up)
+    }
+
+    /// Projection with depth 0 at the near plane and 1 at the far plane.
+    pub fn projection(&self, aspect: f64) -> DMat4 {
+        DMat4::perspective_rh(self.fov_y_degrees.to_radians(), aspect, self.near, self.far)
+    }
+}
+
+/// Translation, rotation and scale of an object.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Transform {
+    /// World position.
+    pub translation: DVec3,
+    /// Orientation.
+    pub rotation: DQuat,
+    /// Scale per axis.
+    pub scale: DVec3,
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Self {
+            translation: DVec3::ZERO,
+            rotation: DQuat::IDENTITY,
+            scale: DVec3::ONE,
+        }
+    }
+}
+
+impl Transform {
+    /// Object-to-camera-relative matrix: the translation is taken relative to `origin` in f64.
+    pub fn relative_to(&self, origin: DVec3) -> DMat4 {
+        DMat4::from_scale_rotation_translation(self.scale, self.rotation, self.translation - origin)
+    }
+}
+
+/// How the pixels of an object are lit. Each model used in a scene gets one shader-mask channel
+/// and one full-screen lighting pass.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LightingModel {
+    /// Filament's PBR: Lambert diffuse, GGX/Smith/Schlick specular, clearcoat, anisotropy.
+    Pbr,
+    /// Lambert diffuse plus Blinn-Phong specular with an exponent (the r2 seed's model).
+    BlinnPhong,
+    /// Lambert diffuse only.
+    Lambert,
+    /// Cel shading: N.L quantised into three bands.
+    Toon,
+    /// Albedo as emitted radiance, no lights.
+    Unlit,
+}
+
+impl LightingModel {
+    /// Every model, in mask-channel order.
+    pub const ALL: [LightingModel; 5] = [
+        LightingModel::Pbr,
+        LightingModel::BlinnPhong,
+        LightingModel::Lambert,
+        LightingModel::Toon,
+        LightingModel::Unlit,
+    ];
+
+    /// Name used in scene files, pass names and messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            LightingModel::Pbr => "pbr",
+            LightingModel::BlinnPhong => "blinn-phong",
+            LightingModel::Lambert => "lambert",
+            LightingModel::Toon => "toon",
+            LightingModel::Unlit => "unlit",
+        }
+    }
+
+    /// The fragment entry point of its lighting pass in `lighting.wgsl`.
+    pub fn entry_point(self) -> &'static str {
+        match self {
+            LightingModel::Pbr => "fs_pbr",
+            LightingModel::BlinnPhong => "fs_blinn_phong",
+            LightingModel::Lambert => "fs_lambert",
+            LightingModel::Toon => "fs_toon",
+            LightingModel::Unlit => "fs_unlit",
+        }
+    }
+}
+
+impl fmt::Display for LightingModel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for LightingModel {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
+                format!(
+                    "unknown lighting model `{s}` (expected one of: {})",
+                    names.join(", ")
+                )
+            })
+    }
+}
+
+/// Index of a texture in [`Scene::textures`].
+pub type TextureIndex = usize;
+
+/// Surface parameters. Where a map is present it replaces the scalar (the seed's rule: per-object
+/// parameters are the fallback where a material has no map).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Base color (albedo), linear RGB.
+    pub base_color: [f32; 3],
+    /// Perceptual roughness, 0..1.
+    pub roughness: f32,
+    /// Metallic, 0..1.
+    pub metallic: f32,
+    /// Specular (F0 = 0.16 specular^2 for dielectrics), 0..1; also Blinn-Phong's specular scale.
+    pub specular: f32,
+    /// Anisotropy, -1..1 (positive stretches highlights along the tangent).
+    pub anisotropy: f32,
+    /// Clearcoat strength, 0..1.
+    pub clearcoat: f32,
+    /// Clearcoat perceptual roughness, 0..1.
+    pub clearcoat_roughness: f32,
+    /// Blinn-Phong specular exponent.
+    pub specular_exponent: f32,
+    /// Base color map (sRGB; multiplies nothing, replaces `base_color`).
+    pub base_color_map: Option<TextureIndex>,
+    /// Tangent-space normal map (linear, OpenGL convention: +Y along +v).
+    pub normal_map: Option<TextureIndex>,
+    /// Roughness map (linear, red channel).
+    pub roughness_map: Option<TextureIndex>,
+    /// Metallic map (linear, red channel).
+    pub metallic_map: Option<TextureIndex>,
+    /// Clearcoat strength map (linear, red channel).
+    pub clearcoat_map: Option<TextureIndex>,
+    /// Specular map (linear, red channel).
+    pub specular_map: Option<TextureIndex>,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Self {
+            base_color: [0.8, 0.8, 0.8],
+            roughness: 0.5,
+            metallic: 0.0,
+            specular: 0.5,
+            anisotropy: 0.0,
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.1,
+            specular_exponent: 32.0,
+            base_color_map: None,
+            normal_map: None,
+            roughness_map: None,
+            metallic_map: None,
+            clearcoat_map: None,
+            specular_map: None,
+        }
+    }
+}
+
+/// One drawable: a mesh with a transform, a material and a lighting model.
+#[derive(Clone, Debug)]
+pub struct Object {
+    /// Name for messages and plans.
+    pub name: String,
+    /// Geometry (shared between objects that use the same mesh).
+    pub mesh: Arc<MeshData>,
+    /// Placement.
+    pub transform: Transform,
+    /// Surface.
+    pub material: Material,
+    /// Which lighting pass shades it.
+    pub lighting: LightingModel,
+    /// Whether it is drawn into shadow maps.
+    pub casts_shadows: bool,
+}
+
+/// Shadow-map settings of a light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowSettings {
+    /// Shadow map size in texels (square; per cube face for point lights).
+    pub map_size: u32,
+    /// Constant depth bias.
+    pub bias: f32,
+    /// Slope-scaled bias.
+    pub slope_bias: f32,
+}
+
+impl Default for ShadowSettings {
+    fn default() -> Self {
+        Self {
+            map_size: 1024,
+            bias: 0.002,
+            slope_bias: 2.0,
+        }
+    }
+}
+
+/// A light. Incoming radiance is `color * intensity * attenuation * shadow`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Light {
+    /// Parallel light from a direction.
+    Directional {
+        /// Direction from the surface towards the light (normalised when used).
+        direction: DVec3,
+        /// Linear RGB color.
+        color: [f32; 3],
+        /// Intensity multiplier.
+        intensity: f32,
+        /// Shadow map, if it casts shadows.
+        shadow: Option<ShadowSettings>,
+    },
+    /// Light from a point with the r2 renderer's attenuation
+    /// `max(0, 1 - (distance / radius)^(1 / falloff))`.
+    Point {
+        /// World position.
+        position: DVec3,
+        /// Linear RGB color.
+        color: [f32; 3],
+        /// Intensity multiplier.
+        intensity: f32,
+        /// Distance at which the light reaches zero.
+        radius: f32,
+        /// Shape of the falloff: 1 is linear, below 1 stays bright longer, above 1 fades sooner.
+        falloff: f32,
+        /// Shadow cube map, if it casts shadows.
+        shadow: Option<ShadowSettings>,
+    },
+}
+
+impl Light {
+    /// Whether the light has shadow settings.
+    pub fn casts_shadows(&self) -> bool {
+        match self {
+            Light::Directional { shadow, .. } | Light::Point { shadow, .. } => shadow.is_some(),
+        }
+    }
+}
+
+/// An environment map around the scene.
+#[derive(Clone, Debug)]
+pub struct Environment {
+    /// The equirectangular image.
+    pub image: Arc<EnvironmentImage>,
+    /// Rotation about +Y in degrees.
+    pub rotation_degrees: f32,
+    /// Radiance multiplier.
+    pub intensity: f32,
+}
+
+/// Tone-mapping operator from the exposed HDR light buffer to display values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ToneMap {
+    /// Narkowicz's fit of the ACES filmic curve: `x(2.51x+0.03) / (x(2.43x+0.59)+0.14)`.
+    Aces,
+    /// Reinhard: `x / (1 + x)` per channel.
+    Reinhard,
+    /// Clamp to 0..1 (for tests that read display values directly).
+    Clamp,
+}
+
+impl ToneMap {
+    /// Name in scene files and plans.
+    pub fn name(self) -> &'static str {
+        match self {
+            ToneMap::Aces => "aces",
+            ToneMap::Reinhard => "reinhard",
+            ToneMap::Clamp => "clamp",
+        }
+    }
+}
+
+/// Output size and the knobs that trade time for error.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Quality {
+    /// Output width in pixels.
+    pub width: u32,
+    /// Output height in pixels.
+    pub height: u32,
+    /// Linear exposure applied before the light buffer (keeps fp16 in range).
+    pub exposure: f32,
+    /// Tone-mapping operator.
+    pub tone_map: ToneMap,
+    /// Whether the gizmos pass runs (axes, light directions, point-light markers).
+    pub gizmos: bool,
+}
+
+impl Default for Quality {
+    fn default() -> Self {
+        Self {
+            width: 512,
+            height: 512,
+            exposure: 1.0,
+            tone_map: ToneMap::Aces,
+            gizmos: false,
+        }
+    }
+}
+
+/// Everything one frame depends on.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Scene name (file stem for scene files).
+    pub name: String,
+    /// The camera.
+    pub camera: Camera,
+    /// Drawables.
+    pub objects: Vec<Object>,
+    /// Lights, any number.
+    pub lights: Vec<Light>,
+    /// Uniform ambient radiance from every direction (linear RGB); zero for none.
+    pub ambient: [f32; 3],
+    /// Environment map, if any.
+    pub environment: Option<Environment>,
+    /// Textures referenced by materials ([`TextureIndex`]).
+    pub textures: Vec<Arc<TextureImage>>,
+    /// Output size and quality knobs.
+    pub quality: Quality,
+}
+
+impl Scene {
+    /// The lighting models the scene's objects use, in mask-channel order, without duplicates.
+    pub fn lighting_models(&self) -> Vec<LightingModel> {
+        LightingModel::ALL
+            .into_iter()
+            .filter(|m| self.objects.iter().any(|o| o.lighting == *m))
+            .collect()
+    }
+
+    /// The same scene moved by `offset` (objects, lights and camera).
+    pub fn translated(&self, offset: DVec3) -> Scene {
+        let mut moved = self.clone();
+        moved.camera.position += offset;
+        moved.camera.target += offset;
+        for object in &mut moved.objects {
+            object.transform.translation += offset;
+        }
+        for light in &mut moved.lights {
+            if let Light::Point { position, .. } = light {
+                *position += offset;
+            }
+        }
+        moved
+    }
+}

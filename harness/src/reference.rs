@@ -1,0 +1,436 @@
+//! CPU reference of the lighting pass in f64.
+//!
+//! It evaluates the same lighting models as `lighting.wgsl`, written independently from the
+//! formulas (Filament's BRDF for PBR, r2's Blinn-Phong), on the G-buffer read back from the GPU.
+//! Feeding both the same G-buffer isolates the lighting pass's arithmetic: what is left is f32
+//! against f64 and fp16 storage of the light buffer.
+//!
+//! Error metric (issue 3): per channel, `|gpu - ref| / max(|ref|, 1e-3 * max(ref))` over every
+//! pixel some lighting model covers; the 99.9th percentile must stay under 2e-3.
+
+use std::f64::consts::PI;
+
+use engine::plan;
+use engine::renderer::{light_uniforms, Frame};
+use engine::scene::{LightingModel, Scene};
+use engine::Image;
+use glam::DVec3;
+
+/// Largest value the lighting pass writes (fp16-safe clamp in `lighting.wgsl`).
+const FP16_SAFE_MAX: f64 = 65000.0;
+
+/// The G-buffer at one pixel, in f64.
+#[derive(Clone, Copy, Debug)]
+pub struct Surface {
+    /// Camera-relative position.
+    pub position: DVec3,
+    /// Perceptual roughness.
+    pub roughness: f64,
+    /// Unit normal.
+    pub normal: DVec3,
+    /// Specular.
+    pub specular: f64,
+    /// Tangent.
+    pub tangent: DVec3,
+    /// Base color.
+    pub base_color: DVec3,
+    /// Anisotropy.
+    pub anisotropy: f64,
+    /// Metallic.
+    pub metallic: f64,
+    /// Clearcoat strength.
+    pub clearcoat: f64,
+    /// Clearcoat roughness.
+    pub clearcoat_roughness: f64,
+    /// Blinn-Phong exponent.
+    pub specular_exponent: f64,
+}
+
+/// A light as the reference sees it: camera-relative, exposure applied.
+#[derive(Clone, Copy, Debug)]
+pub enum RefLight {
+    /// Direction towards the light and radiance.
+    Directional(DVec3, DVec3),
+    /// Camera-relative position, radiance, radius, 1 / falloff.
+    Point(DVec3, DVec3, f64, f64),
+}
+
+/// The scene's lights for the reference, from the same f64 scene data the renderer starts from.
+pub fn reference_lights(scene: &Scene) -> Vec<RefLight> {
+    // The GPU receives exactly these f32 values; the reference starts from them too, in f64.
+    light_uniforms(scene)
+        .iter()
+        .map(|l| {
+            let p = DVec3::new(
+                l.position[0] as f64,
+                l.position[1] as f64,
+                l.position[2] as f64,
+            );
+            let c = DVec3::new(l.color[0] as f64, l.color[1] as f64, l.color[2] as f64);
+            if l.position[3] < 0.5 {
+                RefLight::Directional(p, c)
+            } else {
+                RefLight::Point(p, c, l.color[3] as f64, l.params[0] as f64)
+            }
+        })
+        .collect()
+}
+
+fn pow5(x: f64) -> f64 {
+    x * x * x * x * x
+}
+
+/// GGX distribution.
+pub fn d_ggx(n_dot_h: f64, alpha: f64) -> f64 {
+    let a2 = alpha * alpha;
+    let f = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
+    a2 / (PI * f * f)
+}
+
+/// Height-correlated Smith-GGX visibility.
+pub fn v_smith_ggx_correlated(n_dot_v: f64, n_dot_l: f64, alpha: f64) -> f64 {
+    let a2 = alpha * alpha;
+    let lv = n_dot_l * (n_dot_v * n_dot_v * (1.0 - a2) + a2).sqrt();
+    let ll = n_dot_v * (n_dot_l * n_dot_l * (1.0 - a2) + a2).sqrt();
+    0.5 / (lv + ll)
+}
+
+/// Anisotropic GGX distribution (Burley; Filament's form).
+pub fn d_ggx_anisotropic(at: f64, ab: f64, t_dot_h: f64, b_dot_h: f64, n_dot_h: f64) -> f64 {
+    let x = t_dot_h / at;
+    let y = b_dot_h / ab;
+    let d = x * x + y * y + n_dot_h * n_dot_h;
+    1.0 / (PI * at * ab * d * d)
+}
+
+/// Anisotropic height-correlated Smith-GGX visibility (Heitz; Filament's form).
+#[allow(clippy::too_many_arguments)]
+pub fn v_smith_ggx_correlated_anisotropic(
+    at: f64,
+    ab: f64,
+    t_dot_v: f64,
+    b_dot_v: f64,
+    t_dot_l: f64,
+    b_dot_l: f64,
+    n_dot_v: f64,
+    n_dot_l: f64,
+) -> f64 {
+    let lv = n_dot_l * DVec3::new(at * t_dot_v, ab * b_dot_v, n_dot_v).length();
+    let ll = n_dot_v * DVec3::new(at * t_dot_l, ab * b_dot_l, n_dot_l).length();
+    0.5 / (lv + ll)
+}
+
+/// Filament's PBR BRDF times N.L.
+pub fn pbr(s: &Surface, v: DVec3, l: DVec3) -> DVec3 {
+    let n = s.normal;
+    let n_dot_l = n.dot(l).clamp(0.0, 1.0);
+    if n_dot_l <= 0.0 {
+        return DVec3::ZERO;
+    }
+    let n_dot_v = n.dot(v).max(1e-4);
+    let h = (v + l).try_normalize().unwrap_or(n);
+    let n_dot_h = n.dot(h).clamp(0.0, 1.0);
+    let l_dot_h = l.dot(h).clamp(0.0, 1.0);
+    let alpha = s.roughness * s.roughness + 0.001;
+    let f0 = DVec3::splat(0.16 * s.specular * s.specular * (1.0 - s.metallic))
+        + s.base_color * s.metallic;
+    let fresnel = f0 + (DVec3::ONE - f0) * pow5(1.0 - l_dot_h);
+    let (d, vis) = if s.anisotropy != 0.0 {
+        let t = s.tangent;
+        let b = n.cross(t);
+        let at = (alpha * (1.0 + s.anisotropy)).max(0.001);
+        let ab = (alpha * (1.0 - s.anisotropy)).max(0.001);
+        (
+            d_ggx_anisotropic(at, ab, t.dot(h), b.dot(h), n_dot_h),
+            v_smith_ggx_correlated_anisotropic(
+                at,
+                ab,
+                t.dot(v),
+                b.dot(v),
+                t.dot(l),
+                b.dot(l),
+                n_dot_v,
+                n_dot_l,
+            ),
+        )
+    } else {
+        (
+            d_ggx(n_dot_h, alpha),
+            v_smith_ggx_correlated(n_dot_v, n_dot_l, alpha),
+        )
+    };
+    let specular = fresnel * (d * vis);
+    let diffuse = s.base_color * (DVec3::ONE - fresnel) * (1.0 - s.metallic) / PI;
+    let clearcoat_alpha = s.clearcoat_roughness * s.clearcoat_roughness + 0.001;
+    let clearcoat_fresnel = (0.04 + 0.96 * pow5(1.0 - l_dot_h)) * s.clearcoat;
+    let clearcoat =
+        d_ggx(n_dot_h, clearcoat_alpha) * 0.25 / (l_dot_h * l_dot_h).max(1e-4) * clearcoat_fresnel;
+    ((diffuse + specular) * (1.0 - clearcoat_fresnel) + DVec3::splat(clearcoat)) * n_dot_l
+}
+
+/// Lambert diffuse plus Blinn-Phong specular (r2), times N.L for the diffuse part.
+pub fn blinn_phong(s: &Surface, v: DVec3, l: DVec3) -> DVec3 {
+    let n_dot_l = s.normal.dot(l);
+    if n_dot_l <= 0.0 {
+        return DVec3::ZERO;
+    }
+    let h = (v + l).try_normalize().unwrap_or(s.normal);
+    let n_dot_h = s.normal.dot(h).max(0.0);
+    s.base_color * n_dot_l + DVec3::splat(s.specular * n_dot_h.powf(s.specular_exponent.max(0.0)))
+}
+
+/// Direction to the light and radiance arriving at the surface.
+fn incoming(light: &RefLight, s: &Surface) -> (DVec3, DVec3) {
+    match *light {
+        RefLight::Directional(d, c) => (d, c),
+        RefLight::Point(p, c, radius, inverse_falloff) => {
+            let to_light = p - s.position;
+            let distance = to_light.length();
+            let l = if distance > 1e-6 {
+                to_light / distance
+            } else {
+                s.normal
+            };
+            let ratio = (distance / radius.max(1e-6)).min(1.0);
+            (l, c * (1.0 - ratio.powf(inverse_falloff)).max(0.0))
+        }
+    }
+}
+
+/// Exposed radiance the lighting pass should write for a surface.
+pub fn shade(model: LightingModel, s: &Surface, lights: &[RefLight], ambient: DVec3) -> DVec3 {
+    let v = (-s.position).try_normalize().unwrap_or(s.normal);
+    let mut radiance = match model {
+        LightingModel::Pbr => s.base_color * (1.0 - s.metallic) * ambient,
+        LightingModel::Unlit => s.base_color,
+        _ => s.base_color * ambient,
+    };
+    if model != LightingModel::Unlit {
+        for light in lights {
+            let (l, li) = incoming(light, s);
+            let f = match model {
+                LightingModel::Pbr => pbr(s, v, l),
+                LightingModel::BlinnPhong => blinn_phong(s, v, l),
+                LightingModel::Lambert => s.base_color * s.normal.dot(l).max(0.0) / PI,
+                LightingModel::Toon => {
+                    let n_dot_l = s.normal.dot(l);
+                    let band = if n_dot_l > 0.8 {
+                        1.0
+                    } else if n_dot_l > 0.4 {
+                        0.7
+                    } else if n_dot_l > 0.0 {
+                        0.35
+                    } else {
+                        0.0
+                    };
+                    s.base_color * band
+                }
+                LightingModel::Unlit => DVec3::ZERO,
+            };
+            radiance += f * li;
+        }
+    }
+    radiance.clamp(DVec3::ZERO, DVec3::splat(FP16_SAFE_MAX))
+}
+
+/// Result of comparing the GPU light buffer with the reference.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct LightingError {
+    /// Pixels compared (covered by some lighting model).
+    pub pixels: usize,
+    /// 99.9th percentile of the relative error over all compared channels.
+    pub p999_relative: f64,
+    /// Largest relative error.
+    pub max_relative: f64,
+    /// Non-finite values in the GPU light buffer.
+    pub non_finite: usize,
+    /// Pixel (x, y) of the largest error.
+    pub worst_pixel: (u32, u32),
+}
+
+/// Why the comparison could not run.
+#[derive(Debug, thiserror::Error)]
+#[error("reference comparison: {0}")]
+pub struct ReferenceError(String);
+
+fn f32_image<'a>(frame: &'a Frame, name: &str) -> Result<&'a Image, ReferenceError> {
+    frame
+        .output(name)
+        .ok_or_else(|| ReferenceError(format!("frame has no `{name}` output")))
+}
+
+fn sample(image: &Image, index: usize) -> [f64; 4] {
+    match &image.data {
+        engine::ImageData::F32(d) => {
+            let p = &d[index * 4..index * 4 + 4];
+            [p[0] as f64, p[1] as f64, p[2] as f64, p[3] as f64]
+        }
+        engine::ImageData::U8(d) => {
+            let p = &d[index * 4..index * 4 + 4];
+            [
+                p[0] as f64 / 255.0,
+                p[1] as f64 / 255.0,
+                p[2] as f64 / 255.0,
+                p[3] as f64 / 255.0,
+            ]
+        }
+    }
+}
+
+/// The G-buffer surface at pixel `index`.
+pub fn surface_at(gbuffer: &[&Image; 5], index: usize) -> Surface {
+    let [p, n, t, a, m] = gbuffer.map(|image| sample(image, index));
+    Surface {
+        position: DVec3::new(p[0], p[1], p[2]),
+        roughness: p[3].clamp(0.0, 1.0),
+        normal: DVec3::new(n[0], n[1], n[2]).normalize_or_zero(),
+        specular: n[3],
+        tangent: DVec3::new(t[0], t[1], t[2]),
+        base_color: DVec3::new(a[0], a[1], a[2]),
+        anisotropy: a[3].clamp(-1.0, 1.0),
+        metallic: m[0],
+        clearcoat: m[1],
+        clearcoat_roughness: m[2].clamp(0.0, 1.0),
+        specular_exponent: m[3],
+    }
+}
+
+/// The reference light buffer for every covered pixel: (pixel index, model, radiance).
+pub fn reference_light_buffer(
+    scene: &Scene,
+    frame: &Frame,
+) -> Result<Vec<(usize, LightingModel, DVec3)>, ReferenceError> {
+    let gbuffer = [
+        f32_image(frame, plan::GBUFFER_TARGETS[0])?,
+        f32_image(frame, plan::GBUFFER_TARGETS[1])?,
+        f32_image(frame, plan::GBUFFER_TARGETS[2])?,
+        f32_image(frame, plan::GBUFFER_TARGETS[3])?,
+        f32_image(frame, plan::GBUFFER_TARGETS[4])?,
+    ];
+    let masks: Vec<&Image> = (0..2)
+        .map(plan::mask_target_name)
+        .filter_map(|name| frame.output(&name))
+        .collect();
+    if masks.is_empty() {
+        return Err(ReferenceError("frame has no mask output".into()));
+    }
+    let lights = reference_lights(scene);
+    let exposure = scene.quality.exposure as f64;
+    let ambient = DVec3::new(
+        scene.ambient[0] as f64,
+        scene.ambient[1] as f64,
+        scene.ambient[2] as f64,
+    ) * exposure;
+    let pixels = (frame.plan.width * frame.plan.height) as usize;
+    let mut out = Vec::new();
+    for index in 0..pixels {
+        let model = frame.plan.mask_channels.iter().find(|c| {
+            masks
+                .get(c.target)
+                .is_some_and(|m| sample(m, index)[c.channel] > 0.5)
+        });
+        if let Some(channel) = model {
+            let s = surface_at(&gbuffer, index);
+            out.push((
+                index,
+                channel.model,
+                shade(channel.model, &s, &lights, ambient),
+            ));
+        }
+    }
+    Ok(out)
+}
+
+/// Compares the frame's light buffer with the reference (issue 3's metric).
+pub fn lighting_error(scene: &Scene, frame: &Frame) -> Result<LightingError, ReferenceError> {
+    let light = f32_image(frame, plan::LIGHT)?;
+    let reference = reference_light_buffer(scene, frame)?;
+    let image_max = reference
+        .iter()
+        .map(|(_, _, r)| r.max_element())
+        .fold(0.0, f64::max);
+    let floor = (1e-3 * image_max).max(f64::MIN_POSITIVE);
+    let mut errors = Vec::with_capacity(reference.len() * 3);
+    let mut non_finite = 0;
+    let mut worst = (0.0, 0usize);
+    for &(index, _, r) in &reference {
+        let g = sample(light, index);
+        for c in 0..3 {
+            if !g[c].is_finite() {
+                non_finite += 1;
+                continue;
+            }
+            let e = (g[c] - r[c]).abs() / r[c].abs().max(floor);
+            if e > worst.0 {
+                worst = (e, index);
+            }
+            errors.push(e);
+        }
+    }
+    errors.sort_by(f64::total_cmp);
+    let p999 = errors
+        .get(((errors.len() as f64 * 0.999).ceil() as usize).saturating_sub(1))
+        .copied()
+        .unwrap_or(0.0);
+    Ok(LightingError {
+        pixels: reference.len(),
+        p999_relative: p999,
+        max_relative: worst.0,
+        non_finite,
+        worst_pixel: (
+            (worst.1 as u32) % frame.plan.width,
+            (worst.1 as u32) / frame.plan.width,
+        ),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The GGX lobe integrates to one over the projected hemisphere: int D(h) (n.h) dh = 1.
+    #[test]
+    fn ggx_is_normalised() {
+        for alpha in [0.05, 0.3, 1.0] {
+            let steps = 20000;
+            let mut sum = 0.0;
+            for i in 0..steps {
+                let theta = (i as f64 + 0.5) / steps as f64 * PI / 2.0;
+                sum += d_ggx(theta.cos(), alpha)
+                    * theta.cos()
+                    * theta.sin()
+                    * 2.0
+                    * PI
+                    * (PI / 2.0 / steps as f64);
+            }
+            assert!((sum - 1.0).abs() < 1e-3, "alpha {alpha}: {sum}");
+        }
+    }
+
+    /// The anisotropic forms reduce to the isotropic ones at zero anisotropy.
+    #[test]
+    fn anisotropic_matches_isotropic_at_zero_anisotropy() {
+        let n = DVec3::Z;
+        let t = DVec3::X;
+        let b = n.cross(t);
+        let v = DVec3::new(0.3, -0.2, 0.9).normalize();
+        let l = DVec3::new(-0.5, 0.4, 0.6).normalize();
+        let h = (v + l).normalize();
+        let alpha = 0.35;
+        let iso = d_ggx(n.dot(h), alpha);
+        let aniso = d_ggx_anisotropic(alpha, alpha, t.dot(h), b.dot(h), n.dot(h));
+        assert!((iso - aniso).abs() / iso < 1e-12);
+        let iso_v = v_smith_ggx_correlated(n.dot(v), n.dot(l), alpha);
+        let aniso_v = v_smith_ggx_correlated_anisotropic(
+            alpha,
+            alpha,
+            t.dot(v),
+            b.dot(v),
+            t.dot(l),
+            b.dot(l),
+            n.dot(v),
+            n.dot(l),
+        );
+        assert!((iso_v - aniso_v).abs() / iso_v < 1e-12);
+    }
+}
