@@ -3,5 +3,6 @@
 
 pub mod compare;
 pub mod first_scene;
+pub mod images;
 pub mod reference;
 pub mod test_scenes;

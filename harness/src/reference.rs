@@ -11,7 +11,7 @@
 use std::f64::consts::PI;
 
 use engine::plan;
-use engine::renderer::{light_uniforms, Frame};
+use engine::renderer::{ambient_radiance, light_uniforms, Frame};
 use engine::scene::{LightingModel, Scene};
 use engine::Image;
 use glam::DVec3;
@@ -316,11 +316,8 @@ pub fn reference_light_buffer(
     }
     let lights = reference_lights(scene);
     let exposure = scene.quality.exposure as f64;
-    let ambient = DVec3::new(
-        scene.ambient[0] as f64,
-        scene.ambient[1] as f64,
-        scene.ambient[2] as f64,
-    ) * exposure;
+    let [r, g, b] = ambient_radiance(scene);
+    let ambient = DVec3::new(r as f64, g as f64, b as f64) * exposure;
     let pixels = (frame.plan.width * frame.plan.height) as usize;
     let mut out = Vec::new();
     for index in 0..pixels {

@@ -179,7 +179,7 @@ pub fn five_models(size: u32) -> Scene {
     let mut scene = empty_scene(
         "five_models",
         size,
-        camera(DVec3::new(0.0, 2.0, 6.0), DVec3::new(0.0, 0.3, 0.0)),
+        camera(DVec3::new(0.0, 2.5, 8.5), DVec3::new(0.0, 0.3, 0.0)),
     );
     for (i, model) in LightingModel::ALL.into_iter().enumerate() {
         scene.objects.push(sphere_at(

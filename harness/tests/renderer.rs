@@ -190,3 +190,86 @@ fn renders_are_deterministic() {
         }
     }
 }
+
+/// Normal mapping through the TBN and maps replacing scalars: a plane facing +Y (tangent +X,
+/// bitangent along +v = -Z) with a constant normal map tilting towards +u, then towards +v; a
+/// roughness map replaces the scalar, and without it the scalar is written.
+#[test]
+fn normal_and_parameter_maps_reach_the_gbuffer() {
+    use engine::scene::{Material, TextureImage};
+    use std::sync::Arc;
+
+    let texture = |rgba: [u8; 4], srgb: bool| {
+        Arc::new(TextureImage {
+            label: format!("{rgba:?}"),
+            srgb,
+            width: 2,
+            height: 2,
+            mips: vec![rgba.repeat(4), rgba.to_vec()],
+        })
+    };
+    // Tangent-space normals (0.6, 0, 0.8) and (0, 0.6, 0.8), encoded n * 0.5 + 0.5.
+    let cases = [
+        ([204u8, 128, 230, 255], [0.6f32, 0.8, 0.0]),
+        ([128u8, 204, 230, 255], [0.0f32, 0.8, -0.6]),
+    ];
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        for (encoded, expected) in cases {
+            let mut scene = test_scenes::many_point_lights(64, 1);
+            scene.camera.position = glam::DVec3::new(0.0, 5.0, 0.01);
+            scene.textures = vec![texture(encoded, false), texture([51, 0, 0, 255], false)];
+            scene.objects[0].material = Material {
+                normal_map: Some(0),
+                roughness_map: Some(1),
+                roughness: 0.9,
+                ..Material::default()
+            };
+            let frame = render(backend.as_mut(), &scene);
+            let normal = frame.output("gbuffer_normal").unwrap().pixel(32, 32);
+            let position = frame.output("gbuffer_position").unwrap().pixel(32, 32);
+            for i in 0..3 {
+                assert!(
+                    (normal[i] - expected[i]).abs() < 0.01,
+                    "{kind}: normal {normal:?}, expected {expected:?}"
+                );
+            }
+            assert!(
+                (position[3] - 0.2).abs() < 0.002,
+                "{kind}: roughness {}",
+                position[3]
+            );
+
+            scene.objects[0].material.roughness_map = None;
+            let frame = render(backend.as_mut(), &scene);
+            let position = frame.output("gbuffer_position").unwrap().pixel(32, 32);
+            assert!(
+                (position[3] - 0.9).abs() < 0.001,
+                "{kind}: scalar roughness {}",
+                position[3]
+            );
+        }
+    }
+}
+
+/// Gizmos are off by default and, when on, add a pass that draws over the final image only.
+#[test]
+fn gizmos_are_optional_and_only_touch_the_final_image() {
+    let mut scene = test_scenes::five_models(96);
+    assert!(!scene.quality.gizmos);
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        scene.quality.gizmos = false;
+        let plain = render(backend.as_mut(), &scene);
+        scene.quality.gizmos = true;
+        let with = render(backend.as_mut(), &scene);
+        assert!(!plain.plan.passes.iter().any(|p| p.name == "gizmos"));
+        assert!(with.plan.passes.iter().any(|p| p.name == "gizmos"));
+        assert_eq!(plain.outputs["light"], with.outputs["light"], "{kind}");
+        let changed =
+            harness::compare::u8_difference(&plain.outputs["final"], &with.outputs["final"], 0)
+                .unwrap()
+                .pixels_over;
+        assert!(changed > 50, "{kind}: gizmos changed only {changed} pixels");
+    }
+}

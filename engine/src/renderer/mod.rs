@@ -24,7 +24,7 @@ use crate::plan::{self, MaskChannel, PassKind, RenderPlan, MAX_LIGHTS_PER_DRAW};
 use crate::scene::{Light, LightingModel, Scene, ToneMap, Transform};
 use crate::shaders;
 
-pub use uniforms::light_uniforms;
+pub use uniforms::{ambient_radiance, environment_mean, light_uniforms};
 
 /// Why a frame could not be rendered.
 #[derive(Debug, thiserror::Error)]

@@ -6,7 +6,7 @@ use glam::{DVec3, Mat4};
 
 use super::{object_matrices, CameraMatrices};
 use crate::plan::{MaskChannel, MAX_LIGHTS_PER_DRAW};
-use crate::scene::{Light, Object, Scene, Transform};
+use crate::scene::{EnvironmentImage, Light, Object, Scene, Transform};
 
 /// `LightData` in `lighting.wgsl`.
 #[repr(C)]
@@ -113,12 +113,8 @@ pub(super) fn lighting_uniforms(
     select[channel.channel] = 1.0;
     let exposure = scene.quality.exposure;
     let ambient = if first_batch {
-        [
-            scene.ambient[0] * exposure,
-            scene.ambient[1] * exposure,
-            scene.ambient[2] * exposure,
-            0.0,
-        ]
+        let a = ambient_radiance(scene);
+        [a[0] * exposure, a[1] * exposure, a[2] * exposure, 0.0]
     } else {
         [0.0; 4]
     };
@@ -147,4 +143,40 @@ pub(super) fn skybox_uniforms(scene: &Scene, camera: &CameraMatrices) -> Vec<f32
         intensity * scene.quality.exposure,
     ]);
     data
+}
+
+/// Uniform ambient radiance the lighting passes apply (diffuse only): the scene's `ambient` plus,
+/// with an environment, its solid-angle-weighted mean radiance times its intensity (the
+/// environment's constant spherical-harmonic band; the IBL passes replace it).
+pub fn ambient_radiance(scene: &Scene) -> [f32; 3] {
+    let mut ambient = scene.ambient;
+    if let Some(env) = &scene.environment {
+        let mean = environment_mean(&env.image);
+        for c in 0..3 {
+            ambient[c] += (mean[c] * f64::from(env.intensity)) as f32;
+        }
+    }
+    ambient
+}
+
+/// Solid-angle-weighted mean of an equirectangular image (rows weighted by sin(latitude angle)).
+pub fn environment_mean(image: &EnvironmentImage) -> [f64; 3] {
+    let (w, h) = (image.width as usize, image.height as usize);
+    let mut sum = [0.0f64; 3];
+    let mut weight = 0.0;
+    for (y, row) in image.texels.chunks_exact(w.max(1)).take(h).enumerate() {
+        let theta = std::f64::consts::PI * (y as f64 + 0.5) / h as f64;
+        let row_weight = theta.sin();
+        for texel in row {
+            for c in 0..3 {
+                sum[c] += f64::from(texel[c]) * row_weight;
+            }
+        }
+        weight += row_weight * w as f64;
+    }
+    if weight > 0.0 {
+        sum.map(|s| s / weight)
+    } else {
+        [0.0; 3]
+    }
 }

@@ -1,0 +1,695 @@
+//! Scene files: TOML, parsed with serde into [`SceneFile`], then resolved into a [`Scene`] by
+//! loading the meshes, textures and environment they name. Paths are relative to the scene
+//! file. Unknown keys are errors that name the key, the file and the line.
+//!
+//! The `[tolerances]` table belongs to the golden harness; the engine keeps it as raw TOML
+//! ([`SceneFile::tolerances`]) for the harness to parse.
+//!
+//! The format is documented with a full example in the README ("Scene files").
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{DQuat, DVec3, EulerRot};
+use serde::Deserialize;
+
+use crate::assets::{self, AssetError, ColorSpace, TextureCache, TextureId};
+use crate::mesh::{self, MeshData};
+use crate::scene::*;
+
+/// Why a scene file could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneFileError {
+    /// The file could not be read.
+    #[error("{path}: cannot read scene file: {source}")]
+    Io {
+        /// Scene file.
+        path: PathBuf,
+        /// OS error.
+        source: std::io::Error,
+    },
+    /// TOML syntax error, wrong type or unknown key.
+    #[error("{path}:{line}:{column}: {message}")]
+    Parse {
+        /// Scene file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What is wrong (names the key for unknown keys).
+        message: String,
+    },
+    /// Parsed, but the values make no sense (NaN, negative radius, ...).
+    #[error("{path}: {message}")]
+    Invalid {
+        /// Scene file.
+        path: PathBuf,
+        /// What is wrong and where.
+        message: String,
+    },
+    /// A mesh, texture or environment it names failed to load.
+    #[error("{path}: {source}")]
+    Asset {
+        /// Scene file.
+        path: PathBuf,
+        /// The asset error (names the asset file).
+        source: AssetError,
+    },
+    /// `--scene NAME` named no canonical scene.
+    #[error("no scene `{name}`: not a file, and not one of the scenes in {dir} ({known})")]
+    UnknownScene {
+        /// What was asked for.
+        name: String,
+        /// Where canonical scenes were looked for.
+        dir: String,
+        /// Scenes found there.
+        known: String,
+    },
+}
+
+fn default_up() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+fn default_fov() -> f64 {
+    45.0
+}
+fn default_near() -> f64 {
+    0.05
+}
+fn default_far() -> f64 {
+    100.0
+}
+fn default_one() -> f32 {
+    1.0
+}
+fn default_true() -> bool {
+    true
+}
+
+/// `[camera]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraSpec {
+    /// Eye position.
+    pub position: [f64; 3],
+    /// Point looked at.
+    pub target: [f64; 3],
+    /// Up vector (default +Y).
+    #[serde(default = "default_up")]
+    pub up: [f64; 3],
+    /// Vertical field of view, degrees (default 45).
+    #[serde(default = "default_fov")]
+    pub fov_y: f64,
+    /// Near plane (default 0.05).
+    #[serde(default = "default_near")]
+    pub near: f64,
+    /// Far plane (default 100).
+    #[serde(default = "default_far")]
+    pub far: f64,
+}
+
+/// `[quality]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QualitySpec {
+    /// Output width (default 512).
+    pub width: Option<u32>,
+    /// Output height (default 512).
+    pub height: Option<u32>,
+    /// Linear exposure (default 1).
+    pub exposure: Option<f32>,
+    /// `aces` (default), `reinhard` or `clamp`.
+    pub tone_map: Option<ToneMap>,
+    /// Draw gizmos (default false).
+    pub gizmos: Option<bool>,
+}
+
+/// `[environment]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentSpec {
+    /// Equirectangular EXR, relative to the scene file.
+    pub path: PathBuf,
+    /// Rotation about +Y in degrees.
+    #[serde(default)]
+    pub rotation: f32,
+    /// Radiance multiplier (default 1).
+    #[serde(default = "default_one")]
+    pub intensity: f32,
+}
+
+/// Material overrides; every field is optional and replaces the MTL's value or the default.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Linear base color.
+    pub base_color: Option<[f32; 3]>,
+    /// Perceptual roughness.
+    pub roughness: Option<f32>,
+    /// Metallic.
+    pub metallic: Option<f32>,
+    /// Specular.
+    pub specular: Option<f32>,
+    /// Anisotropy -1..1.
+    pub anisotropy: Option<f32>,
+    /// Clearcoat strength.
+    pub clearcoat: Option<f32>,
+    /// Clearcoat roughness.
+    pub clearcoat_roughness: Option<f32>,
+    /// Blinn-Phong exponent.
+    pub specular_exponent: Option<f32>,
+    /// Set false to ignore the MTL's maps (scalars only).
+    pub use_maps: Option<bool>,
+}
+
+/// A scale: one number or three.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum ScaleSpec {
+    /// Uniform.
+    Uniform(f64),
+    /// Per axis.
+    PerAxis([f64; 3]),
+}
+
+/// `[[objects]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectSpec {
+    /// Name (default: the mesh file stem and index).
+    pub name: Option<String>,
+    /// OBJ path relative to the scene file, or `builtin:sphere` / `builtin:plane`.
+    pub mesh: String,
+    /// World position.
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// Euler angles in degrees, applied X, then Y, then Z.
+    #[serde(default)]
+    pub rotation: [f64; 3],
+    /// Scale (default 1).
+    pub scale: Option<ScaleSpec>,
+    /// Lighting model (default `pbr`).
+    pub lighting: Option<LightingModel>,
+    /// Drawn into shadow maps (default true).
+    #[serde(default = "default_true")]
+    pub casts_shadows: bool,
+    /// Overrides for every mesh of the object.
+    #[serde(default)]
+    pub material: MaterialSpec,
+    /// Overrides per MTL material name (applied after `material`).
+    #[serde(default)]
+    pub materials: BTreeMap<String, MaterialSpec>,
+}
+
+/// `[lights.shadow]`.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShadowSpec {
+    /// Map size in texels (default 1024).
+    pub map_size: Option<u32>,
+    /// Constant bias.
+    pub bias: Option<f32>,
+    /// Slope-scaled bias.
+    pub slope_bias: Option<f32>,
+}
+
+/// `[[lights]]`.
+#[derive(Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum LightSpec {
+    /// A directional light.
+    Directional {
+        /// Direction from the scene towards the light.
+        direction: [f64; 3],
+        /// Linear color (default white).
+        color: Option<[f32; 3]>,
+        /// Intensity (default 1).
+        intensity: Option<f32>,
+        /// Shadow settings; absent means no shadows.
+        shadow: Option<ShadowSpec>,
+    },
+    /// A point light with r2 attenuation.
+    Point {
+        /// Position.
+        position: [f64; 3],
+        /// Linear color (default white).
+        color: Option<[f32; 3]>,
+        /// Intensity (default 1).
+        intensity: Option<f32>,
+        /// Radius where the light reaches zero.
+        radius: f32,
+        /// Falloff exponent shape (default 1, linear).
+        falloff: Option<f32>,
+        /// Shadow settings; absent means no shadows.
+        shadow: Option<ShadowSpec>,
+    },
+}
+
+/// A parsed scene file, before any asset is loaded.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Scene name (default: file stem).
+    pub name: Option<String>,
+    /// One-line description shown by `harness inspect` and the report.
+    pub description: Option<String>,
+    /// Uniform ambient radiance (default black).
+    #[serde(default)]
+    pub ambient: [f32; 3],
+    /// Camera.
+    pub camera: CameraSpec,
+    /// Quality.
+    #[serde(default = "QualitySpec::empty")]
+    pub quality: QualitySpec,
+    /// Environment.
+    pub environment: Option<EnvironmentSpec>,
+    /// Objects.
+    #[serde(default)]
+    pub objects: Vec<ObjectSpec>,
+    /// Lights.
+    #[serde(default)]
+    pub lights: Vec<LightSpec>,
+    /// Per-pass tolerances, parsed by the harness.
+    #[serde(default)]
+    pub tolerances: toml::Table,
+}
+
+impl QualitySpec {
+    fn empty() -> Self {
+        Self {
+            width: None,
+            height: None,
+            exposure: None,
+            tone_map: None,
+            gizmos: None,
+        }
+    }
+}
+
+/// A loaded scene with what the harness needs from its file.
+pub struct LoadedScene {
+    /// The scene.
+    pub scene: Scene,
+    /// Where it was loaded from.
+    pub path: PathBuf,
+    /// The description line.
+    pub description: Option<String>,
+    /// Raw `[tolerances]` table.
+    pub tolerances: toml::Table,
+    /// Texture files decoded while loading (each at most once).
+    pub textures_decoded: usize,
+}
+
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+    (line, column)
+}
+
+/// Parses scene-file text (no assets are loaded).
+pub fn parse(path: &Path, text: &str) -> Result<SceneFile, SceneFileError> {
+    toml::from_str(text).map_err(|e| {
+        let (line, column) = e
+            .span()
+            .map_or((1, 1), |span| line_column(text, span.start));
+        SceneFileError::Parse {
+            path: path.to_owned(),
+            line,
+            column,
+            message: e.message().trim().to_owned(),
+        }
+    })
+}
+
+/// Finds a scene by canonical name (`chess`) or path (`scenes/chess.toml`). Names are looked
+/// up in `scenes_dir`.
+pub fn resolve(name_or_path: &str, scenes_dir: &Path) -> Result<PathBuf, SceneFileError> {
+    let as_path = Path::new(name_or_path);
+    if as_path.is_file() {
+        return Ok(as_path.to_owned());
+    }
+    let candidate = scenes_dir.join(format!("{name_or_path}.toml"));
+    if candidate.is_file() {
+        return Ok(candidate);
+    }
+    Err(SceneFileError::UnknownScene {
+        name: name_or_path.to_owned(),
+        dir: scenes_dir.display().to_string(),
+        known: canonical_scenes(scenes_dir).join(", "),
+    })
+}
+
+/// Names of the scene files directly in `scenes_dir`, sorted.
+pub fn canonical_scenes(scenes_dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(scenes_dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter_map(|e| {
+            let path = e.path();
+            (path.extension().is_some_and(|x| x == "toml"))
+                .then(|| path.file_stem()?.to_str().map(str::to_owned))
+                .flatten()
+        })
+        .collect();
+    names.sort();
+    names
+}
+
+/// Reads, parses and resolves a scene file, loading every asset it names.
+pub fn load(path: &Path) -> Result<LoadedScene, SceneFileError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneFileError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    let file = parse(path, &text)?;
+    Resolver::new(path).resolve(file)
+}
+
+struct Resolver {
+    path: PathBuf,
+    dir: PathBuf,
+    cache: TextureCache,
+    texture_index: HashMap<TextureId, usize>,
+    textures: Vec<Arc<TextureImage>>,
+    models: HashMap<PathBuf, Arc<MeshParts>>,
+}
+
+/// The meshes of one OBJ file, each with its MTL material.
+type MeshParts = Vec<(Arc<MeshData>, Option<assets::MaterialData>)>;
+
+fn finite(values: &[f64]) -> bool {
+    values.iter().all(|v| v.is_finite())
+}
+
+impl Resolver {
+    fn new(path: &Path) -> Self {
+        Self {
+            path: path.to_owned(),
+            dir: path.parent().map(Path::to_owned).unwrap_or_default(),
+            cache: TextureCache::new(),
+            texture_index: HashMap::new(),
+            textures: Vec::new(),
+            models: HashMap::new(),
+        }
+    }
+
+    fn invalid(&self, message: String) -> SceneFileError {
+        SceneFileError::Invalid {
+            path: self.path.clone(),
+            message,
+        }
+    }
+
+    fn asset(&self, source: AssetError) -> SceneFileError {
+        SceneFileError::Asset {
+            path: self.path.clone(),
+            source,
+        }
+    }
+
+    fn texture(&mut self, id: Option<TextureId>) -> Option<usize> {
+        let id = id?;
+        if let Some(&index) = self.texture_index.get(&id) {
+            return Some(index);
+        }
+        let data = self.cache.get(id)?;
+        let index = self.textures.len();
+        self.textures.push(Arc::new(TextureImage {
+            label: data.path.display().to_string(),
+            srgb: data.color_space == ColorSpace::Srgb,
+            width: data.width,
+            height: data.height,
+            mips: data.mips.clone(),
+        }));
+        self.texture_index.insert(id, index);
+        Some(index)
+    }
+
+    /// The meshes (with their MTL materials) of an OBJ file or built-in mesh, loaded once.
+    fn model(&mut self, mesh_ref: &str) -> Result<Arc<MeshParts>, SceneFileError> {
+        let key = if mesh_ref.starts_with("builtin:") {
+            PathBuf::from(mesh_ref)
+        } else {
+            self.dir.join(mesh_ref)
+        };
+        if let Some(parts) = self.models.get(&key) {
+            return Ok(parts.clone());
+        }
+        let parts: MeshParts = match mesh_ref.strip_prefix("builtin:") {
+            Some("sphere") => vec![(Arc::new(mesh::uv_sphere(64, 32)), None)],
+            Some("plane") => vec![(Arc::new(mesh::plane(1.0, 1.0)), None)],
+            Some(other) => {
+                return Err(self.invalid(format!(
+                    "unknown built-in mesh `builtin:{other}` (expected builtin:sphere or \
+                     builtin:plane)"
+                )))
+            }
+            None => {
+                let model = assets::load_obj(&key, &mut self.cache).map_err(|e| self.asset(e))?;
+                let materials = model.materials;
+                model
+                    .meshes
+                    .into_iter()
+                    .map(|m| {
+                        let material = m.material.and_then(|i| materials.get(i).cloned());
+                        (Arc::new(m), material)
+                    })
+                    .collect()
+            }
+        };
+        let parts = Arc::new(parts);
+        self.models.insert(key, parts.clone());
+        Ok(parts)
+    }
+
+    fn resolve(mut self, file: SceneFile) -> Result<LoadedScene, SceneFileError> {
+        let c = &file.camera;
+        if !finite(&[c.fov_y, c.near, c.far]) || !finite(&c.position) || !finite(&c.target) {
+            return Err(self.invalid("[camera]: values must be finite".into()));
+        }
+        let camera = Camera {
+            position: DVec3::from(c.position),
+            target: DVec3::from(c.target),
+            up: DVec3::from(c.up),
+            fov_y_degrees: c.fov_y,
+            near: c.near,
+            far: c.far,
+        };
+        let defaults = Quality::default();
+        let q = &file.quality;
+        let quality = Quality {
+            width: q.width.unwrap_or(defaults.width),
+            height: q.height.unwrap_or(defaults.height),
+            exposure: q.exposure.unwrap_or(defaults.exposure),
+            tone_map: q.tone_map.unwrap_or(defaults.tone_map),
+            gizmos: q.gizmos.unwrap_or(defaults.gizmos),
+        };
+        let environment = match &file.environment {
+            Some(spec) => {
+                let env_path = self.dir.join(&spec.path);
+                let loaded = assets::load_environment(&env_path).map_err(|e| self.asset(e))?;
+                Some(Environment {
+                    image: Arc::new(EnvironmentImage {
+                        label: env_path.display().to_string(),
+                        width: loaded.width,
+                        height: loaded.height,
+                        texels: loaded.texels,
+                    }),
+                    rotation_degrees: spec.rotation,
+                    intensity: spec.intensity,
+                })
+            }
+            None => None,
+        };
+
+        let mut objects = Vec::new();
+        for (index, spec) in file.objects.iter().enumerate() {
+            let parts = self.model(&spec.mesh)?;
+            let base_name = spec.name.clone().unwrap_or_else(|| {
+                let stem = Path::new(&spec.mesh)
+                    .file_stem()
+                    .and_then(|s| s.to_str())
+                    .unwrap_or("object");
+                format!("{stem}_{index}")
+            });
+            if !finite(&spec.position) || !finite(&spec.rotation) {
+                return Err(self.invalid(format!(
+                    "object `{base_name}`: position and rotation must be finite"
+                )));
+            }
+            let scale = match spec.scale {
+                None => DVec3::ONE,
+                Some(ScaleSpec::Uniform(s)) => DVec3::splat(s),
+                Some(ScaleSpec::PerAxis(s)) => DVec3::from(s),
+            };
+            let [rx, ry, rz] = spec.rotation.map(f64::to_radians);
+            let transform = Transform {
+                translation: DVec3::from(spec.position),
+                rotation: DQuat::from_euler(EulerRot::ZYX, rz, ry, rx),
+                scale,
+            };
+            let single = parts.len() == 1;
+            for (mesh, mtl) in parts.iter() {
+                let mut material = Material::default();
+                let mut use_maps = true;
+                let mtl_name = mtl.as_ref().map(|m| m.name.clone());
+                let overrides = std::iter::once(&spec.material).chain(
+                    mtl_name
+                        .as_ref()
+                        .and_then(|name| spec.materials.get(name)),
+                );
+                if let Some(mtl) = mtl {
+                    if let Some(kd) = mtl.diffuse {
+                        material.base_color = kd;
+                    }
+                    if let Some(ns) = mtl.shininess {
+                        material.specular_exponent = ns;
+                    }
+                }
+                for o in overrides.clone() {
+                    if let Some(v) = o.use_maps {
+                        use_maps = v;
+                    }
+                }
+                if let (Some(mtl), true) = (mtl, use_maps) {
+                    let maps = mtl.maps.clone();
+                    material.base_color_map = self.texture(maps.base_color);
+                    material.normal_map = self.texture(maps.normal);
+                    material.roughness_map = self.texture(maps.roughness);
+                    material.metallic_map = self.texture(maps.metallic);
+                    material.clearcoat_map = self.texture(maps.clearcoat);
+                    material.specular_map = self.texture(maps.specular);
+                }
+                for o in overrides {
+                    apply(&mut material, o);
+                }
+                let name = if single {
+                    base_name.clone()
+                } else {
+                    format!("{base_name}/{}", mesh.name)
+                };
+                objects.push(Object {
+                    name,
+                    mesh: mesh.clone(),
+                    transform,
+                    material,
+                    lighting: spec.lighting.unwrap_or(LightingModel::Pbr),
+                    casts_shadows: spec.casts_shadows,
+                });
+            }
+        }
+
+        let mut lights = Vec::new();
+        for (index, spec) in file.lights.iter().enumerate() {
+            let shadow = |s: &Option<ShadowSpec>| {
+                s.map(|s| {
+                    let d = ShadowSettings::default();
+                    ShadowSettings {
+                        map_size: s.map_size.unwrap_or(d.map_size),
+                        bias: s.bias.unwrap_or(d.bias),
+                        slope_bias: s.slope_bias.unwrap_or(d.slope_bias),
+                    }
+                })
+            };
+            let light = match spec {
+                LightSpec::Directional {
+                    direction,
+                    color,
+                    intensity,
+                    shadow: s,
+                } => Light::Directional {
+                    direction: DVec3::from(*direction),
+                    color: color.unwrap_or([1.0; 3]),
+                    intensity: intensity.unwrap_or(1.0),
+                    shadow: shadow(s),
+                },
+                LightSpec::Point {
+                    position,
+                    color,
+                    intensity,
+                    radius,
+                    falloff,
+                    shadow: s,
+                } => Light::Point {
+                    position: DVec3::from(*position),
+                    color: color.unwrap_or([1.0; 3]),
+                    intensity: intensity.unwrap_or(1.0),
+                    radius: *radius,
+                    falloff: falloff.unwrap_or(1.0),
+                    shadow: shadow(s),
+                },
+            };
+            if let Some(s) = match &light {
+                Light::Directional { shadow, .. } | Light::Point { shadow, .. } => shadow,
+            } {
+                if !(64..=8192).contains(&s.map_size) || !s.bias.is_finite() {
+                    return Err(self.invalid(format!(
+                        "light {index}: shadow map_size must be 64..8192 and bias finite"
+                    )));
+                }
+            }
+            lights.push(light);
+        }
+
+        let name = file.name.clone().unwrap_or_else(|| {
+            self.path
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("scene")
+                .to_owned()
+        });
+        let scene = Scene {
+            name,
+            camera,
+            objects,
+            lights,
+            ambient: file.ambient,
+            environment,
+            textures: self.textures.clone(),
+            quality,
+        };
+        crate::renderer::validate(&scene).map_err(|e| self.invalid(e.to_string()))?;
+        Ok(LoadedScene {
+            scene,
+            path: self.path.clone(),
+            description: file.description,
+            tolerances: file.tolerances,
+            textures_decoded: self.cache.decode_count(),
+        })
+    }
+}
+
+fn apply(material: &mut Material, o: &MaterialSpec) {
+    if let Some(v) = o.base_color {
+        material.base_color = v;
+        material.base_color_map = None;
+    }
+    let mut set = |value: Option<f32>, target: &mut f32| {
+        if let Some(v) = value {
+            *target = v;
+        }
+    };
+    set(o.roughness, &mut material.roughness);
+    set(o.metallic, &mut material.metallic);
+    set(o.specular, &mut material.specular);
+    set(o.anisotropy, &mut material.anisotropy);
+    set(o.clearcoat, &mut material.clearcoat);
+    set(o.clearcoat_roughness, &mut material.clearcoat_roughness);
+    set(o.specular_exponent, &mut material.specular_exponent);
+    if o.roughness.is_some() {
+        material.roughness_map = None;
+    }
+    if o.metallic.is_some() {
+        material.metallic_map = None;
+    }
+    if o.clearcoat.is_some() {
+        material.clearcoat_map = None;
+    }
+    if o.specular.is_some() {
+        material.specular_map = None;
+    }
+}

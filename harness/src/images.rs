@@ -1,0 +1,312 @@
+//! Reading and writing pass outputs: PNG for 8-bit images, EXR (fp16, ZIP-compressed) for float
+//! images. Every write goes to a temporary file beside the destination and is renamed into place,
+//! so a crash or a full disk never leaves a half-written image (or golden) behind.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use engine::backend::TextureFormat;
+use engine::{Image, ImageData};
+
+/// Why an image could not be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageFileError {
+    /// File system error.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// OS error.
+        source: std::io::Error,
+    },
+    /// PNG encode or decode error.
+    #[error("{path}: PNG: {message}")]
+    Png {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// EXR encode or decode error.
+    #[error("{path}: EXR: {message}")]
+    Exr {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// The image cannot be stored in this format.
+    #[error("{path}: {message}")]
+    Unsupported {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
+}
+
+/// Writes `bytes` to `path` atomically (temporary file in the same folder, fsync, rename).
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ImageFileError> {
+    let io = |source| ImageFileError::Io {
+        path: path.to_owned(),
+        source,
+    };
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(io)?;
+    }
+    let file_name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let temp = path.with_file_name(format!(".{file_name}.tmp{}", std::process::id()));
+    let result = (|| {
+        let mut file = std::fs::File::create(&temp)?;
+        file.write_all(bytes)?;
+        file.sync_all()?;
+        std::fs::rename(&temp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&temp);
+    }
+    result.map_err(io)
+}
+
+/// PNG bytes of an 8-bit RGBA image.
+pub fn encode_png(image: &Image, path: &Path) -> Result<Vec<u8>, ImageFileError> {
+    use image::ImageEncoder;
+    let data = image.as_u8().ok_or_else(|| ImageFileError::Unsupported {
+        path: path.to_owned(),
+        message: format!("{:?} is a float image; write it as .exr", image.format),
+    })?;
+    let mut out = Vec::new();
+    image::codecs::png::PngEncoder::new_with_quality(
+        &mut out,
+        image::codecs::png::CompressionType::Best,
+        image::codecs::png::FilterType::Adaptive,
+    )
+    .write_image(
+        data,
+        image.width,
+        image.height,
+        image::ExtendedColorType::Rgba8,
+    )
+    .map_err(|e| ImageFileError::Png {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })?;
+    Ok(out)
+}
+
+/// An 8-bit view of any image for looking at: float channels clamped to 0..1 and scaled
+/// (no tone mapping, no sRGB encoding); depth shown as gray.
+pub fn display_u8(image: &Image) -> Image {
+    match &image.data {
+        ImageData::U8(_) => image.clone(),
+        ImageData::F32(data) => {
+            let channels = image.channels();
+            let mut out = Vec::with_capacity((image.width * image.height * 4) as usize);
+            for texel in data.chunks_exact(channels) {
+                let c = |i: usize| texel.get(i).copied().unwrap_or(texel[0]);
+                for i in 0..3 {
+                    out.push((c(i).clamp(0.0, 1.0) * 255.0).round() as u8);
+                }
+                out.push(255);
+            }
+            Image {
+                width: image.width,
+                height: image.height,
+                format: TextureFormat::Rgba8Unorm,
+                data: ImageData::U8(out),
+            }
+        }
+    }
+}
+
+/// Writes an image: `.png` needs 8 bits (float images are converted with [`display_u8`]),
+/// `.exr` stores float RGBA as fp16 (depth and R32F as f32) with ZIP compression.
+pub fn write_image(image: &Image, path: &Path) -> Result<(), ImageFileError> {
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match extension.as_str() {
+        "png" => write_atomically(path, &encode_png(&display_u8(image), path)?),
+        "exr" => write_atomically(path, &encode_exr(image, path)?),
+        _ => Err(ImageFileError::Unsupported {
+            path: path.to_owned(),
+            message: "unknown image extension (use .png or .exr)".to_owned(),
+        }),
+    }
+}
+
+/// EXR bytes of a float image.
+pub fn encode_exr(image: &Image, path: &Path) -> Result<Vec<u8>, ImageFileError> {
+    use exr::prelude::*;
+    let data = image.as_f32().ok_or_else(|| ImageFileError::Unsupported {
+        path: path.to_owned(),
+        message: "EXR output needs a float image; write 8-bit images as .png".to_owned(),
+    })?;
+    let channels = image.channels();
+    let (w, h) = (image.width as usize, image.height as usize);
+    let exr_error = |e: exr::error::Error| ImageFileError::Exr {
+        path: path.to_owned(),
+        message: e.to_string(),
+    };
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    let encoding = Encoding {
+        compression: Compression::ZIP16,
+        ..Encoding::FAST_LOSSLESS
+    };
+    if channels == 1 {
+        // Depth and single-channel data stay f32: fp16 would quantise depth.
+        let layer = Layer::new(
+            (w, h),
+            LayerAttributes::named("main"),
+            encoding,
+            SpecificChannels::build()
+                .with_channel("Y")
+                .with_pixel_fn(|p: Vec2<usize>| (data[p.y() * w + p.x()],)),
+        );
+        exr::image::Image::from_layer(layer)
+            .write()
+            .to_buffered(&mut bytes)
+            .map_err(exr_error)?;
+    } else {
+        let layer = Layer::new(
+            (w, h),
+            LayerAttributes::named("main"),
+            encoding,
+            SpecificChannels::rgba(|p: Vec2<usize>| {
+                let t = &data[(p.y() * w + p.x()) * channels..];
+                (
+                    f16::from_f32(t[0]),
+                    f16::from_f32(t[1]),
+                    f16::from_f32(t[2]),
+                    f16::from_f32(t[3]),
+                )
+            }),
+        );
+        exr::image::Image::from_layer(layer)
+            .write()
+            .to_buffered(&mut bytes)
+            .map_err(exr_error)?;
+    }
+    Ok(bytes.into_inner())
+}
+
+/// Reads a PNG as RGBA8 (format `Rgba8Unorm`; the caller knows whether it holds sRGB).
+pub fn read_png(path: &Path) -> Result<Image, ImageFileError> {
+    let decoded = image::open(path).map_err(|e| ImageFileError::Png {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })?;
+    let rgba = decoded.to_rgba8();
+    Ok(Image {
+        width: rgba.width(),
+        height: rgba.height(),
+        format: TextureFormat::Rgba8Unorm,
+        data: ImageData::U8(rgba.into_raw()),
+    })
+}
+
+/// Reads the first layer of an EXR written by [`write_image`] (RGBA or single channel).
+pub fn read_exr(path: &Path) -> Result<engine::Image, ImageFileError> {
+    use exr::prelude::*;
+    let exr_error = |e: exr::error::Error| ImageFileError::Exr {
+        path: path.to_owned(),
+        message: e.to_string(),
+    };
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(exr_error)?;
+    let layer = image.layer_data;
+    let (w, h) = (layer.size.width(), layer.size.height());
+    let channel = |name: &str| {
+        layer
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name.eq_case_insensitive(name))
+            .map(|c| c.sample_data.values_as_f32().collect::<Vec<f32>>())
+    };
+    if let Some(y) = channel("Y") {
+        return Ok(engine::Image {
+            width: w as u32,
+            height: h as u32,
+            format: TextureFormat::R32Float,
+            data: ImageData::F32(y),
+        });
+    }
+    let (Some(r), Some(g), Some(b)) = (channel("R"), channel("G"), channel("B")) else {
+        return Err(ImageFileError::Exr {
+            path: path.to_owned(),
+            message: "no R, G, B or Y channels".to_owned(),
+        });
+    };
+    let a = channel("A").unwrap_or_else(|| vec![1.0; w * h]);
+    let mut data = Vec::with_capacity(w * h * 4);
+    for i in 0..w * h {
+        data.extend_from_slice(&[r[i], g[i], b[i], a[i]]);
+    }
+    Ok(engine::Image {
+        width: w as u32,
+        height: h as u32,
+        format: TextureFormat::Rgba32Float,
+        data: ImageData::F32(data),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exr_round_trips_fp16_values_and_depth_exactly() {
+        let dir = std::env::temp_dir().join(format!("harness-images-{}", std::process::id()));
+        let rgba = Image {
+            width: 3,
+            height: 2,
+            format: TextureFormat::Rgba16Float,
+            data: ImageData::F32(
+                (0..24)
+                    .map(|i| half::f16::from_f32(i as f32 * 0.37 - 2.0).to_f32())
+                    .collect(),
+            ),
+        };
+        let path = dir.join("rgba.exr");
+        write_image(&rgba, &path).unwrap();
+        let back = read_exr(&path).unwrap();
+        assert_eq!(back.data, rgba.data);
+        let depth = Image {
+            width: 2,
+            height: 2,
+            format: TextureFormat::Depth32Float,
+            data: ImageData::F32(vec![0.1234567, 1.0, 0.5, 0.999_999_9]),
+        };
+        let path = dir.join("depth.exr");
+        write_image(&depth, &path).unwrap();
+        assert_eq!(read_exr(&path).unwrap().data, depth.data);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn png_round_trips() {
+        let dir = std::env::temp_dir().join(format!("harness-png-{}", std::process::id()));
+        let image = Image {
+            width: 2,
+            height: 1,
+            format: TextureFormat::Rgba8UnormSrgb,
+            data: ImageData::U8(vec![1, 2, 3, 255, 250, 128, 0, 255]),
+        };
+        let path = dir.join("a.png");
+        write_image(&image, &path).unwrap();
+        assert_eq!(read_png(&path).unwrap().data, image.data);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
