@@ -4,5 +4,7 @@
 pub mod compare;
 pub mod first_scene;
 pub mod images;
+pub mod metrics;
 pub mod reference;
 pub mod test_scenes;
+pub mod tolerance;

@@ -1,0 +1,378 @@
+//! Image-difference metrics, written once and used by tolerances, the report and bless.
+//!
+//! Every metric compares an `actual` image with a `golden` (expected) one of the same size and
+//! channel count. 8-bit images are compared in 0..1 units (1/255 per step); float images in their
+//! own units. Each metric is tested on synthetic images with known answers.
+//!
+//! - `max_abs`: largest per-channel absolute difference (per channel and overall).
+//! - `fraction_over(t)`: fraction of pixels with some channel differing by more than `t`.
+//! - `rmse` and `psnr` (peak 1 for 8-bit images, the golden's largest value for float images).
+//! - `relative`: `|a - g| / max(|g|, 1e-3 * max(g))` per channel; its percentile and maximum.
+//! - `flip_mean` / `flip_percentile`: NVIDIA FLIP (LDR) via `nv-flip`, for sRGB 8-bit images.
+//! - a shift radius `r` makes `max_abs` and `fraction_over` forgiving of edge jitter: each actual
+//!   pixel is compared with the best-matching golden pixel within `r` pixels.
+//!
+//! Non-finite values are counted separately and always fail (see [`crate::tolerance`]).
+
+use engine::{Image, ImageData};
+
+/// Why two images cannot be compared.
+#[derive(Debug, thiserror::Error)]
+pub enum MetricError {
+    /// Different sizes or channel counts.
+    #[error("size or layout differs: actual {actual}, golden {golden}")]
+    Mismatch {
+        /// Actual image shape.
+        actual: String,
+        /// Golden image shape.
+        golden: String,
+    },
+    /// FLIP needs 8-bit RGBA images.
+    #[error("FLIP needs 8-bit images")]
+    FlipNeedsU8,
+}
+
+/// Both images as f32 values (8-bit scaled to 0..1) with their channel count.
+pub struct Pair {
+    actual: Vec<f32>,
+    golden: Vec<f32>,
+    width: usize,
+    height: usize,
+    channels: usize,
+    eight_bit: bool,
+}
+
+fn shape(image: &Image) -> String {
+    format!(
+        "{}x{} {:?} ({} channels)",
+        image.width,
+        image.height,
+        image.format,
+        image.channels()
+    )
+}
+
+fn values(image: &Image) -> Vec<f32> {
+    match &image.data {
+        ImageData::U8(d) => d.iter().map(|&v| f32::from(v) / 255.0).collect(),
+        ImageData::F32(d) => d.clone(),
+    }
+}
+
+impl Pair {
+    /// Prepares two images for comparison.
+    pub fn new(actual: &Image, golden: &Image) -> Result<Self, MetricError> {
+        let same = actual.width == golden.width
+            && actual.height == golden.height
+            && actual.channels() == golden.channels()
+            && matches!(actual.data, ImageData::U8(_)) == matches!(golden.data, ImageData::U8(_));
+        if !same {
+            return Err(MetricError::Mismatch {
+                actual: shape(actual),
+                golden: shape(golden),
+            });
+        }
+        Ok(Self {
+            actual: values(actual),
+            golden: values(golden),
+            width: actual.width as usize,
+            height: actual.height as usize,
+            channels: actual.channels(),
+            eight_bit: matches!(actual.data, ImageData::U8(_)),
+        })
+    }
+
+    /// Number of pixels.
+    pub fn pixels(&self) -> usize {
+        self.width * self.height
+    }
+
+    /// Non-finite values in the actual image.
+    pub fn non_finite(&self) -> usize {
+        self.actual.iter().filter(|v| !v.is_finite()).count()
+    }
+
+    /// Per-pixel largest channel difference, comparing each actual pixel with the closest golden
+    /// pixel within `shift` pixels (0: the same pixel).
+    pub fn pixel_differences(&self, shift: u32) -> Vec<f32> {
+        let c = self.channels;
+        let r = shift as isize;
+        let mut out = Vec::with_capacity(self.pixels());
+        for y in 0..self.height {
+            for x in 0..self.width {
+                let a = &self.actual[(y * self.width + x) * c..][..c];
+                let mut best = f32::INFINITY;
+                for dy in -r..=r {
+                    for dx in -r..=r {
+                        let (gx, gy) = (x as isize + dx, y as isize + dy);
+                        if gx < 0
+                            || gy < 0
+                            || gx >= self.width as isize
+                            || gy >= self.height as isize
+                        {
+                            continue;
+                        }
+                        let g = &self.golden[(gy as usize * self.width + gx as usize) * c..][..c];
+                        let d = a
+                            .iter()
+                            .zip(g)
+                            .map(|(a, g)| (a - g).abs())
+                            .fold(
+                                0.0f32,
+                                |m, d| if d.is_nan() { f32::INFINITY } else { m.max(d) },
+                            );
+                        best = best.min(d);
+                    }
+                }
+                out.push(best);
+            }
+        }
+        out
+    }
+
+    /// Largest absolute difference per channel (no shift).
+    pub fn max_abs_per_channel(&self) -> Vec<f64> {
+        let mut max = vec![0.0f64; self.channels];
+        for (i, (a, g)) in self.actual.iter().zip(&self.golden).enumerate() {
+            let d = f64::from((a - g).abs());
+            let slot = &mut max[i % self.channels];
+            *slot = if d.is_nan() {
+                f64::INFINITY
+            } else {
+                slot.max(d)
+            };
+        }
+        max
+    }
+
+    /// Largest absolute difference over all channels, with a shift radius.
+    pub fn max_abs(&self, shift: u32) -> f64 {
+        self.pixel_differences(shift)
+            .into_iter()
+            .fold(0.0f64, |m, d| m.max(f64::from(d)))
+    }
+
+    /// Fraction of pixels with a channel differing by more than `threshold`, with a shift radius.
+    pub fn fraction_over(&self, threshold: f64, shift: u32) -> f64 {
+        let over = self
+            .pixel_differences(shift)
+            .into_iter()
+            .filter(|&d| f64::from(d) > threshold)
+            .count();
+        over as f64 / self.pixels().max(1) as f64
+    }
+
+    /// Root-mean-square difference over all channels.
+    pub fn rmse(&self) -> f64 {
+        let sum: f64 = self
+            .actual
+            .iter()
+            .zip(&self.golden)
+            .map(|(a, g)| f64::from(a - g).powi(2))
+            .sum();
+        (sum / self.actual.len().max(1) as f64).sqrt()
+    }
+
+    /// Peak signal-to-noise ratio in dB (infinite for identical images).
+    pub fn psnr(&self) -> f64 {
+        let peak = if self.eight_bit {
+            1.0
+        } else {
+            self.golden
+                .iter()
+                .filter(|v| v.is_finite())
+                .fold(0.0f64, |m, &v| m.max(f64::from(v).abs()))
+                .max(1e-12)
+        };
+        let rmse = self.rmse();
+        if rmse == 0.0 {
+            f64::INFINITY
+        } else {
+            20.0 * (peak / rmse).log10()
+        }
+    }
+
+    /// Relative error per channel, `|a - g| / max(|g|, floor * max|g|)`, sorted ascending.
+    pub fn relative_errors(&self, floor: f64) -> Vec<f64> {
+        let golden_max = self
+            .golden
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, |m, &v| m.max(f64::from(v).abs()));
+        let denominator_floor = (floor * golden_max).max(f64::MIN_POSITIVE);
+        let mut errors: Vec<f64> = self
+            .actual
+            .iter()
+            .zip(&self.golden)
+            .map(|(&a, &g)| {
+                let (a, g) = (f64::from(a), f64::from(g));
+                let e = (a - g).abs() / g.abs().max(denominator_floor);
+                if e.is_nan() {
+                    f64::INFINITY
+                } else {
+                    e
+                }
+            })
+            .collect();
+        errors.sort_by(f64::total_cmp);
+        errors
+    }
+
+    /// The `percentile` (0..1) of the relative error.
+    pub fn relative_percentile(&self, percentile: f64, floor: f64) -> f64 {
+        percentile_of_sorted(&self.relative_errors(floor), percentile)
+    }
+
+    /// FLIP error map of two 8-bit images (values 0..1 per pixel).
+    pub fn flip_map(actual: &Image, golden: &Image) -> Result<Vec<f32>, MetricError> {
+        let (ImageData::U8(a), ImageData::U8(g)) = (&actual.data, &golden.data) else {
+            return Err(MetricError::FlipNeedsU8);
+        };
+        let rgb =
+            |d: &[u8]| -> Vec<u8> { d.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect() };
+        let reference = nv_flip::FlipImageRgb8::with_data(golden.width, golden.height, &rgb(g));
+        let test = nv_flip::FlipImageRgb8::with_data(actual.width, actual.height, &rgb(a));
+        Ok(nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE).to_vec())
+    }
+}
+
+/// The `percentile` (0..1) of an ascending list (nearest rank).
+pub fn percentile_of_sorted(sorted: &[f64], percentile: f64) -> f64 {
+    if sorted.is_empty() {
+        return 0.0;
+    }
+    let rank = ((sorted.len() as f64 * percentile).ceil() as usize).clamp(1, sorted.len());
+    sorted[rank - 1]
+}
+
+/// Mean and percentile of a FLIP error map.
+pub fn flip_stats(map: &[f32], percentile: f64) -> (f64, f64) {
+    let mean = map.iter().map(|&v| f64::from(v)).sum::<f64>() / map.len().max(1) as f64;
+    let mut sorted: Vec<f64> = map.iter().map(|&v| f64::from(v)).collect();
+    sorted.sort_by(f64::total_cmp);
+    (mean, percentile_of_sorted(&sorted, percentile))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use engine::backend::TextureFormat;
+
+    fn u8_image(width: u32, height: u32, f: impl Fn(u32, u32) -> [u8; 4]) -> Image {
+        let mut data = Vec::new();
+        for y in 0..height {
+            for x in 0..width {
+                data.extend_from_slice(&f(x, y));
+            }
+        }
+        Image {
+            width,
+            height,
+            format: TextureFormat::Rgba8UnormSrgb,
+            data: ImageData::U8(data),
+        }
+    }
+
+    fn f32_image(width: u32, height: u32, f: impl Fn(u32, u32) -> [f32; 4]) -> Image {
+        let mut data = Vec::new();
+        for y in 0..height {
+            for x in 0..width {
+                data.extend_from_slice(&f(x, y));
+            }
+        }
+        Image {
+            width,
+            height,
+            format: TextureFormat::Rgba16Float,
+            data: ImageData::F32(data),
+        }
+    }
+
+    #[test]
+    fn identical_images_have_zero_error() {
+        let a = u8_image(8, 8, |x, y| [x as u8 * 30, y as u8 * 30, 7, 255]);
+        let pair = Pair::new(&a, &a).unwrap();
+        assert_eq!(pair.max_abs(0), 0.0);
+        assert_eq!(pair.fraction_over(0.0, 0), 0.0);
+        assert_eq!(pair.rmse(), 0.0);
+        assert!(pair.psnr().is_infinite());
+        let map = Pair::flip_map(&a, &a).unwrap();
+        assert_eq!(flip_stats(&map, 0.99), (0.0, 0.0));
+    }
+
+    #[test]
+    fn known_differences_give_known_numbers() {
+        // 10 of 100 pixels differ by 51/255 = 0.2 in red only.
+        let golden = u8_image(10, 10, |_, _| [100, 100, 100, 255]);
+        let actual = u8_image(10, 10, |x, _| {
+            [if x == 3 { 151 } else { 100 }, 100, 100, 255]
+        });
+        let pair = Pair::new(&actual, &golden).unwrap();
+        assert!((pair.max_abs(0) - 0.2).abs() < 1e-6);
+        assert_eq!(pair.max_abs_per_channel()[1], 0.0);
+        assert!((pair.fraction_over(0.1, 0) - 0.1).abs() < 1e-12);
+        assert_eq!(pair.fraction_over(0.25, 0), 0.0);
+        // RMSE: 10 of 400 values off by 0.2 -> sqrt(10 * 0.04 / 400) = sqrt(0.001).
+        assert!((pair.rmse() - 0.001f64.sqrt()).abs() < 1e-6);
+        assert!((pair.psnr() - 30.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn shift_radius_forgives_a_one_pixel_edge_move() {
+        let golden = u8_image(16, 4, |x, _| if x < 8 { [0; 4] } else { [255; 4] });
+        let actual = u8_image(16, 4, |x, _| if x < 9 { [0; 4] } else { [255; 4] });
+        let pair = Pair::new(&actual, &golden).unwrap();
+        assert!((pair.fraction_over(0.5, 0) - 4.0 / 64.0).abs() < 1e-12);
+        assert_eq!(pair.fraction_over(0.5, 1), 0.0);
+        assert_eq!(pair.max_abs(1), 0.0);
+    }
+
+    #[test]
+    fn relative_error_uses_the_floor_for_dark_pixels() {
+        let golden = f32_image(2, 1, |x, _| if x == 0 { [100.0; 4] } else { [0.0; 4] });
+        let actual = f32_image(2, 1, |x, _| if x == 0 { [101.0; 4] } else { [0.05; 4] });
+        let pair = Pair::new(&actual, &golden).unwrap();
+        let errors = pair.relative_errors(1e-3);
+        // Bright pixel: 1/100; dark pixel: 0.05 / (1e-3 * 100) = 0.5.
+        assert!((errors[0] - 0.01).abs() < 1e-9);
+        assert!((errors[7] - 0.5).abs() < 1e-6);
+        assert!((pair.relative_percentile(0.5, 1e-3) - 0.01).abs() < 1e-9);
+    }
+
+    #[test]
+    fn non_finite_values_are_counted_and_make_errors_infinite() {
+        let golden = f32_image(2, 1, |_, _| [1.0; 4]);
+        let actual = f32_image(2, 1, |x, _| {
+            if x == 0 {
+                [f32::NAN, 1.0, 1.0, 1.0]
+            } else {
+                [1.0; 4]
+            }
+        });
+        let pair = Pair::new(&actual, &golden).unwrap();
+        assert_eq!(pair.non_finite(), 1);
+        assert!(pair.max_abs(0).is_infinite());
+        assert!(pair.relative_percentile(1.0, 1e-3).is_infinite());
+    }
+
+    #[test]
+    fn flip_grows_with_the_difference() {
+        let golden = u8_image(32, 32, |x, y| [(x * 6) as u8, (y * 8) as u8, 128, 255]);
+        let small = u8_image(32, 32, |x, y| [(x * 6) as u8 + 2, (y * 8) as u8, 128, 255]);
+        let large = u8_image(32, 32, |x, y| [(x * 6) as u8 + 40, (y * 8) as u8, 128, 255]);
+        let (small_mean, _) = flip_stats(&Pair::flip_map(&small, &golden).unwrap(), 0.99);
+        let (large_mean, _) = flip_stats(&Pair::flip_map(&large, &golden).unwrap(), 0.99);
+        assert!(small_mean > 0.0 && small_mean < 0.05, "{small_mean}");
+        assert!(
+            large_mean > 3.0 * small_mean,
+            "{small_mean} vs {large_mean}"
+        );
+    }
+
+    #[test]
+    fn mismatched_sizes_are_an_error() {
+        let a = u8_image(2, 2, |_, _| [0; 4]);
+        let b = u8_image(3, 2, |_, _| [0; 4]);
+        assert!(Pair::new(&a, &b).is_err());
+    }
+}
