@@ -1,0 +1,327 @@
+//! Golden images: where they live, how a pass output is checked against one, and blessing.
+//!
+//! Layout: `golden/<scene>/<pass>.png` for 8-bit outputs (final image, masks) and
+//! `golden/<scene>/<pass>.exr` (fp16, ZIP; depth as f32) for float outputs, one golden per scene
+//! and pass for every backend, plus `golden/<scene>/blessed.toml` recording, per pass, when it was
+//! blessed, from which backend and driver, and how it differed from the golden it replaced.
+//!
+//! Blessing refuses images with NaN/Inf, writes atomically (temporary file and rename), and
+//! touches only the passes it is asked to.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use engine::backend::DriverInfo;
+use engine::{Image, ImageData};
+
+use crate::images::{self, ImageFileError};
+use crate::tolerance::{Rule, Verdict};
+
+/// Pass outputs that get goldens, when the scene's plan has them.
+pub const GOLDEN_PASSES: [&str; 7] = [
+    "gbuffer_normal",
+    "gbuffer_albedo",
+    "depth",
+    "mask",
+    "mask_1",
+    "light",
+    "final",
+];
+
+/// Why a golden operation failed.
+#[derive(Debug, thiserror::Error)]
+pub enum GoldenError {
+    /// Reading or writing an image.
+    #[error(transparent)]
+    File(#[from] ImageFileError),
+    /// The image to bless has NaN or infinite values.
+    #[error("refusing to bless {scene}/{pass}: {count} NaN/Inf values in the image")]
+    NonFinite {
+        /// Scene.
+        scene: String,
+        /// Pass.
+        pass: String,
+        /// How many.
+        count: usize,
+    },
+    /// blessed.toml could not be read or written.
+    #[error("{path}: {message}")]
+    Record {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+/// The golden folder.
+#[derive(Clone, Debug)]
+pub struct GoldenStore {
+    root: PathBuf,
+}
+
+/// What `blessed.toml` holds for one pass.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize, PartialEq)]
+pub struct BlessRecord {
+    /// UTC time of the bless (RFC 3339).
+    pub blessed: String,
+    /// Backend the golden was rendered on.
+    pub backend: String,
+    /// Driver fingerprint of that backend.
+    pub driver: String,
+    /// Metrics against the golden it replaced, or "new".
+    pub previous: String,
+}
+
+#[derive(Debug, Default, serde::Serialize, serde::Deserialize)]
+struct BlessFile {
+    #[serde(default)]
+    passes: BTreeMap<String, BlessRecord>,
+}
+
+/// A one-line driver fingerprint.
+pub fn fingerprint(info: &DriverInfo) -> String {
+    let mut parts = vec![
+        format!("{} {}", info.api, info.api_version),
+        info.renderer.clone(),
+    ];
+    if let Some(mesa) = &info.mesa_version {
+        parts.push(format!("Mesa {mesa}"));
+    }
+    if let Some(llvm) = &info.llvm_version {
+        parts.push(format!("LLVM {llvm}"));
+    }
+    for (k, v) in &info.env {
+        parts.push(format!("{k}={v}"));
+    }
+    parts.join(" | ")
+}
+
+/// Whether a pass is stored as 8-bit PNG (otherwise EXR).
+pub fn is_eight_bit(image: &Image) -> bool {
+    matches!(image.data, ImageData::U8(_))
+}
+
+impl GoldenStore {
+    /// A store rooted at `root` (usually `<workspace>/golden`).
+    pub fn new(root: impl Into<PathBuf>) -> Self {
+        Self { root: root.into() }
+    }
+
+    /// The workspace's `golden/` folder.
+    pub fn workspace() -> Self {
+        Self::new(crate::workspace_root().join("golden"))
+    }
+
+    /// Root folder.
+    pub fn root(&self) -> &Path {
+        &self.root
+    }
+
+    /// Path of a golden; the extension follows the image kind.
+    pub fn path(&self, scene: &str, pass: &str, eight_bit: bool) -> PathBuf {
+        self.root
+            .join(scene)
+            .join(format!("{pass}.{}", if eight_bit { "png" } else { "exr" }))
+    }
+
+    /// Loads a golden; `Ok(None)` when it does not exist.
+    pub fn load(
+        &self,
+        scene: &str,
+        pass: &str,
+        eight_bit: bool,
+    ) -> Result<Option<Image>, GoldenError> {
+        let path = self.path(scene, pass, eight_bit);
+        if !path.exists() {
+            return Ok(None);
+        }
+        Ok(Some(if eight_bit {
+            images::read_png(&path)?
+        } else {
+            images::read_exr(&path)?
+        }))
+    }
+
+    fn record_path(&self, scene: &str) -> PathBuf {
+        self.root.join(scene).join("blessed.toml")
+    }
+
+    /// What blessed.toml says about each pass of a scene.
+    pub fn records(&self, scene: &str) -> Result<BTreeMap<String, BlessRecord>, GoldenError> {
+        let path = self.record_path(scene);
+        if !path.exists() {
+            return Ok(BTreeMap::new());
+        }
+        let text = std::fs::read_to_string(&path).map_err(|e| GoldenError::Record {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+        let file: BlessFile = toml::from_str(&text).map_err(|e| GoldenError::Record {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+        Ok(file.passes)
+    }
+
+    /// Writes `image` as the golden of `scene`/`pass` and records the bless. Refuses NaN/Inf.
+    pub fn bless(
+        &self,
+        scene: &str,
+        pass: &str,
+        image: &Image,
+        backend: &str,
+        driver: &str,
+        previous: &str,
+    ) -> Result<PathBuf, GoldenError> {
+        if let Some(values) = image.as_f32() {
+            let count = values.iter().filter(|v| !v.is_finite()).count();
+            if count > 0 {
+                return Err(GoldenError::NonFinite {
+                    scene: scene.to_owned(),
+                    pass: pass.to_owned(),
+                    count,
+                });
+            }
+        }
+        let eight_bit = is_eight_bit(image);
+        let path = self.path(scene, pass, eight_bit);
+        images::write_image(image, &path)?;
+        // A pass changing kind (PNG <-> EXR) must not leave the old file behind.
+        let stale = self.path(scene, pass, !eight_bit);
+        if stale.exists() {
+            let _ = std::fs::remove_file(stale);
+        }
+        let mut records = self.records(scene)?;
+        records.insert(
+            pass.to_owned(),
+            BlessRecord {
+                blessed: humantime::format_rfc3339_seconds(std::time::SystemTime::now())
+                    .to_string(),
+                backend: backend.to_owned(),
+                driver: driver.to_owned(),
+                previous: previous.to_owned(),
+            },
+        );
+        let text = toml::to_string_pretty(&BlessFile { passes: records }).map_err(|e| {
+            GoldenError::Record {
+                path: self.record_path(scene),
+                message: e.to_string(),
+            }
+        })?;
+        let header = "# Written by `harness bless`: when each golden was blessed, from which \
+                      backend and driver,\n# and how it differed from the golden it replaced.\n\n";
+        images::write_atomically(
+            &self.record_path(scene),
+            format!("{header}{text}").as_bytes(),
+        )?;
+        Ok(path)
+    }
+}
+
+/// Outcome of checking one pass output against its golden.
+#[derive(Clone, Debug, serde::Serialize)]
+pub enum Outcome {
+    /// Within tolerance.
+    Passed(Verdict),
+    /// Outside tolerance (or NaN/Inf).
+    Failed(Verdict),
+    /// No golden yet.
+    MissingGolden,
+    /// Golden and output cannot be compared (size or format changed).
+    Incomparable(String),
+}
+
+impl Outcome {
+    /// Whether the check passed.
+    pub fn passed(&self) -> bool {
+        matches!(self, Outcome::Passed(_))
+    }
+}
+
+/// Checks an output against its golden with a rule.
+pub fn check(actual: &Image, golden: Option<&Image>, rule: &Rule) -> Outcome {
+    let Some(golden) = golden else {
+        return Outcome::MissingGolden;
+    };
+    match rule.evaluate(actual, golden) {
+        Ok(verdict) if verdict.passed => Outcome::Passed(verdict),
+        Ok(verdict) => Outcome::Failed(verdict),
+        Err(e) => Outcome::Incomparable(e.to_string()),
+    }
+}
+
+/// A diff heatmap: per-pixel largest channel difference, scaled so that `scale` maps to full
+/// intensity, on a black-red-yellow-white ramp (RGBA8).
+pub fn diff_heatmap(actual: &Image, golden: &Image, scale: f64) -> Option<Image> {
+    let pair = crate::metrics::Pair::new(actual, golden).ok()?;
+    let differences = pair.pixel_differences(0);
+    let mut data = Vec::with_capacity(differences.len() * 4);
+    for d in differences {
+        let t = if d.is_finite() {
+            (f64::from(d) / scale.max(1e-12)).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let channel = |x: f64| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
+        data.extend_from_slice(&[
+            channel(t * 3.0),
+            channel(t * 3.0 - 1.0),
+            channel(t * 3.0 - 2.0),
+            255,
+        ]);
+    }
+    Some(Image {
+        width: actual.width,
+        height: actual.height,
+        format: engine::backend::TextureFormat::Rgba8Unorm,
+        data: ImageData::U8(data),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use engine::backend::TextureFormat;
+
+    fn temp_store(name: &str) -> GoldenStore {
+        let dir = std::env::temp_dir().join(format!("golden-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        GoldenStore::new(dir)
+    }
+
+    #[test]
+    fn bless_writes_the_golden_and_the_record_and_refuses_nan() {
+        let store = temp_store("bless");
+        let image = Image {
+            width: 1,
+            height: 1,
+            format: TextureFormat::Rgba16Float,
+            data: ImageData::F32(vec![1.0, 2.0, 3.0, 1.0]),
+        };
+        let path = store
+            .bless("s", "light", &image, "gl", "llvmpipe", "new")
+            .unwrap();
+        assert!(path.ends_with("s/light.exr"));
+        assert_eq!(
+            store.load("s", "light", false).unwrap().unwrap().data,
+            image.data
+        );
+        let records = store.records("s").unwrap();
+        assert_eq!(records["light"].backend, "gl");
+        let bad = Image {
+            data: ImageData::F32(vec![f32::NAN, 0.0, 0.0, 1.0]),
+            ..image.clone()
+        };
+        let err = store
+            .bless("s", "light", &bad, "gl", "llvmpipe", "new")
+            .unwrap_err();
+        assert!(err.to_string().contains("NaN/Inf"), "{err}");
+        // The refused bless left the old golden untouched.
+        assert_eq!(
+            store.load("s", "light", false).unwrap().unwrap().data,
+            image.data
+        );
+        let _ = std::fs::remove_dir_all(store.root());
+    }
+}
