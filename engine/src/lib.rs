@@ -6,6 +6,7 @@
 //! - [`image`]: read-back images.
 //! - [`lit_cube`]: the first end-to-end scene, rendered identically on every backend.
 
+pub mod assets;
 pub mod backend;
 pub mod image;
 pub mod lit_cube;
@@ -13,6 +14,7 @@ pub mod mesh;
 pub mod plan;
 pub mod renderer;
 pub mod scene;
+pub mod scene_file;
 pub mod shaders;
 
 pub use backend::{Backend, BackendKind};

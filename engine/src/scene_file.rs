@@ -537,11 +537,8 @@ impl Resolver {
                 let mut material = Material::default();
                 let mut use_maps = true;
                 let mtl_name = mtl.as_ref().map(|m| m.name.clone());
-                let overrides = std::iter::once(&spec.material).chain(
-                    mtl_name
-                        .as_ref()
-                        .and_then(|name| spec.materials.get(name)),
-                );
+                let overrides = std::iter::once(&spec.material)
+                    .chain(mtl_name.as_ref().and_then(|name| spec.materials.get(name)));
                 if let Some(mtl) = mtl {
                     if let Some(kd) = mtl.diffuse {
                         material.base_color = kd;
@@ -668,7 +665,7 @@ fn apply(material: &mut Material, o: &MaterialSpec) {
         material.base_color = v;
         material.base_color_map = None;
     }
-    let mut set = |value: Option<f32>, target: &mut f32| {
+    let set = |value: Option<f32>, target: &mut f32| {
         if let Some(v) = value {
             *target = v;
         }

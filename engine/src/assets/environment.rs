@@ -1,0 +1,164 @@
+//! Equirectangular environment maps from OpenEXR files (via the `exr` crate).
+//!
+//! The first layer with `R`, `G` and `B` channels is read at its largest
+//! resolution level; `A` is optional (defaults to 1). Samples of any type
+//! (f16, f32, u32) are converted to f32. Texels are RGBA, linear, top row
+//! first. "Radiance" here is the **maximum of the R, G and B channels** of a
+//! texel (not luminance).
+
+use std::io::Cursor;
+
+use exr::image::read::image::ReadLayers as _;
+use exr::image::read::layers::ReadChannels as _;
+use std::path::{Path, PathBuf};
+
+use super::error::AssetError;
+
+/// Largest environment accepted, in texels (8192 x 8192; 1 GiB as f32 RGBA).
+pub const MAX_ENVIRONMENT_TEXELS: usize = 1 << 26;
+
+/// A decoded equirectangular environment map.
+#[derive(Clone, Debug)]
+pub struct Environment {
+    /// The EXR file.
+    pub path: PathBuf,
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// RGBA f32 linear texels, row-major, top row first.
+    pub texels: Vec<[f32; 4]>,
+    /// Smallest per-texel radiance, `max(R, G, B)`.
+    pub min_radiance: f32,
+    /// Largest per-texel radiance, `max(R, G, B)`.
+    pub max_radiance: f32,
+}
+
+impl Environment {
+    /// Mean per-texel radiance `max(R, G, B)` (computed in f64).
+    pub fn mean_radiance(&self) -> f32 {
+        if self.texels.is_empty() {
+            return 0.0;
+        }
+        let sum: f64 = self.texels.iter().map(|t| f64::from(radiance(t))).sum();
+        (sum / self.texels.len() as f64) as f32
+    }
+}
+
+/// Radiance measure used throughout: `max(R, G, B)`.
+pub fn radiance(texel: &[f32; 4]) -> f32 {
+    texel[0].max(texel[1]).max(texel[2])
+}
+
+type Pixels = (usize, Vec<[f32; 4]>);
+
+/// Loads an EXR environment map; rejects missing/corrupt files, zero or
+/// oversized images and any non-finite texel (naming the first bad pixel).
+pub fn load_environment(path: &Path) -> Result<Environment, AssetError> {
+    let bytes = std::fs::read(path).map_err(|e| AssetError::io(path, e))?;
+    let exr_err = |source| AssetError::Exr {
+        path: path.to_path_buf(),
+        source,
+    };
+    let meta =
+        exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes), false).map_err(exr_err)?;
+    let has = |h: &exr::meta::header::Header, n: &str| h.channels.list.iter().any(|c| c.name.eq(n));
+    let rgb_layers: Vec<_> = meta
+        .headers
+        .iter()
+        .filter(|h| !h.deep && has(h, "R") && has(h, "G") && has(h, "B"))
+        .collect();
+    if rgb_layers.is_empty() {
+        return Err(AssetError::invalid_image(
+            path,
+            "no layer with R, G and B channels",
+        ));
+    }
+    for h in &rgb_layers {
+        let (w, hgt) = (h.layer_size.width(), h.layer_size.height());
+        if w == 0 || hgt == 0 {
+            return Err(AssetError::invalid_image(
+                path,
+                format!("image has zero size ({w}x{hgt})"),
+            ));
+        }
+        if w.checked_mul(hgt)
+            .is_none_or(|a| a > MAX_ENVIRONMENT_TEXELS)
+        {
+            return Err(AssetError::invalid_image(
+                path,
+                format!("image too large ({w}x{hgt}, limit {MAX_ENVIRONMENT_TEXELS} texels)"),
+            ));
+        }
+    }
+
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |size, _channels| -> Pixels {
+                let area = size.width().saturating_mul(size.height());
+                if area > MAX_ENVIRONMENT_TEXELS {
+                    (size.width(), Vec::new())
+                } else {
+                    (size.width(), vec![[0.0; 4]; area])
+                }
+            },
+            |pixels: &mut Pixels, pos, (r, g, b, a): (f32, f32, f32, f32)| {
+                let index = pos
+                    .y()
+                    .checked_mul(pixels.0)
+                    .and_then(|i| i.checked_add(pos.x()));
+                if let Some(t) = index.and_then(|i| pixels.1.get_mut(i)) {
+                    *t = [r, g, b, a];
+                }
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(Cursor::new(&bytes))
+        .map_err(exr_err)?;
+
+    let layer = image.layer_data;
+    let (w, h) = (layer.size.width(), layer.size.height());
+    let texels = layer.channel_data.pixels.1;
+    if w == 0 || h == 0 || w.checked_mul(h) != Some(texels.len()) {
+        return Err(AssetError::invalid_image(
+            path,
+            format!("unusable image size {w}x{h}"),
+        ));
+    }
+    let (width, height) = match (u32::try_from(w), u32::try_from(h)) {
+        (Ok(a), Ok(b)) => (a, b),
+        _ => {
+            return Err(AssetError::invalid_image(
+                path,
+                format!("image too large ({w}x{h})"),
+            ))
+        }
+    };
+    let (mut min, mut max) = (f32::INFINITY, f32::NEG_INFINITY);
+    for (i, t) in texels.iter().enumerate() {
+        if !t.iter().all(|c| c.is_finite()) {
+            return Err(AssetError::invalid_image(
+                path,
+                format!("non-finite texel at pixel ({}, {}): {:?}", i % w, i / w, t),
+            ));
+        }
+        let r = radiance(t);
+        min = min.min(r);
+        max = max.max(r);
+    }
+    log::info!(
+        "loaded environment {} ({width}x{height}, radiance {min}..{max})",
+        path.display()
+    );
+    Ok(Environment {
+        path: path.to_path_buf(),
+        width,
+        height,
+        texels,
+        min_radiance: min,
+        max_radiance: max,
+    })
+}

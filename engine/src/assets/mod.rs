@@ -1,0 +1,41 @@
+//! Asset loading for the deferred renderer.
+//!
+//! - [`load_obj`]: Wavefront OBJ + MTL via `tobj`, with a line-accurate
+//!   pre-scan, generated normals/UVs where missing and validated MikkTSpace
+//!   tangents ([`Vertex`] is the 48-byte geometry-pass vertex).
+//! - [`TextureCache`] / [`load_texture`]: PNG textures as RGBA8 with a CPU mip
+//!   chain, decoded once per (file, colour space).
+//! - [`load_environment`]: equirectangular OpenEXR environment maps.
+//!
+//! Every failure is an [`AssetError`] naming the file (and line, where known);
+//! no input makes these loaders panic.
+
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::indexing_slicing
+    )
+)]
+
+mod environment;
+mod error;
+mod mesh;
+mod mtl;
+mod obj;
+mod summary;
+mod texture;
+
+pub use environment::{load_environment, radiance, Environment, MAX_ENVIRONMENT_TEXELS};
+pub use error::AssetError;
+pub use mesh::{Aabb, MeshData, Vertex};
+pub use obj::{load_obj, MaterialData, MaterialMaps, Model};
+pub use summary::{EnvironmentSummary, MaterialSummary, MeshSummary, ModelSummary, TextureSummary};
+pub use texture::{
+    generate_mips, linear_to_srgb_u8, load_texture, srgb_to_linear, ColorSpace, TextureCache,
+    TextureData, TextureId,
+};

@@ -1,0 +1,569 @@
+//! Wavefront OBJ loading.
+//!
+//! The file is read once as bytes and pre-scanned line by line (`tobj` errors
+//! carry no line numbers and `tobj` can overflow/panic on absurd indices), so
+//! every syntax or range problem is reported as `file:line: problem` before
+//! anything is allocated from an index value. The pre-scan also produces a
+//! normalized copy of the file for `tobj` (vertex colours dropped, `l`/`p`
+//! elements removed, keywords re-spaced), which `tobj::load_obj_buf` then
+//! loads with `triangulate` + `single_index`.
+//!
+//! Mesh split: `tobj` starts a new mesh at every `o` **and** `g` statement
+//! (groups are not merged into their object) and at every `usemtl` change, so
+//! one [`MeshData`] is one (object-or-group, material) run. Polygons with more
+//! than three vertices are fan-triangulated. Points and lines are skipped with
+//! a warning. Smoothing groups (`s`) are ignored: generated normals are smooth.
+
+use std::cell::RefCell;
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+
+use super::error::AssetError;
+use super::mesh::MeshData;
+use super::mtl::{parse_mtl_file, MapSlot, ParsedMtl};
+use super::texture::{TextureCache, TextureId};
+
+/// A loaded OBJ file: meshes, their materials and any load warnings.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// The OBJ file.
+    pub path: PathBuf,
+    /// Triangle meshes, one per (object/group, material) run.
+    pub meshes: Vec<MeshData>,
+    /// Materials from all `mtllib` files, in file order.
+    pub materials: Vec<MaterialData>,
+    /// Non-fatal problems and notes (skipped elements, unknown keys,
+    /// generated normals/UVs, repaired tangents, ...).
+    pub warnings: Vec<String>,
+}
+
+/// A material from an MTL file.
+#[derive(Clone, Debug, Default)]
+pub struct MaterialData {
+    /// `newmtl` name.
+    pub name: String,
+    /// `Kd`.
+    pub diffuse: Option<[f32; 3]>,
+    /// `Ks`.
+    pub specular: Option<[f32; 3]>,
+    /// `Ns`.
+    pub shininess: Option<f32>,
+    /// Texture maps, as ids into the [`TextureCache`] passed to [`load_obj`].
+    pub maps: MaterialMaps,
+}
+
+/// Texture slots of a material.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub struct MaterialMaps {
+    /// `map_Kd` (sRGB).
+    pub base_color: Option<TextureId>,
+    /// `norm`, `map_Bump`/`map_bump` or `bump` (linear); `norm` wins.
+    pub normal: Option<TextureId>,
+    /// `map_Ks` (linear).
+    pub specular: Option<TextureId>,
+    /// `map_roughness` or `map_Pr` (linear).
+    pub roughness: Option<TextureId>,
+    /// `map_metallic` or `map_Pm` (linear).
+    pub metallic: Option<TextureId>,
+    /// `map_clearcoat` (linear).
+    pub clearcoat: Option<TextureId>,
+}
+
+impl MaterialMaps {
+    /// Every set slot as (slot name, id).
+    pub fn iter(&self) -> impl Iterator<Item = (&'static str, TextureId)> {
+        [
+            ("base_color", self.base_color),
+            ("normal", self.normal),
+            ("specular", self.specular),
+            ("roughness", self.roughness),
+            ("metallic", self.metallic),
+            ("clearcoat", self.clearcoat),
+        ]
+        .into_iter()
+        .filter_map(|(n, id)| id.map(|id| (n, id)))
+    }
+
+    fn slot_mut(&mut self, slot: MapSlot) -> &mut Option<TextureId> {
+        match slot {
+            MapSlot::BaseColor => &mut self.base_color,
+            MapSlot::Normal => &mut self.normal,
+            MapSlot::Specular => &mut self.specular,
+            MapSlot::Roughness => &mut self.roughness,
+            MapSlot::Metallic => &mut self.metallic,
+            MapSlot::Clearcoat => &mut self.clearcoat,
+        }
+    }
+}
+
+/// Loads an OBJ file, its MTL libraries and their textures (into `textures`),
+/// and builds render-ready meshes with normals and MikkTSpace tangents.
+pub fn load_obj(path: &Path, textures: &mut TextureCache) -> Result<Model, AssetError> {
+    let bytes = std::fs::read(path).map_err(|e| AssetError::io(path, e))?;
+    let scan = prescan(path, &bytes)?;
+    let mut warnings = scan.warnings.clone();
+    if scan.faces == 0 {
+        return Err(AssetError::NoGeometry {
+            path: path.to_path_buf(),
+            detail: format!(
+                "no faces ({} vertices, {} points and {} lines skipped)",
+                scan.positions, scan.points, scan.lines
+            ),
+        });
+    }
+
+    let obj_dir = path.parent().unwrap_or(Path::new(""));
+    let state: RefCell<LoaderState> = RefCell::default();
+    // `..Default::default()` keeps this compiling if another crate enables
+    // tobj's `merging`/`reordering` features (which add fields).
+    #[allow(clippy::needless_update)]
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    let result = tobj::load_obj_buf(
+        &mut Cursor::new(scan.normalized.as_bytes()),
+        &options,
+        |name: &Path| load_mtllib(&state, &scan, path, obj_dir, name),
+    );
+    let state = state.into_inner();
+    if let Some(err) = state.error {
+        return Err(err);
+    }
+    let (models, _) = result.map_err(|source| AssetError::Obj {
+        path: path.to_path_buf(),
+        source,
+    })?;
+
+    let mut materials = Vec::new();
+    for lib in &state.libs {
+        warnings.extend(lib.warnings.iter().cloned());
+        for m in &lib.materials {
+            let mut data = MaterialData {
+                name: m.name.clone(),
+                diffuse: m.diffuse,
+                specular: m.specular,
+                shininess: m.shininess,
+                maps: MaterialMaps::default(),
+            };
+            for map in &m.maps {
+                let id = textures
+                    .load(&map.path, map.slot.color_space())
+                    .map_err(|e| AssetError::Texture {
+                        path: map.path.clone(),
+                        mtl: lib.path.clone(),
+                        line: Some(map.line),
+                        key: map.key.clone(),
+                        source: Box::new(e),
+                    })?;
+                *data.maps.slot_mut(map.slot) = Some(id);
+            }
+            materials.push(data);
+        }
+    }
+    for (name, line) in &scan.usemtls {
+        if !materials.iter().any(|m| &m.name == name) {
+            warn(
+                &mut warnings,
+                format!(
+                    "{}:{line}: usemtl `{name}` names no material in the loaded MTL files",
+                    path.display()
+                ),
+            );
+        }
+    }
+
+    let mut meshes = Vec::new();
+    for (i, m) in models.iter().enumerate() {
+        let mesh = &m.mesh;
+        let positions: Vec<[f32; 3]> = mesh
+            .positions
+            .chunks_exact(3)
+            .map(|c| [c.first(), c.get(1), c.get(2)].map(|v| v.copied().unwrap_or(0.0)))
+            .collect();
+        let normals: Vec<[f32; 3]> = mesh
+            .normals
+            .chunks_exact(3)
+            .map(|c| [c.first(), c.get(1), c.get(2)].map(|v| v.copied().unwrap_or(0.0)))
+            .collect();
+        let uvs: Vec<[f32; 2]> = mesh
+            .texcoords
+            .chunks_exact(2)
+            .map(|c| [c.first(), c.get(1)].map(|v| v.copied().unwrap_or(0.0)))
+            .collect();
+        let name = if m.name.is_empty() {
+            format!("unnamed{i}")
+        } else {
+            m.name.clone()
+        };
+        let mut data = MeshData::from_triangles(
+            &name,
+            &positions,
+            (!mesh.normals.is_empty()).then_some(normals.as_slice()),
+            (!mesh.texcoords.is_empty()).then_some(uvs.as_slice()),
+            &mesh.indices,
+            &mut warnings,
+        );
+        if data.indices.is_empty() {
+            continue;
+        }
+        data.material = mesh.material_id.filter(|&id| id < materials.len());
+        meshes.push(data);
+    }
+    if meshes.is_empty() {
+        return Err(AssetError::NoGeometry {
+            path: path.to_path_buf(),
+            detail: "no triangles after loading".to_string(),
+        });
+    }
+    log::info!(
+        "loaded {}: {} meshes, {} materials, {} warnings",
+        path.display(),
+        meshes.len(),
+        materials.len(),
+        warnings.len()
+    );
+    Ok(Model {
+        path: path.to_path_buf(),
+        meshes,
+        materials,
+        warnings,
+    })
+}
+
+fn warn(warnings: &mut Vec<String>, msg: String) {
+    log::warn!("{msg}");
+    warnings.push(msg);
+}
+
+#[derive(Default)]
+struct LoaderState {
+    calls: usize,
+    libs: Vec<ParsedMtl>,
+    error: Option<AssetError>,
+}
+
+/// `tobj` material-loader callback: parses the MTL file(s) named by the
+/// `mtllib` statement and hands `tobj` name-only materials in the same order,
+/// so `tobj`'s `material_id`s index our material list.
+fn load_mtllib(
+    state: &RefCell<LoaderState>,
+    scan: &Scan,
+    obj: &Path,
+    obj_dir: &Path,
+    name: &Path,
+) -> tobj::MTLLoadResult {
+    let mut st = state.borrow_mut();
+    let line = scan.mtllibs.get(st.calls).copied();
+    st.calls += 1;
+    if st.error.is_some() {
+        return Err(tobj::LoadError::OpenFileFailed);
+    }
+    let whole = obj_dir.join(name);
+    let text = name.to_string_lossy();
+    // `mtllib a.mtl b.mtl` names several files unless one file has that name.
+    let files: Vec<PathBuf> = if whole.exists() || !text.contains(char::is_whitespace) {
+        vec![whole]
+    } else {
+        text.split_whitespace().map(|n| obj_dir.join(n)).collect()
+    };
+    let mut tobj_materials = Vec::new();
+    let mut map = std::collections::HashMap::new();
+    for file in files {
+        match parse_mtl_file(&file, obj, line) {
+            Ok(lib) => {
+                for m in &lib.materials {
+                    map.insert(m.name.clone(), tobj_materials.len());
+                    tobj_materials.push(tobj::Material {
+                        name: m.name.clone(),
+                        ..Default::default()
+                    });
+                }
+                st.libs.push(lib);
+            }
+            Err(e) => {
+                st.error = Some(e);
+                return Err(tobj::LoadError::OpenFileFailed);
+            }
+        }
+    }
+    Ok((tobj_materials, map))
+}
+
+/// Result of the byte-level pre-scan.
+#[derive(Debug, Default)]
+struct Scan {
+    /// Normalized OBJ text for `tobj`.
+    normalized: String,
+    /// Line of each `mtllib` statement, in order.
+    mtllibs: Vec<usize>,
+    /// `usemtl` names with their lines.
+    usemtls: Vec<(String, usize)>,
+    positions: usize,
+    texcoords: usize,
+    normals: usize,
+    faces: usize,
+    points: usize,
+    lines: usize,
+    warnings: Vec<String>,
+}
+
+/// Statements that are valid OBJ but not supported (free-form geometry etc.).
+const SILENTLY_IGNORED: &[&str] = &[
+    "s",
+    "mg",
+    "lod",
+    "shadow_obj",
+    "trace_obj",
+    "bevel",
+    "c_interp",
+    "d_interp",
+];
+
+fn prescan(path: &Path, bytes: &[u8]) -> Result<Scan, AssetError> {
+    let mut scan = Scan {
+        normalized: String::with_capacity(bytes.len()),
+        ..Default::default()
+    };
+    let (mut first_skipped, mut polygons, mut colors) = (None, 0usize, 0usize);
+    let (mut unsupported, mut first_unsupported) = (0usize, None);
+    for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
+        let lineno = i + 1;
+        let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
+        let line = std::str::from_utf8(raw).map_err(|e| {
+            AssetError::parse(
+                path,
+                lineno,
+                format!("invalid UTF-8 at byte {}", e.valid_up_to() + 1),
+            )
+        })?;
+        let mut line = line.trim();
+        // Inline comments on element lines (names and file paths may contain '#').
+        if matches!(
+            line.split_whitespace().next(),
+            Some("v" | "vt" | "vn" | "f" | "l" | "p")
+        ) {
+            line = line
+                .split_once('#')
+                .map_or(line, |(before, _)| before)
+                .trim_end();
+        }
+        let mut toks = line.split_whitespace();
+        let Some(key) = toks.next() else { continue };
+        let rest = line.get(key.len()..).unwrap_or("").trim();
+        let err = |msg: String| AssetError::parse(path, lineno, msg);
+        match key {
+            k if k.starts_with('#') => {}
+            "v" => {
+                let vals: Vec<&str> = toks.take(8).collect();
+                if vals.len() < 3 {
+                    return Err(err(format!(
+                        "vertex has {} coordinates, need 3",
+                        vals.len()
+                    )));
+                }
+                let mut out = String::from("v");
+                for (j, t) in vals.iter().enumerate() {
+                    let is_w = vals.len() == 4 && j == 3;
+                    if j >= 3 && !is_w {
+                        colors += 1;
+                        break;
+                    }
+                    let v = parse_finite(t).map_err(|m| err(format!("vertex {m}")))?;
+                    if is_w && v == 0.0 {
+                        return Err(err("vertex w is zero".to_string()));
+                    }
+                    out.push(' ');
+                    out.push_str(t);
+                }
+                push_line(&mut scan.normalized, &out);
+                scan.positions += 1;
+            }
+            "vt" => {
+                let vals: Vec<&str> = toks.take(3).collect();
+                let Some(u) = vals.first() else {
+                    return Err(err("texture coordinate has no values".to_string()));
+                };
+                let v = vals.get(1).copied().unwrap_or("0");
+                for t in [*u, v] {
+                    parse_finite(t).map_err(|m| err(format!("texture coordinate {m}")))?;
+                }
+                push_line(&mut scan.normalized, &format!("vt {u} {v}"));
+                scan.texcoords += 1;
+            }
+            "vn" => {
+                let vals: Vec<&str> = toks.take(4).collect();
+                if vals.len() < 3 {
+                    return Err(err(format!("normal has {} components, need 3", vals.len())));
+                }
+                let mut out = String::from("vn");
+                for t in vals.iter().take(3) {
+                    parse_finite(t).map_err(|m| err(format!("normal {m}")))?;
+                    out.push(' ');
+                    out.push_str(t);
+                }
+                push_line(&mut scan.normalized, &out);
+                scan.normals += 1;
+            }
+            "f" => {
+                let mut count = 0usize;
+                for t in toks {
+                    check_face_vertex(t, [scan.positions, scan.texcoords, scan.normals])
+                        .map_err(&err)?;
+                    count += 1;
+                }
+                if count < 3 {
+                    return Err(err(format!("face has {count} vertices, need at least 3")));
+                }
+                if count > 3 {
+                    polygons += 1;
+                }
+                scan.faces += 1;
+                push_line(&mut scan.normalized, &format!("f {rest}"));
+            }
+            "l" | "p" => {
+                if key == "l" {
+                    scan.lines += 1;
+                } else {
+                    scan.points += 1;
+                }
+                first_skipped.get_or_insert(lineno);
+            }
+            "o" | "g" => push_line(&mut scan.normalized, &format!("{key} {rest}")),
+            "usemtl" | "mtllib" => {
+                if rest.is_empty() {
+                    return Err(err(format!("`{key}` without a name")));
+                }
+                if key == "usemtl" {
+                    scan.usemtls.push((rest.to_string(), lineno));
+                } else {
+                    scan.mtllibs.push(lineno);
+                }
+                push_line(&mut scan.normalized, &format!("{key} {rest}"));
+            }
+            k if SILENTLY_IGNORED.contains(&k) => {}
+            k => {
+                unsupported += 1;
+                first_unsupported.get_or_insert((k.to_string(), lineno));
+            }
+        }
+    }
+    let p = path.display();
+    let mut notes = Vec::new();
+    if let Some(line) = first_skipped {
+        notes.push((
+            true,
+            format!(
+            "{p}:{line}: skipped {} point (p) and {} line (l) elements (only faces are rendered)",
+            scan.points, scan.lines
+        ),
+        ));
+    }
+    if polygons > 0 {
+        notes.push((
+            false,
+            format!("{p}: triangulated {polygons} polygons with more than 3 vertices"),
+        ));
+    }
+    if colors > 0 {
+        notes.push((
+            false,
+            format!("{p}: ignored vertex colours on {colors} vertices"),
+        ));
+    }
+    if let Some((k, line)) = first_unsupported {
+        notes.push((
+            true,
+            format!("{p}:{line}: ignored {unsupported} unsupported statements (first: `{k}`)"),
+        ));
+    }
+    for (is_warning, msg) in notes {
+        if is_warning {
+            log::warn!("{msg}");
+        } else {
+            log::info!("{msg}");
+        }
+        scan.warnings.push(msg);
+    }
+    Ok(scan)
+}
+
+fn push_line(out: &mut String, line: &str) {
+    out.push_str(line);
+    out.push('\n');
+}
+
+fn parse_finite(t: &str) -> Result<f32, String> {
+    let v: f32 = t.parse().map_err(|_| format!("has invalid number `{t}`"))?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("has non-finite value `{t}`"))
+    }
+}
+
+const INDEX_KINDS: [(&str, &str); 3] = [
+    ("face index", "positions"),
+    ("texture coordinate index", "texture coordinates"),
+    ("normal index", "normals"),
+];
+
+/// Checks one `v`, `v/vt`, `v//vn` or `v/vt/vn` face vertex against the
+/// element counts seen so far. Never allocates based on an index value.
+fn check_face_vertex(tok: &str, counts: [usize; 3]) -> Result<(), String> {
+    for (k, part) in tok.split('/').enumerate() {
+        let (Some((kind, plural)), Some(&count)) = (INDEX_KINDS.get(k), counts.get(k)) else {
+            return Err(format!("face vertex `{tok}` has more than 3 components"));
+        };
+        if part.is_empty() {
+            if k == 0 {
+                return Err(format!("face vertex `{tok}` has no position index"));
+            }
+            continue;
+        }
+        let count_u = count as u64;
+        match part.parse::<i64>() {
+            Ok(0) => return Err(format!("{kind} 0 is invalid (OBJ indices start at 1)")),
+            Ok(x) if x > 0 && x.unsigned_abs() > count_u => {
+                return Err(format!("{kind} {x} out of range ({count} {plural})"))
+            }
+            Ok(x) if x < 0 && x.unsigned_abs() > count_u => {
+                return Err(format!(
+                    "relative {kind} {x} out of range ({count} {plural})"
+                ))
+            }
+            Ok(_) => {}
+            Err(_) => {
+                let digits = part.strip_prefix(['-', '+']).unwrap_or(part);
+                if !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) {
+                    return Err(format!("{kind} {part} out of range ({count} {plural})"));
+                }
+                return Err(format!("invalid {kind} `{part}`"));
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn face_vertex_checks() {
+        let c = [3, 2, 1];
+        assert_eq!(check_face_vertex("1", c), Ok(()));
+        assert_eq!(check_face_vertex("-3/-2/-1", c), Ok(()));
+        assert_eq!(check_face_vertex("3//1", c), Ok(()));
+        assert!(check_face_vertex("4", c).is_err_and(|e| e.contains("4 out of range")));
+        assert!(check_face_vertex("1/3", c).is_err_and(|e| e.contains("texture coordinate")));
+        assert!(check_face_vertex("1/1/2", c).is_err_and(|e| e.contains("normal index 2")));
+        assert!(check_face_vertex("1/1/1/1", c).is_err_and(|e| e.contains("more than 3")));
+        assert!(check_face_vertex("/1", c).is_err_and(|e| e.contains("no position")));
+        assert!(check_face_vertex("x", c).is_err_and(|e| e.contains("invalid face index")));
+        assert!(check_face_vertex("-9223372036854775808", c).is_err());
+    }
+}

@@ -1,0 +1,224 @@
+//! Bad-input fixtures: each must error (naming file, line and problem) or
+//! load with a warning, and never panic.
+
+mod common;
+
+use std::time::{Duration, Instant};
+
+use common::{fixture, load, load_err};
+
+#[test]
+fn empty_obj() {
+    let e = load_err("empty.obj");
+    assert!(e.contains("no geometry"), "{e}");
+}
+
+#[test]
+fn truncated_face() {
+    let e = load_err("truncated_face.obj");
+    assert!(
+        e.contains("truncated_face.obj:4: face has 2 vertices, need at least 3"),
+        "{e}"
+    );
+}
+
+#[test]
+fn truncated_vertex() {
+    let e = load_err("truncated_vertex.obj");
+    assert!(
+        e.contains("truncated_vertex.obj:2: vertex has 2 coordinates, need 3"),
+        "{e}"
+    );
+}
+
+#[test]
+fn face_index_out_of_range() {
+    let e = load_err("out_of_range.obj");
+    assert!(
+        e.ends_with("out_of_range.obj:10: face index 9 out of range (8 positions)"),
+        "{e}"
+    );
+    let err = load("out_of_range.obj").unwrap_err();
+    assert_eq!(err.line(), Some(10));
+    assert_eq!(err.path(), fixture("out_of_range.obj"));
+}
+
+#[test]
+fn face_index_zero() {
+    let e = load_err("zero_index.obj");
+    assert!(
+        e.contains("zero_index.obj:4: face index 0 is invalid"),
+        "{e}"
+    );
+}
+
+#[test]
+fn relative_indices() {
+    let e = load_err("relative_out_of_range.obj");
+    assert!(
+        e.contains(":4: relative face index -9 out of range (3 positions)"),
+        "{e}"
+    );
+    let model = load("relative_ok.obj").unwrap();
+    assert_eq!(model.meshes[0].triangle_count(), 1);
+}
+
+#[test]
+fn nan_and_inf_coordinates() {
+    let e = load_err("nan_coord.obj");
+    assert!(
+        e.contains("nan_coord.obj:2: vertex has non-finite value `nan`"),
+        "{e}"
+    );
+    let e = load_err("inf_coord.obj");
+    assert!(
+        e.contains("inf_coord.obj:3: vertex has non-finite value `inf`"),
+        "{e}"
+    );
+    let e = load_err("overflow_uv.obj");
+    assert!(
+        e.contains("overflow_uv.obj:5: texture coordinate has non-finite value `1e39`"),
+        "{e}"
+    );
+}
+
+#[test]
+fn non_utf8_bytes() {
+    let e = load_err("non_utf8.obj");
+    assert!(e.contains("non_utf8.obj:4: invalid UTF-8"), "{e}");
+}
+
+#[test]
+fn gigantic_indices_fail_fast() {
+    for (name, needle) in [
+        ("huge_index.obj", ":4: face index 4000000000 out of range (3 positions)"),
+        ("huge_index_2_40.obj", ":4: face index 1099511627776 out of range (3 positions)"),
+        (
+            "huge_index_overflow.obj",
+            ":5: texture coordinate index 99999999999999999999999 out of range (1 texture coordinates)",
+        ),
+    ] {
+        let start = Instant::now();
+        let e = load_err(name);
+        assert!(start.elapsed() < Duration::from_secs(1), "{name} took {:?}", start.elapsed());
+        assert!(e.contains(needle), "{e}");
+    }
+}
+
+#[test]
+fn missing_mtl() {
+    let e = load_err("missing_mtl.obj");
+    assert!(
+        e.contains("does_not_exist.mtl: material library referenced from"),
+        "{e}"
+    );
+    assert!(e.contains("missing_mtl.obj:1"), "{e}");
+}
+
+#[test]
+fn missing_texture() {
+    let e = load_err("missing_texture.obj");
+    assert!(
+        e.contains("missing_texture.mtl:4: `map_Kd` texture failed to load"),
+        "{e}"
+    );
+    assert!(e.contains("textures/nope.png: cannot read file"), "{e}");
+    let err = load("missing_texture.obj").unwrap_err();
+    assert_eq!(err.path(), fixture("textures/nope.png"));
+}
+
+#[test]
+fn corrupt_texture() {
+    let e = load_err("corrupt_texture.obj");
+    assert!(
+        e.contains("corrupt_texture.mtl:2: `map_roughness` texture failed to load"),
+        "{e}"
+    );
+    assert!(e.contains("corrupt.png: cannot decode image"), "{e}");
+}
+
+#[test]
+fn short_kd_is_an_error_not_a_panic() {
+    // tobj's own MTL parser panics on this line.
+    let e = load_err("short_kd.obj");
+    assert!(
+        e.contains("short_kd.mtl:2: `Kd` needs 3 values, found 2"),
+        "{e}"
+    );
+}
+
+#[test]
+fn unknown_mtl_keys_warn() {
+    let model = load("unknown_keys.obj").unwrap();
+    let w = model.warnings.join("\n");
+    assert!(
+        w.contains("unknown_keys.mtl:3: unknown MTL key `foo_bar` ignored"),
+        "{w}"
+    );
+    assert!(
+        w.contains("unknown_keys.mtl:6: unknown texture option `-zz` ignored"),
+        "{w}"
+    );
+    assert!(!w.contains("`Ka`") && !w.contains("`illum`"), "{w}");
+    assert!(model.materials[0].maps.base_color.is_some());
+}
+
+#[test]
+fn points_and_lines_are_skipped() {
+    let model = load("points_lines.obj").unwrap();
+    assert_eq!(model.meshes.len(), 1);
+    assert_eq!(model.meshes[0].triangle_count(), 1);
+    let w = model.warnings.join("\n");
+    assert!(
+        w.contains("points_lines.obj:5: skipped 1 point (p) and 2 line (l) elements"),
+        "{w}"
+    );
+}
+
+#[test]
+fn quads_and_ngons_are_triangulated() {
+    let model = load("ngons.obj").unwrap();
+    assert_eq!(model.meshes[0].triangle_count(), 5);
+    assert!(model
+        .warnings
+        .iter()
+        .any(|w| w.contains("triangulated 2 polygons")));
+    common::check_model(&model);
+}
+
+#[test]
+fn groups_stay_separate_meshes() {
+    let model = load("groups.obj").unwrap();
+    let names: Vec<&str> = model.meshes.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(names, ["left", "right"]);
+}
+
+#[test]
+fn missing_obj() {
+    let e = load_err("no_such_file.obj");
+    assert!(e.contains("cannot read file"), "{e}");
+}
+
+#[test]
+fn random_garbage_never_panics() {
+    // Deterministic xorshift fuzz over OBJ-ish tokens.
+    let tokens = [
+        "v", "vt", "vn", "f", "l", "p", "o", "g", "s", "usemtl", "mtllib", "1", "-1", "0", "2/1",
+        "1//1", "3/2/1", "nan", "1e40", "0.5", "-3", "/", "//", "\n", "\n", " ", "x",
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    for case in 0..200 {
+        let mut text = String::new();
+        for _ in 0..60 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            text.push_str(tokens[(state % tokens.len() as u64) as usize]);
+            text.push(' ');
+        }
+        let path = dir.path().join(format!("fuzz{case}.obj"));
+        std::fs::write(&path, text).unwrap();
+        let _ = engine::assets::load_obj(&path, &mut engine::assets::TextureCache::new());
+    }
+}

@@ -1,0 +1,180 @@
+//! Normal and tangent guarantees on small fixture meshes.
+
+mod common;
+
+use common::{check_model, load};
+
+#[test]
+fn vertex_is_48_bytes_and_pod() {
+    assert_eq!(std::mem::size_of::<engine::assets::Vertex>(), 48);
+    let v = engine::assets::Vertex {
+        position: [1.0, 2.0, 3.0],
+        normal: [0.0, 1.0, 0.0],
+        uv: [0.5, 0.5],
+        tangent: [1.0, 0.0, 0.0, 1.0],
+    };
+    assert_eq!(bytemuck::bytes_of(&v).len(), 48);
+}
+
+#[test]
+fn cube_with_normals_and_uvs() {
+    let model = load("cube.obj").unwrap();
+    check_model(&model);
+    let mesh = &model.meshes[0];
+    assert_eq!(mesh.triangle_count(), 12);
+    assert_eq!(mesh.vertices.len(), 24);
+    assert_eq!(mesh.bounds.min, [-1.0; 3]);
+    assert_eq!(mesh.bounds.max, [1.0; 3]);
+    // On the +Z face u runs along +X, so the tangent is +X with w = +1.
+    for v in mesh.vertices.iter().filter(|v| v.normal == [0.0, 0.0, 1.0]) {
+        assert!((v.tangent[0] - 1.0).abs() < 1e-4, "{v:?}");
+        assert_eq!(v.tangent[3], 1.0);
+    }
+}
+
+#[test]
+fn mirrored_uvs_get_opposite_handedness_and_split_seam() {
+    let model = load("mirrored_quad.obj").unwrap();
+    check_model(&model);
+    let mesh = &model.meshes[0];
+    assert_eq!(mesh.triangle_count(), 4);
+    // 6 positions; the 2 seam vertices are split into a +1 and a -1 copy.
+    assert_eq!(mesh.vertices.len(), 8, "{:#?}", mesh.vertices);
+    for v in &mesh.vertices {
+        let x = v.position[0];
+        if x < 1.0 {
+            assert_eq!(v.tangent[3], 1.0, "{v:?}");
+            assert!((v.tangent[0] - 1.0).abs() < 1e-4, "{v:?}");
+        } else if x > 1.0 {
+            assert_eq!(v.tangent[3], -1.0, "{v:?}");
+            assert!((v.tangent[0] + 1.0).abs() < 1e-4, "{v:?}");
+        }
+    }
+    let seam: Vec<_> = mesh
+        .vertices
+        .iter()
+        .filter(|v| v.position[0] == 1.0)
+        .collect();
+    assert_eq!(seam.len(), 4);
+    assert_eq!(seam.iter().filter(|v| v.tangent[3] == 1.0).count(), 2);
+    assert_eq!(seam.iter().filter(|v| v.tangent[3] == -1.0).count(), 2);
+    // Every triangle uses one handedness only.
+    for tri in mesh.indices.chunks(3) {
+        let w: Vec<f32> = tri
+            .iter()
+            .map(|&i| mesh.vertices[i as usize].tangent[3])
+            .collect();
+        assert!(w.iter().all(|&x| x == w[0]), "mixed handedness in {tri:?}");
+    }
+}
+
+#[test]
+fn collapsed_uvs_fall_back_to_plus_one() {
+    let model = load("collapsed_uv.obj").unwrap();
+    check_model(&model);
+    for v in &model.meshes[0].vertices {
+        assert_eq!(v.tangent[3], 1.0);
+        assert_eq!(v.normal, [0.0, 0.0, 1.0]);
+    }
+    assert!(
+        model.warnings.iter().any(|w| w.contains("degenerate")),
+        "{:?}",
+        model.warnings
+    );
+}
+
+#[test]
+fn zero_area_triangle() {
+    let model = load("zero_area.obj").unwrap();
+    check_model(&model);
+    assert_eq!(model.meshes.len(), 2);
+    let degenerate = model
+        .meshes
+        .iter()
+        .find(|m| m.name == "degenerate")
+        .unwrap();
+    assert_eq!(degenerate.triangle_count(), 1);
+    for v in &degenerate.vertices {
+        assert_eq!(
+            v.normal,
+            [0.0, 1.0, 0.0],
+            "zero-area normal falls back to +Y"
+        );
+        assert_eq!(v.tangent[3], 1.0);
+    }
+    let healthy = model.meshes.iter().find(|m| m.name == "healthy").unwrap();
+    for v in &healthy.vertices {
+        assert!(
+            (v.normal[2] - 1.0).abs() < 1e-6,
+            "generated normal is +Z: {v:?}"
+        );
+    }
+}
+
+#[test]
+fn mesh_without_normals_gets_generated_normals() {
+    let model = load("no_normals.obj").unwrap();
+    check_model(&model);
+    for v in &model.meshes[0].vertices {
+        assert!((v.normal[2] - 1.0).abs() < 1e-6, "{v:?}");
+    }
+    assert!(
+        model.warnings.iter().any(|w| w.contains("no normals")),
+        "{:?}",
+        model.warnings
+    );
+}
+
+#[test]
+fn mesh_without_uvs_gets_tangents() {
+    let model = load("no_uvs.obj").unwrap();
+    check_model(&model);
+    assert_eq!(model.meshes[0].triangle_count(), 12);
+    assert!(
+        model.warnings.iter().any(|w| w.contains("no UVs")),
+        "{:?}",
+        model.warnings
+    );
+}
+
+#[test]
+fn zero_normal_is_replaced() {
+    let model = load("zero_normal.obj").unwrap();
+    check_model(&model);
+    for v in &model.meshes[0].vertices {
+        assert!((v.normal[2] - 1.0).abs() < 1e-6, "{v:?}");
+    }
+    assert!(model
+        .warnings
+        .iter()
+        .any(|w| w.contains("zero or non-finite normals")));
+}
+
+#[test]
+fn from_triangles_survives_hostile_input() {
+    let mut notes = Vec::new();
+    let nan = f32::NAN;
+    let mesh = engine::assets::MeshData::from_triangles(
+        "hostile",
+        &[
+            [0.0, 0.0, 0.0],
+            [nan, 1.0, 0.0],
+            [0.0, 1.0, f32::INFINITY],
+            [1.0, 1.0, 1.0],
+        ],
+        Some(&[
+            [nan, 0.0, 0.0],
+            [0.0; 3],
+            [0.0, 0.0, 2.0],
+            [1e-30, 0.0, 0.0],
+        ]),
+        Some(&[[nan, 0.0], [0.0; 2], [0.0; 2], [1.0, 1.0]]),
+        &[0, 1, 2, 0, 2, 3, 7, 8, 9, 0, 0, 0, 1],
+        &mut notes,
+    );
+    for (i, v) in mesh.vertices.iter().enumerate() {
+        common::check_vertex(v, &format!("hostile {i}"));
+    }
+    assert_eq!(mesh.triangle_count(), 3);
+    assert!(!notes.is_empty());
+}
