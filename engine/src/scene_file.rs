@@ -553,7 +553,7 @@ impl Resolver {
                     }
                 }
                 if let (Some(mtl), true) = (mtl, use_maps) {
-                    let maps = mtl.maps.clone();
+                    let maps = mtl.maps;
                     material.base_color_map = self.texture(maps.base_color);
                     material.normal_map = self.texture(maps.normal);
                     material.roughness_map = self.texture(maps.roughness);
