@@ -5,6 +5,7 @@ pub mod compare;
 pub mod first_scene;
 pub mod golden;
 pub mod images;
+pub mod inspect;
 pub mod metrics;
 pub mod reference;
 pub mod test_scenes;
@@ -16,4 +17,17 @@ pub fn workspace_root() -> std::path::PathBuf {
     std::env::var_os("HARNESS_ROOT")
         .map(std::path::PathBuf::from)
         .unwrap_or_else(|| std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+}
+
+/// The canonical scenes' folder, `<workspace>/scenes`.
+pub fn scenes_dir() -> std::path::PathBuf {
+    workspace_root().join("scenes")
+}
+
+/// Loads a scene by canonical name (`chess`) or path (`scenes/chess.toml`).
+pub fn load_scene(
+    name_or_path: &str,
+) -> Result<engine::scene_file::LoadedScene, engine::scene_file::SceneFileError> {
+    let path = engine::scene_file::resolve(name_or_path, &scenes_dir())?;
+    engine::scene_file::load(&path)
 }

@@ -33,7 +33,7 @@ mod texture;
 pub use environment::{load_environment, radiance, Environment, MAX_ENVIRONMENT_TEXELS};
 pub use error::AssetError;
 pub use mesh::{Aabb, MeshData, Vertex};
-pub use obj::{load_obj, MaterialData, MaterialMaps, Model};
+pub use obj::{load_mtl, load_obj, MaterialData, MaterialMaps, Model};
 pub use summary::{EnvironmentSummary, MaterialSummary, MeshSummary, ModelSummary, TextureSummary};
 pub use texture::{
     generate_mips, linear_to_srgb_u8, load_texture, srgb_to_linear, ColorSpace, TextureCache,

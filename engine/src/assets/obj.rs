@@ -141,28 +141,7 @@ pub fn load_obj(path: &Path, textures: &mut TextureCache) -> Result<Model, Asset
     let mut materials = Vec::new();
     for lib in &state.libs {
         warnings.extend(lib.warnings.iter().cloned());
-        for m in &lib.materials {
-            let mut data = MaterialData {
-                name: m.name.clone(),
-                diffuse: m.diffuse,
-                specular: m.specular,
-                shininess: m.shininess,
-                maps: MaterialMaps::default(),
-            };
-            for map in &m.maps {
-                let id = textures
-                    .load(&map.path, map.slot.color_space())
-                    .map_err(|e| AssetError::Texture {
-                        path: map.path.clone(),
-                        mtl: lib.path.clone(),
-                        line: Some(map.line),
-                        key: map.key.clone(),
-                        source: Box::new(e),
-                    })?;
-                *data.maps.slot_mut(map.slot) = Some(id);
-            }
-            materials.push(data);
-        }
+        materials.extend(resolve_materials(lib, textures)?);
     }
     for (name, line) in &scan.usemtls {
         if !materials.iter().any(|m| &m.name == name) {
@@ -291,6 +270,48 @@ fn load_mtllib(
         }
     }
     Ok((tobj_materials, map))
+}
+
+/// Loads the textures a parsed MTL library references and returns its materials.
+fn resolve_materials(
+    lib: &ParsedMtl,
+    textures: &mut TextureCache,
+) -> Result<Vec<MaterialData>, AssetError> {
+    let mut materials = Vec::new();
+    for m in &lib.materials {
+        let mut data = MaterialData {
+            name: m.name.clone(),
+            diffuse: m.diffuse,
+            specular: m.specular,
+            shininess: m.shininess,
+            maps: MaterialMaps::default(),
+        };
+        for map in &m.maps {
+            let id = textures
+                .load(&map.path, map.slot.color_space())
+                .map_err(|e| AssetError::Texture {
+                    path: map.path.clone(),
+                    mtl: lib.path.clone(),
+                    line: Some(map.line),
+                    key: map.key.clone(),
+                    source: Box::new(e),
+                })?;
+            *data.maps.slot_mut(map.slot) = Some(id);
+        }
+        materials.push(data);
+    }
+    Ok(materials)
+}
+
+/// Loads an MTL file on its own (for `harness inspect`): its materials, with every texture they
+/// reference decoded into `textures`, and its warnings (unknown keys and the like).
+pub fn load_mtl(
+    path: &Path,
+    textures: &mut TextureCache,
+) -> Result<(Vec<MaterialData>, Vec<String>), AssetError> {
+    let lib = parse_mtl_file(path, path, None)?;
+    let materials = resolve_materials(&lib, textures)?;
+    Ok((materials, lib.warnings))
 }
 
 /// Result of the byte-level pre-scan.

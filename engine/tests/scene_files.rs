@@ -1,0 +1,127 @@
+//! Scene files: parsing, unknown keys, relative paths, texture sharing, canonical names, and
+//! the canonical scenes themselves.
+
+use std::path::{Path, PathBuf};
+
+use engine::scene_file::{self, SceneFileError};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures")
+        .join(name)
+}
+
+fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes")
+}
+
+fn parse_err(text: &str) -> String {
+    scene_file::parse(Path::new("dir/bad.toml"), text)
+        .err()
+        .expect("must fail")
+        .to_string()
+}
+
+const CAMERA: &str = "[camera]\nposition = [0, 0, 1]\ntarget = [0, 0, 0]\n";
+
+#[test]
+fn unknown_keys_name_the_key_the_file_and_the_line() {
+    let e = parse_err(&format!("colour = 1\n{CAMERA}"));
+    assert!(e.starts_with("dir/bad.toml:1:"), "{e}");
+    assert!(e.contains("unknown field `colour`"), "{e}");
+    let e = parse_err(&format!(
+        "{CAMERA}\n[[objects]]\nmesh = \"a.obj\"\nroughnes = 0.5\n"
+    ));
+    assert!(e.contains("dir/bad.toml:7:"), "{e}");
+    assert!(e.contains("`roughnes`"), "{e}");
+    let e = parse_err(&format!(
+        "{CAMERA}\n[[lights]]\ntype = \"spot\"\nposition = [0, 0, 0]\n"
+    ));
+    assert!(e.contains("spot"), "{e}");
+    let e = parse_err("[camera]\nposition = [0, 0]\ntarget = [0, 0, 0]\n");
+    assert!(e.contains("dir/bad.toml:2:"), "{e}");
+}
+
+#[test]
+fn paths_are_relative_to_the_scene_file_and_shared_textures_load_once() {
+    let loaded = scene_file::load(&fixture("scenes/two_materials.toml")).unwrap();
+    let scene = &loaded.scene;
+    // Two OBJ meshes per OBJ object, loaded once and shared; plus the built-in sphere.
+    assert_eq!(scene.objects.len(), 5);
+    assert!(std::sync::Arc::ptr_eq(
+        &scene.objects[0].mesh,
+        &scene.objects[2].mesh
+    ));
+    // `brick` and `stone` both use checker.png: decoded once, one texture, same index.
+    assert_eq!(loaded.textures_decoded, 3);
+    assert_eq!(scene.textures.len(), 3);
+    let brick = &scene.objects[0].material;
+    let stone = &scene.objects[1].material;
+    assert!(brick.base_color_map.is_some());
+    assert_eq!(brick.base_color_map, stone.base_color_map);
+    // Per-material override applies to `stone` of the second object only.
+    assert_eq!(scene.objects[3].material.roughness, 0.9);
+    assert_eq!(scene.objects[1].material.roughness, 0.5);
+    assert_eq!(
+        scene.objects[4].lighting,
+        engine::scene::LightingModel::BlinnPhong
+    );
+    assert_eq!(scene.quality.width, 64);
+}
+
+#[test]
+fn bad_values_and_missing_assets_are_errors_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, text: &str| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let path = write(
+        "radius.toml",
+        &format!("{CAMERA}[[lights]]\ntype = \"point\"\nposition = [0, 0, 0]\nradius = -1\n"),
+    );
+    let e = scene_file::load(&path).err().unwrap();
+    assert!(matches!(e, SceneFileError::Invalid { .. }), "{e}");
+    assert!(e.to_string().contains("radius.toml"), "{e}");
+    let path = write(
+        "missing.toml",
+        &format!("{CAMERA}[[objects]]\nmesh = \"nowhere.obj\"\n"),
+    );
+    let e = scene_file::load(&path).err().unwrap().to_string();
+    assert!(
+        e.contains("missing.toml") && e.contains("nowhere.obj"),
+        "{e}"
+    );
+    let path = write(
+        "env.toml",
+        &format!("{CAMERA}[environment]\npath = \"sky.exr\"\n"),
+    );
+    let e = scene_file::load(&path).err().unwrap().to_string();
+    assert!(e.contains("sky.exr"), "{e}");
+    let path = write(
+        "nan.toml",
+        "[camera]\nposition = [nan, 0, 1]\ntarget = [0, 0, 0]\n",
+    );
+    let e = scene_file::load(&path).err().unwrap().to_string();
+    assert!(e.contains("nan.toml") && e.contains("finite"), "{e}");
+    let e = scene_file::load(&dir.path().join("absent.toml"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("absent.toml"), "{e}");
+}
+
+#[test]
+fn canonical_names_resolve_and_unknown_names_list_the_scenes() {
+    let dir = scenes_dir();
+    assert_eq!(
+        scene_file::resolve("chess", &dir).unwrap(),
+        dir.join("chess.toml")
+    );
+    let e = scene_file::resolve("chesss", &dir)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("arrow, chess, ibl"), "{e}");
+}

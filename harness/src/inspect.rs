@@ -1,0 +1,297 @@
+//! `harness inspect PATH`: loads an OBJ, MTL, scene file, EXR or PNG exactly as a render would
+//! and reports what was loaded (or the error), as text or JSON.
+
+use std::path::Path;
+
+use engine::assets::{self, ColorSpace, TextureCache};
+use engine::plan::RenderPlan;
+use engine::scene::Light;
+use engine::scene_file;
+use serde_json::{json, Value};
+
+/// Why inspection failed: the loader's error, already naming the file.
+#[derive(Debug, thiserror::Error)]
+pub enum InspectError {
+    /// An asset failed to load.
+    #[error(transparent)]
+    Asset(#[from] assets::AssetError),
+    /// A scene file failed to load.
+    #[error(transparent)]
+    Scene(#[from] scene_file::SceneFileError),
+    /// The extension is not one `inspect` knows.
+    #[error("{0}: don't know how to inspect this (expected .obj, .mtl, .toml, .exr or .png)")]
+    UnknownKind(String),
+}
+
+/// Loads `path` and returns a JSON description of what was loaded.
+pub fn inspect(path: &Path) -> Result<Value, InspectError> {
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match extension.as_str() {
+        "obj" => {
+            let mut textures = TextureCache::new();
+            let model = assets::load_obj(path, &mut textures)?;
+            let summary = serde_json::to_value(model.summary(&textures)).unwrap_or(Value::Null);
+            Ok(json!({ "kind": "obj", "model": summary }))
+        }
+        "mtl" => {
+            let mut textures = TextureCache::new();
+            let (materials, warnings) = assets::load_mtl(path, &mut textures)?;
+            let texture_path = |id| {
+                textures
+                    .get(id)
+                    .map(|t| t.path.display().to_string())
+                    .unwrap_or_default()
+            };
+            let materials: Vec<Value> = materials
+                .iter()
+                .map(|m| {
+                    json!({
+                        "name": m.name,
+                        "diffuse": m.diffuse,
+                        "specular": m.specular,
+                        "shininess": m.shininess,
+                        "maps": m.maps.iter().map(|(slot, id)| json!({"slot": slot, "path": texture_path(id)})).collect::<Vec<_>>(),
+                    })
+                })
+                .collect();
+            let textures: Vec<Value> = textures
+                .iter()
+                .map(|(_, t)| {
+                    texture_json(
+                        &t.path.display().to_string(),
+                        t.width,
+                        t.height,
+                        t.mips.len(),
+                        t.color_space,
+                    )
+                })
+                .collect();
+            Ok(
+                json!({ "kind": "mtl", "path": path.display().to_string(), "materials": materials, "textures": textures, "warnings": warnings }),
+            )
+        }
+        "png" => {
+            let texture = assets::load_texture(path, ColorSpace::Srgb)?;
+            Ok(
+                json!({ "kind": "png", "texture": texture_json(&path.display().to_string(), texture.width, texture.height, texture.mips.len(), ColorSpace::Srgb) }),
+            )
+        }
+        "exr" => {
+            let environment = assets::load_environment(path)?;
+            let summary = serde_json::to_value(environment.summary()).unwrap_or(Value::Null);
+            Ok(json!({ "kind": "exr", "environment": summary }))
+        }
+        "toml" => {
+            let loaded = scene_file::load(path)?;
+            let scene = &loaded.scene;
+            let objects: Vec<Value> = scene
+                .objects
+                .iter()
+                .map(|o| {
+                    let m = &o.material;
+                    let maps: Vec<&str> = [
+                        ("base_color", m.base_color_map),
+                        ("normal", m.normal_map),
+                        ("roughness", m.roughness_map),
+                        ("metallic", m.metallic_map),
+                        ("clearcoat", m.clearcoat_map),
+                        ("specular", m.specular_map),
+                    ]
+                    .into_iter()
+                    .filter_map(|(name, map)| map.map(|_| name))
+                    .collect();
+                    json!({
+                        "name": o.name,
+                        "mesh": o.mesh.name,
+                        "vertices": o.mesh.vertices.len(),
+                        "triangles": o.mesh.triangle_count(),
+                        "bounds": o.mesh.bounds,
+                        "lighting": o.lighting.name(),
+                        "base_color": m.base_color,
+                        "roughness": m.roughness,
+                        "metallic": m.metallic,
+                        "clearcoat": m.clearcoat,
+                        "anisotropy": m.anisotropy,
+                        "maps": maps,
+                    })
+                })
+                .collect();
+            let lights: Vec<Value> = scene
+                .lights
+                .iter()
+                .map(|l| match l {
+                    Light::Directional {
+                        direction,
+                        color,
+                        intensity,
+                        shadow,
+                    } => json!({
+                        "type": "directional", "direction": direction.to_array(), "color": color,
+                        "intensity": intensity, "shadow_map": shadow.map(|s| s.map_size),
+                    }),
+                    Light::Point {
+                        position,
+                        color,
+                        intensity,
+                        radius,
+                        falloff,
+                        shadow,
+                    } => json!({
+                        "type": "point", "position": position.to_array(), "color": color,
+                        "intensity": intensity, "radius": radius, "falloff": falloff,
+                        "shadow_map": shadow.map(|s| s.map_size),
+                    }),
+                })
+                .collect();
+            let textures: Vec<Value> = scene
+                .textures
+                .iter()
+                .map(|t| {
+                    let space = if t.srgb {
+                        ColorSpace::Srgb
+                    } else {
+                        ColorSpace::Linear
+                    };
+                    texture_json(&t.label, t.width, t.height, t.mips.len(), space)
+                })
+                .collect();
+            let environment = scene.environment.as_ref().map(|e| {
+                json!({
+                    "path": e.image.label, "width": e.image.width, "height": e.image.height,
+                    "rotation_degrees": e.rotation_degrees, "intensity": e.intensity,
+                })
+            });
+            Ok(json!({
+                "kind": "scene",
+                "path": path.display().to_string(),
+                "name": scene.name,
+                "description": loaded.description,
+                "size": [scene.quality.width, scene.quality.height],
+                "objects": objects,
+                "lights": lights,
+                "environment": environment,
+                "textures": textures,
+                "textures_decoded": loaded.textures_decoded,
+                "plan": RenderPlan::new(scene).to_string(),
+            }))
+        }
+        _ => Err(InspectError::UnknownKind(path.display().to_string())),
+    }
+}
+
+fn texture_json(path: &str, width: u32, height: u32, mips: usize, space: ColorSpace) -> Value {
+    json!({
+        "path": path,
+        "width": width,
+        "height": height,
+        "mips": mips,
+        "color_space": if space == ColorSpace::Srgb { "srgb" } else { "linear" },
+    })
+}
+
+/// A short human-readable rendering of [`inspect`]'s JSON.
+pub fn to_text(value: &Value) -> String {
+    let mut out = String::new();
+    let line = |out: &mut String, s: String| {
+        out.push_str(&s);
+        out.push('\n');
+    };
+    match value["kind"].as_str() {
+        Some("obj") => {
+            let m = &value["model"];
+            line(
+                &mut out,
+                format!("OBJ {}", m["path"].as_str().unwrap_or("")),
+            );
+            for mesh in m["meshes"].as_array().into_iter().flatten() {
+                line(
+                    &mut out,
+                    format!(
+                        "  mesh {:<20} {:>7} vertices {:>7} triangles  material {}  bounds {} .. {}",
+                        mesh["name"].as_str().unwrap_or(""),
+                        mesh["vertices"],
+                        mesh["triangles"],
+                        mesh["material"].as_str().unwrap_or("-"),
+                        mesh["bounds"]["min"],
+                        mesh["bounds"]["max"]
+                    ),
+                );
+            }
+            for material in m["materials"].as_array().into_iter().flatten() {
+                line(
+                    &mut out,
+                    format!(
+                        "  material {} maps {}",
+                        material["name"].as_str().unwrap_or(""),
+                        material["maps"]
+                    ),
+                );
+            }
+            for t in m["textures"].as_array().into_iter().flatten() {
+                line(
+                    &mut out,
+                    format!(
+                        "  texture {} {}x{} {} mips {}",
+                        t["path"].as_str().unwrap_or(""),
+                        t["width"],
+                        t["height"],
+                        t["mips"],
+                        t["color_space"].as_str().unwrap_or("")
+                    ),
+                );
+            }
+            for w in m["warnings"].as_array().into_iter().flatten() {
+                line(&mut out, format!("  note: {}", w.as_str().unwrap_or("")));
+            }
+        }
+        Some("scene") => {
+            line(
+                &mut out,
+                format!(
+                    "scene {} ({})",
+                    value["name"].as_str().unwrap_or(""),
+                    value["path"].as_str().unwrap_or("")
+                ),
+            );
+            if let Some(d) = value["description"].as_str() {
+                line(&mut out, format!("  {d}"));
+            }
+            for o in value["objects"].as_array().into_iter().flatten() {
+                line(
+                    &mut out,
+                    format!(
+                        "  object {:<28} {:>6} triangles  {:<11} maps {}",
+                        o["name"].as_str().unwrap_or(""),
+                        o["triangles"],
+                        o["lighting"].as_str().unwrap_or(""),
+                        o["maps"]
+                    ),
+                );
+            }
+            for l in value["lights"].as_array().into_iter().flatten() {
+                line(&mut out, format!("  light {l}"));
+            }
+            if !value["environment"].is_null() {
+                line(&mut out, format!("  environment {}", value["environment"]));
+            }
+            line(
+                &mut out,
+                format!(
+                    "  {} textures, {} decoded",
+                    value["textures"].as_array().map_or(0, Vec::len),
+                    value["textures_decoded"]
+                ),
+            );
+            out.push_str(value["plan"].as_str().unwrap_or(""));
+        }
+        _ => {
+            out = serde_json::to_string_pretty(value).unwrap_or_default();
+            out.push('\n');
+        }
+    }
+    out
+}
