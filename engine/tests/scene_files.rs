@@ -17,8 +17,7 @@ fn scenes_dir() -> PathBuf {
 
 fn parse_err(text: &str) -> String {
     scene_file::parse(Path::new("dir/bad.toml"), text)
-        .err()
-        .expect("must fail")
+        .expect_err("must fail")
         .to_string()
 }
 
