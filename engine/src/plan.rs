@@ -223,7 +223,7 @@ impl RenderPlan {
                     "1 draw, no lights".to_owned()
                 } else {
                     format!(
-                        "{} lights in {batches} draw(s), additive",
+                        "{} light(s) in {batches} draw(s), additive",
                         scene.lights.len()
                     )
                 },
@@ -292,7 +292,7 @@ impl fmt::Display for RenderPlan {
         }
         writeln!(f, "passes:")?;
         for (i, p) in self.passes.iter().enumerate() {
-            writeln!(f, "  {}. {:<19} {}", i + 1, p.name, p.detail)?;
+            writeln!(f, "  {}. {:<21} {}", i + 1, p.name, p.detail)?;
             if !p.reads.is_empty() {
                 writeln!(f, "       reads  {}", p.reads.join(", "))?;
             }
