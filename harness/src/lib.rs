@@ -8,6 +8,7 @@ pub mod images;
 pub mod inspect;
 pub mod metrics;
 pub mod reference;
+pub mod suite;
 pub mod test_scenes;
 pub mod tolerance;
 

@@ -1,0 +1,86 @@
+//! The `harness` binary on bad and good input: `inspect` exits 1 with the loader's error (never
+//! 101, a panic) on every malformed fixture, and 0 on fixtures that load with warnings.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../engine/tests/fixtures")
+        .join(name)
+}
+
+fn harness(args: &[&str]) -> (i32, String, String) {
+    let output = Command::new(env!("CARGO_BIN_EXE_harness"))
+        .args(args)
+        .output()
+        .expect("run harness");
+    (
+        output.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&output.stdout).into_owned(),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn inspect_fails_cleanly_on_every_malformed_fixture() {
+    let cases = [
+        ("empty.obj", "no geometry"),
+        ("truncated_face.obj", "truncated_face.obj:"),
+        ("truncated_vertex.obj", "truncated_vertex.obj:"),
+        ("out_of_range.obj", "out of range"),
+        ("zero_index.obj", "zero_index.obj:"),
+        ("nan_coord.obj", "nan_coord.obj:"),
+        ("inf_coord.obj", "inf_coord.obj:"),
+        ("non_utf8.obj", "UTF-8"),
+        ("missing_mtl.obj", "missing_mtl.obj"),
+        ("missing_texture.obj", "missing_texture.mtl"),
+        ("corrupt_texture.obj", "corrupt_texture.mtl"),
+        ("huge_index.obj", "huge_index.obj:"),
+        ("huge_index_2_40.obj", "huge_index_2_40.obj:"),
+        ("huge_index_overflow.obj", "huge_index_overflow.obj:"),
+        ("relative_out_of_range.obj", "relative_out_of_range.obj:"),
+        ("corrupt.exr", "corrupt.exr"),
+        ("textures/corrupt.png", "corrupt.png"),
+        ("missing_texture.mtl", "missing_texture.mtl"),
+    ];
+    for (file, expected) in cases {
+        let path = fixture(file);
+        assert!(path.exists(), "fixture {file} missing");
+        let (code, _, stderr) = harness(&["inspect", path.to_str().unwrap()]);
+        assert_eq!(code, 1, "{file}: exit {code}, stderr:\n{stderr}");
+        assert!(
+            stderr.contains(expected),
+            "{file}: error does not mention `{expected}`:\n{stderr}"
+        );
+        assert!(!stderr.contains("panicked"), "{file}: panicked:\n{stderr}");
+    }
+}
+
+#[test]
+fn inspect_loads_fixtures_that_only_warn() {
+    for file in [
+        "unknown_keys.obj",
+        "points_lines.obj",
+        "ngons.obj",
+        "textured.mtl",
+    ] {
+        let (code, stdout, stderr) = harness(&["inspect", fixture(file).to_str().unwrap()]);
+        assert_eq!(code, 0, "{file}: exit {code}\n{stdout}\n{stderr}");
+    }
+    let (code, stdout, _) = harness(&[
+        "inspect",
+        "--json",
+        fixture("scenes/two_materials.toml").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0);
+    let value: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(value["textures_decoded"], 3);
+}
+
+#[test]
+fn unknown_scene_names_list_the_canonical_scenes() {
+    let (code, _, stderr) = harness(&["plan", "--scene", "chesss"]);
+    assert_eq!(code, 1);
+    assert!(stderr.contains("chess"), "{stderr}");
+}

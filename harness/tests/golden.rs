@@ -1,0 +1,156 @@
+//! The golden-image suite: one test per scene x pass x backend, named
+//! `<scene>::<pass>::<backend>` (so `cargo test --test golden chess::final` filters), runnable
+//! under `cargo nextest` (and so shardable with `--partition count:K/N`).
+//!
+//! Each (scene, backend) is rendered once, by the first of its tests to run. A backend that is
+//! not available here is reported as ignored, with the reason on stderr; `REQUIRE_BACKENDS`
+//! (comma-separated names) turns that into a failure. `UPDATE_GOLDENS=1` blesses the reference
+//! backend's outputs instead of checking them, and checks the other backends against those.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
+use engine::backend::{self, BackendKind};
+use engine::renderer::Frame;
+use harness::golden::{self, GoldenStore};
+use harness::suite::{self, Case, REFERENCE_BACKEND};
+use libtest_mimic::{Arguments, Failed, Trial};
+
+type Rendered = Arc<OnceLock<Result<Frame, String>>>;
+
+struct Suite {
+    cases: Vec<Case>,
+    store: GoldenStore,
+    frames: Mutex<HashMap<(usize, BackendKind), Rendered>>,
+    update: bool,
+}
+
+impl Suite {
+    fn frame(&self, case: usize, kind: BackendKind) -> Rendered {
+        let cell = self
+            .frames
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .entry((case, kind))
+            .or_default()
+            .clone();
+        cell.get_or_init(|| self.cases[case].render(kind));
+        cell
+    }
+
+    fn run(&self, case_index: usize, pass: &str, kind: BackendKind) -> Result<(), Failed> {
+        let case = &self.cases[case_index];
+        let rendered = self.frame(case_index, kind);
+        let frame = match rendered.get() {
+            Some(Ok(frame)) => frame,
+            Some(Err(e)) => return Err(format!("render failed on {kind}: {e}").into()),
+            None => return Err("render did not run".into()),
+        };
+        let actual = &frame.outputs[pass];
+        if self.update {
+            if kind == REFERENCE_BACKEND {
+                let previous =
+                    match self
+                        .store
+                        .load(case.name(), pass, golden::is_eight_bit(actual))
+                    {
+                        Ok(Some(old)) => match golden::check(actual, Some(&old), &case.rules[pass])
+                        {
+                            golden::Outcome::Passed(v) | golden::Outcome::Failed(v) => v
+                                .checks
+                                .iter()
+                                .map(ToString::to_string)
+                                .collect::<Vec<_>>()
+                                .join("; "),
+                            other => format!("{other:?}"),
+                        },
+                        _ => "new".to_owned(),
+                    };
+                let driver = backend::create(kind)
+                    .map(|b| golden::fingerprint(b.info()))
+                    .unwrap_or_default();
+                let path = self
+                    .store
+                    .bless(case.name(), pass, actual, kind.name(), &driver, &previous)
+                    .map_err(|e| Failed::from(e.to_string()))?;
+                eprintln!("blessed {} (vs old: {previous})", path.display());
+                return Ok(());
+            }
+            // Check the other backends against the reference backend's fresh render.
+            let reference = self.frame(case_index, REFERENCE_BACKEND);
+            if let Some(Ok(reference)) = reference.get() {
+                let outcome =
+                    golden::check(actual, Some(&reference.outputs[pass]), &case.rules[pass]);
+                return if outcome.passed() {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "{kind} disagrees with {REFERENCE_BACKEND} being blessed: {outcome:?}"
+                    )
+                    .into())
+                };
+            }
+        }
+        let check = suite::check_pass(&self.store, case, pass, kind, actual);
+        if check.outcome.passed() {
+            Ok(())
+        } else {
+            Err(check.message().into())
+        }
+    }
+}
+
+fn main() {
+    let arguments = Arguments::from_args();
+    let cases = match suite::canonical_cases() {
+        Ok(cases) => cases,
+        Err(e) => {
+            eprintln!("error: cannot set up the golden suite: {e}");
+            std::process::exit(101);
+        }
+    };
+    let required = std::env::var("REQUIRE_BACKENDS").unwrap_or_default();
+    let mut available = Vec::new();
+    let mut trials = Vec::new();
+    for kind in BackendKind::ALL {
+        let status = backend::probe(kind);
+        if status.available {
+            available.push(kind);
+        } else {
+            let reason = format!(
+                "{kind} unavailable: {} (fix: {})",
+                status.reason.unwrap_or_default(),
+                status.fix.unwrap_or_default()
+            );
+            if required.split(',').any(|r| r.trim() == kind.name()) {
+                let message = format!("{reason}; REQUIRE_BACKENDS names it");
+                trials.push(Trial::test(format!("backend::{kind}"), move || {
+                    Err(message.into())
+                }));
+            } else {
+                eprintln!("note: {reason}; its golden tests are ignored");
+            }
+        }
+    }
+    let suite = Arc::new(Suite {
+        cases,
+        store: GoldenStore::workspace(),
+        frames: Mutex::default(),
+        update: std::env::var("UPDATE_GOLDENS").is_ok_and(|v| v == "1"),
+    });
+    for (index, case) in suite.cases.iter().enumerate() {
+        for pass in &case.passes {
+            for kind in BackendKind::ALL {
+                let name = format!("{}::{pass}::{kind}", case.name());
+                let is_available = available.contains(&kind);
+                let suite = suite.clone();
+                let pass = pass.clone();
+                trials.push(
+                    Trial::test(name, move || suite.run(index, &pass, kind))
+                        .with_ignored_flag(!is_available),
+                );
+            }
+        }
+    }
+    libtest_mimic::run(&arguments, trials).exit();
+}
