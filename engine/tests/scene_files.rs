@@ -124,3 +124,59 @@ fn canonical_names_resolve_and_unknown_names_list_the_scenes() {
         .to_string();
     assert!(e.contains("arrow, chess, ibl"), "{e}");
 }
+
+/// Every canonical scene loads, renders at 512x512 by default, and every vertex of every mesh
+/// it uses has a finite unit normal and a unit tangent orthogonal to it with w = +1 or -1.
+#[test]
+fn canonical_scenes_load_with_valid_tangent_frames() {
+    let names = scene_file::canonical_scenes(&scenes_dir());
+    assert_eq!(names, ["arrow", "chess", "ibl"]);
+    for name in names {
+        let loaded = scene_file::load(&scenes_dir().join(format!("{name}.toml")))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let scene = &loaded.scene;
+        assert_eq!((scene.quality.width, scene.quality.height), (512, 512));
+        assert!(!scene.objects.is_empty());
+        for object in &scene.objects {
+            for (i, v) in object.mesh.vertices.iter().enumerate() {
+                let n = glam::Vec3::from(v.normal);
+                let t = glam::Vec3::new(v.tangent[0], v.tangent[1], v.tangent[2]);
+                let what = format!("{name}/{} vertex {i}", object.name);
+                assert!(n.is_finite() && t.is_finite(), "{what}: not finite");
+                assert!(
+                    (n.length() - 1.0).abs() <= 1e-3,
+                    "{what}: |n| = {}",
+                    n.length()
+                );
+                assert!(
+                    (t.length() - 1.0).abs() <= 1e-3,
+                    "{what}: |t| = {}",
+                    t.length()
+                );
+                assert!(n.dot(t).abs() <= 1e-3, "{what}: n.t = {}", n.dot(t));
+                assert!(
+                    v.tangent[3] == 1.0 || v.tangent[3] == -1.0,
+                    "{what}: w = {}",
+                    v.tangent[3]
+                );
+            }
+        }
+    }
+    // The chess board's two materials share one albedo texture, decoded once.
+    let chess = scene_file::load(&scenes_dir().join("chess.toml")).unwrap();
+    let board: Vec<_> = chess
+        .scene
+        .objects
+        .iter()
+        .filter(|o| o.name.starts_with("board/"))
+        .collect();
+    assert_eq!(board.len(), 2);
+    assert_eq!(
+        board[0].material.base_color_map,
+        board[1].material.base_color_map
+    );
+    assert_eq!(
+        chess.textures_decoded, 4,
+        "albedo, roughness, normal, clearcoat"
+    );
+}

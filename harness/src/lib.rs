@@ -1,6 +1,7 @@
 //! The harness library: image comparison, cross-backend checks, and (growing) goldens, bless and
 //! reports. The `harness` binary is a thin command line over it.
 
+pub mod check;
 pub mod compare;
 pub mod first_scene;
 pub mod golden;
@@ -8,6 +9,7 @@ pub mod images;
 pub mod inspect;
 pub mod metrics;
 pub mod reference;
+pub mod report;
 pub mod suite;
 pub mod test_scenes;
 pub mod tolerance;

@@ -84,3 +84,29 @@ fn unknown_scene_names_list_the_canonical_scenes() {
     assert_eq!(code, 1);
     assert!(stderr.contains("chess"), "{stderr}");
 }
+
+/// The committed scene assets are exactly what the generator writes, so they can be regenerated.
+#[test]
+fn scene_assets_regenerate_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let status = Command::new(env!("CARGO_BIN_EXE_make_scene_assets"))
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(status.status.success(), "{status:?}");
+    let committed = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/assets");
+    let mut compared = 0;
+    for entry in std::fs::read_dir(dir.path()).unwrap() {
+        let entry = entry.unwrap();
+        let name = entry.file_name();
+        let fresh = std::fs::read(entry.path()).unwrap();
+        let old = std::fs::read(committed.join(&name))
+            .unwrap_or_else(|e| panic!("{name:?} is generated but not committed: {e}"));
+        assert!(
+            fresh == old,
+            "{name:?} differs from the generator's output; run make_scene_assets"
+        );
+        compared += 1;
+    }
+    assert!(compared >= 12, "only {compared} files generated");
+}
