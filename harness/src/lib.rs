@@ -19,7 +19,10 @@ pub mod tolerance;
 pub fn workspace_root() -> std::path::PathBuf {
     std::env::var_os("HARNESS_ROOT")
         .map(std::path::PathBuf::from)
-        .unwrap_or_else(|| std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .unwrap_or_else(|| {
+            let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+            root.canonicalize().unwrap_or(root)
+        })
 }
 
 /// The canonical scenes' folder, `<workspace>/scenes`.

@@ -5,7 +5,6 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::Context;
 use clap::{Parser, Subcommand};
 
 use engine::backend::BackendKind;
@@ -24,11 +23,38 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render on every available backend, compare, and write images (the default command).
+    /// Render every canonical scene on every available backend, check every pass against its
+    /// golden, compare the backends with each other, print a table and write the HTML report
+    /// (the default command). Exits 1 on any failure.
     Check {
-        /// Where to write images.
+        /// Where to write the report (report.html) and failure images.
         #[arg(long, default_value_os_t = default_out_dir())]
         out: PathBuf,
+        /// Only these scenes (canonical names or scene files; repeatable).
+        #[arg(long = "scene")]
+        scenes: Vec<String>,
+        /// Print the results as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Write new goldens after an intended change: shows the metrics against the old golden,
+    /// then writes atomically and records the driver and date in golden/<scene>/blessed.toml.
+    Bless {
+        /// Only this scene (repeatable).
+        #[arg(long = "scene")]
+        scenes: Vec<String>,
+        /// Only this pass (repeatable).
+        #[arg(long = "pass")]
+        passes: Vec<String>,
+        /// Backend to render the goldens with.
+        #[arg(long, default_value = "gl")]
+        backend: BackendKind,
+        /// Bless every pass of every canonical scene (required when no --scene is given).
+        #[arg(long)]
+        all: bool,
+        /// Show what would change without writing anything.
+        #[arg(long)]
+        dry_run: bool,
     },
     /// Render a scene on one backend and write pass outputs (`.png`, or `.exr` for float passes).
     Render {
@@ -74,7 +100,7 @@ enum Command {
 
 /// `target/harness` in the workspace.
 fn default_out_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/harness")
+    harness::workspace_root().join("target/harness")
 }
 
 fn main() -> ExitCode {
@@ -82,10 +108,19 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let command = cli.command.unwrap_or(Command::Check {
         out: default_out_dir(),
+        scenes: vec![],
+        json: false,
     });
     let result = match command {
         Command::Backends { json } => backends(json),
-        Command::Check { out } => check(&out),
+        Command::Check { out, scenes, json } => check(&out, &scenes, json),
+        Command::Bless {
+            scenes,
+            passes,
+            backend,
+            all,
+            dry_run,
+        } => bless(&scenes, &passes, backend, all, dry_run),
         Command::Render {
             scene,
             backend,
@@ -139,55 +174,183 @@ fn backends(json: bool) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn check(out: &std::path::Path) -> anyhow::Result<ExitCode> {
-    let dir = out.join("first_scene");
-    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-    let mut renders = Vec::new();
-    let mut failed = false;
-    for kind in BackendKind::ALL {
-        eprint!("rendering the first scene on {kind} ... ");
-        match first_scene::render(kind) {
-            Ok(images) => {
-                let ms: f64 = images.timings.iter().filter_map(|t| t.gpu_ns).sum::<f64>() / 1e6;
-                eprintln!("ok ({ms:.2} ms GPU)");
-                let path = dir.join(format!("{kind}_ldr.png"));
-                std::fs::write(&path, first_scene::png_bytes(&images.ldr)?)
-                    .with_context(|| format!("writing {}", path.display()))?;
-                renders.push((kind, images));
+fn load_cases(scenes: &[String]) -> anyhow::Result<Vec<harness::suite::Case>> {
+    if scenes.is_empty() {
+        return Ok(harness::suite::canonical_cases()?);
+    }
+    scenes
+        .iter()
+        .map(|s| harness::suite::Case::load(s).map_err(Into::into))
+        .collect()
+}
+
+fn check(out: &std::path::Path, scenes: &[String], json: bool) -> anyhow::Result<ExitCode> {
+    let cases = load_cases(scenes)?;
+    let store = harness::golden::GoldenStore::workspace();
+    let bar = indicatif::ProgressBar::new(0).with_style(
+        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} renders  {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let (run, outputs) = harness::check::run(&cases, &store, |done, total, what| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+        bar.set_message(what.to_owned());
+    });
+    bar.finish_and_clear();
+    for b in &run.backends {
+        if let Some(reason) = &b.unavailable {
+            eprintln!("note: {} unavailable: {reason}", b.backend);
+        }
+    }
+    if run.backends.iter().all(|b| b.unavailable.is_some()) {
+        anyhow::bail!("no backend is available; run `harness backends` for the reasons");
+    }
+    let html = harness::report::html(&run, &outputs, &store);
+    let report = out.join("report.html");
+    harness::images::write_atomically(&report, html.as_bytes())?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&run)?);
+    } else {
+        println!(
+            "{:<8} {:<17} {:<12} {:<8} worst metric",
+            "scene", "pass", "backend", "result"
+        );
+        for r in &run.results {
+            let (label, worst) = match &r.outcome {
+                harness::golden::Outcome::Passed(v) | harness::golden::Outcome::Failed(v) => (
+                    if r.outcome.passed() { "ok" } else { "FAILED" },
+                    v.checks
+                        .iter()
+                        .find(|c| !c.passed)
+                        .or(v.checks.first())
+                        .map(ToString::to_string)
+                        .unwrap_or_default(),
+                ),
+                harness::golden::Outcome::MissingGolden => (
+                    "MISSING",
+                    format!(
+                        "bless: {}",
+                        harness::suite::bless_command(&r.scene, &r.pass)
+                    ),
+                ),
+                harness::golden::Outcome::Incomparable(why) => ("FAILED", why.clone()),
+            };
+            println!(
+                "{:<8} {:<17} {:<12} {:<8} {worst}",
+                r.scene, r.pass, r.backend, label
+            );
+        }
+        for (scene, backend, error) in &run.render_errors {
+            println!(
+                "{scene:<8} {:<17} {backend:<12} FAILED   render: {error}",
+                "-"
+            );
+        }
+        let worst_cross = run
+            .cross
+            .iter()
+            .filter(|c| !c.within_tolerance)
+            .map(|c| format!("{}/{} {} vs {}", c.scene, c.pass, c.a, c.b))
+            .collect::<Vec<_>>();
+        if !worst_cross.is_empty() {
+            println!(
+                "backends disagree beyond tolerance on: {}",
+                worst_cross.join(", ")
+            );
+        }
+        let failed = run.results.iter().filter(|r| !r.outcome.passed()).count();
+        println!(
+            "{} checks, {failed} failed; report: {}",
+            run.results.len(),
+            report.display()
+        );
+        if failed > 0 {
+            println!(
+                "failure images: {}",
+                harness::workspace_root()
+                    .join("target/harness/failures")
+                    .display()
+            );
+        }
+    }
+    Ok(if run.passed() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}
+
+fn bless(
+    scenes: &[String],
+    passes: &[String],
+    kind: BackendKind,
+    all: bool,
+    dry_run: bool,
+) -> anyhow::Result<ExitCode> {
+    if scenes.is_empty() && !all {
+        anyhow::bail!("name what to bless with --scene (and optionally --pass), or bless everything with --all");
+    }
+    let cases = load_cases(scenes)?;
+    let store = harness::golden::GoldenStore::workspace();
+    let mut backend = engine::backend::create(kind)?;
+    let driver = harness::golden::fingerprint(backend.info());
+    for case in &cases {
+        for pass in passes {
+            if !case.passes.contains(pass) {
+                anyhow::bail!(
+                    "scene {} has no golden pass `{pass}` (it has: {})",
+                    case.name(),
+                    case.passes.join(", ")
+                );
             }
-            Err(engine::backend::BackendError::Unavailable { reason, fix, .. }) => {
-                eprintln!("unavailable: {reason} (fix: {fix})");
-            }
-            Err(e) => {
-                eprintln!("FAILED: {e}");
-                failed = true;
+        }
+        let wanted: Vec<&str> = case
+            .passes
+            .iter()
+            .filter(|p| passes.is_empty() || passes.contains(p))
+            .map(String::as_str)
+            .collect();
+        eprintln!("rendering {} on {kind} ...", case.name());
+        let frame = engine::renderer::render(
+            backend.as_mut(),
+            &case.loaded.scene,
+            engine::renderer::Readback::Only(&wanted),
+        )?;
+        for pass in wanted {
+            let image = &frame.outputs[pass];
+            let eight_bit = harness::golden::is_eight_bit(image);
+            let previous = match store.load(case.name(), pass, eight_bit)? {
+                None => "new".to_owned(),
+                Some(old) => match harness::golden::check(image, Some(&old), &case.rules[pass]) {
+                    harness::golden::Outcome::Passed(v) | harness::golden::Outcome::Failed(v) => {
+                        let passed = v.passed;
+                        let metrics = v
+                            .checks
+                            .iter()
+                            .map(ToString::to_string)
+                            .collect::<Vec<_>>()
+                            .join("; ");
+                        format!(
+                            "{} vs old golden: {metrics}",
+                            if passed {
+                                "within tolerance"
+                            } else {
+                                "CHANGED"
+                            }
+                        )
+                    }
+                    other => format!("{other:?}"),
+                },
+            };
+            println!("{}/{pass}: {previous}", case.name());
+            if !dry_run {
+                let path =
+                    store.bless(case.name(), pass, image, kind.name(), &driver, &previous)?;
+                println!("  wrote {}", path.display());
             }
         }
     }
-    let Some((reference, reference_images)) = renders.first() else {
-        anyhow::bail!("no backend is available; run `harness backends` for the reasons");
-    };
-    for (kind, images) in &renders[1..] {
-        let a = first_scene::agreement(*kind, images, *reference, reference_images)?;
-        println!(
-            "{kind:<12} vs {reference}: RGBA8 {:.4}% within 1/255 (max {}), RGBA16F {:.4}% within rel 1e-3 (max rel {:.2e} at {:?}, max abs {:.1e}), depth max rel {:.2e} -> {}",
-            a.ldr.fraction_within * 100.0,
-            a.ldr.max_abs,
-            a.hdr.fraction_within * 100.0,
-            a.hdr.max_relative,
-            a.hdr.worst_pixel,
-            a.hdr.max_abs,
-            a.depth.max_relative,
-            if a.passes() { "agree" } else { "DISAGREE" },
-        );
-        failed |= !a.passes();
-    }
-    println!("images: {}", dir.display());
-    Ok(if failed {
-        ExitCode::FAILURE
-    } else {
-        ExitCode::SUCCESS
-    })
+    Ok(ExitCode::SUCCESS)
 }
 
 fn render(
