@@ -20,7 +20,8 @@ struct ObjectUniforms {
     base_color: vec4<f32>,
     // roughness, metallic, specular, clearcoat.
     params: vec4<f32>,
-    // clearcoat roughness, specular exponent, -, -.
+    // clearcoat roughness, specular exponent, fault flag (1: swap albedo red and blue; only the
+    // harness's mutation self-test sets it), -.
     params2: vec4<f32>,
     // 1.0 where a map replaces the scalar: base color, normal, roughness, metallic.
     maps: vec4<f32>,
@@ -112,7 +113,10 @@ fn fs_gbuffer(in: VertexOut) -> GBuffer {
         t = orthogonalise(t, n);
     }
 
-    let base_color = mix(object.base_color.rgb, base_sample.rgb, object.maps.x);
+    var base_color = mix(object.base_color.rgb, base_sample.rgb, object.maps.x);
+    if object.params2.z > 0.5 {
+        base_color = base_color.bgr;
+    }
     let roughness = mix(object.params.x, roughness_sample.r, object.maps.z);
     let metallic = mix(object.params.y, metallic_sample.r, object.maps.w);
     let specular = mix(object.params.z, specular_sample.r, object.maps2.y);

@@ -10,6 +10,7 @@ pub mod inspect;
 pub mod metrics;
 pub mod reference;
 pub mod report;
+pub mod selftest;
 pub mod suite;
 pub mod test_scenes;
 pub mod tolerance;

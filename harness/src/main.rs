@@ -87,6 +87,14 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Mutation self-test: small known changes (light x1.02, roughness +0.05, camera yaw 0.25
+    /// deg, shadow bias x4, environment rotated 2 deg, a G-buffer channel swap) must each fail a
+    /// golden tolerance, while unmodified renders on every backend pass. Prints the detection table.
+    Selftest {
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// List the canonical scenes with their descriptions.
     Scenes,
     /// List every backend with its availability, the reason and fix when unavailable, and the
@@ -135,6 +143,7 @@ fn main() -> ExitCode {
             .map_err(Into::into),
         Command::Inspect { path, json } => inspect(&path, json),
         Command::Scenes => scenes(),
+        Command::Selftest { json } => selftest(json),
     };
     match result {
         Ok(code) => code,
@@ -442,4 +451,44 @@ fn scenes() -> anyhow::Result<ExitCode> {
         println!("{name:<10} {description}");
     }
     Ok(ExitCode::SUCCESS)
+}
+
+fn selftest(json: bool) -> anyhow::Result<ExitCode> {
+    let cases = harness::suite::canonical_cases()?;
+    let store = harness::golden::GoldenStore::workspace();
+    let available: Vec<BackendKind> = BackendKind::ALL
+        .into_iter()
+        .filter(|&k| engine::backend::probe(k).available)
+        .collect();
+    let Some(&mutation_backend) = available.first() else {
+        anyhow::bail!("no backend is available; run `harness backends` for the reasons");
+    };
+    eprintln!(
+        "self-test: {} scenes, unmodified on {}, mutations on {mutation_backend} ...",
+        cases.len(),
+        available
+            .iter()
+            .map(|k| k.name())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let result = harness::selftest::run(&cases, &store, &available, mutation_backend);
+    if json {
+        println!("{}", serde_json::to_string_pretty(&result)?);
+    } else {
+        print!("{}", result.table());
+        for (scene, backend, what) in &result.false_alarms {
+            println!("FALSE ALARM: unmodified {scene} on {backend}: {what}");
+        }
+        for m in result.undetected() {
+            println!("UNDETECTED: {}", m.describe());
+        }
+    }
+    Ok(
+        if result.false_alarms.is_empty() && result.undetected().is_empty() {
+            ExitCode::SUCCESS
+        } else {
+            ExitCode::FAILURE
+        },
+    )
 }

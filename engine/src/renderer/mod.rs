@@ -78,12 +78,30 @@ impl Frame {
     }
 }
 
+/// Deliberate faults, for the harness's mutation self-test (proof that the golden tolerances
+/// catch a broken pass). All off by default; [`render`] never sets them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Faults {
+    /// The geometry pass writes albedo with red and blue swapped.
+    pub swap_albedo_red_blue: bool,
+}
+
 /// Renders `scene` and reads back the requested outputs. Everything created is destroyed before
 /// returning, also on error.
 pub fn render(
     backend: &mut dyn Backend,
     scene: &Scene,
     readback: Readback<'_>,
+) -> Result<Frame, RenderError> {
+    render_with_faults(backend, scene, readback, &Faults::default())
+}
+
+/// [`render`] with deliberate faults injected (see [`Faults`]).
+pub fn render_with_faults(
+    backend: &mut dyn Backend,
+    scene: &Scene,
+    readback: Readback<'_>,
+    faults: &Faults,
 ) -> Result<Frame, RenderError> {
     validate(scene)?;
     let plan = RenderPlan::new(scene);
@@ -107,7 +125,7 @@ pub fn render(
         }
     };
     let mut scope = ResourceScope::default();
-    let result = record_and_submit(backend, scene, &plan, &wanted, &mut scope);
+    let result = record_and_submit(backend, scene, &plan, &wanted, faults, &mut scope);
     scope.destroy(backend);
     let (outputs, timings) = result?;
     Ok(Frame {
@@ -396,6 +414,7 @@ fn record_and_submit(
     scene: &Scene,
     plan: &RenderPlan,
     wanted: &[String],
+    faults: &Faults,
     scope: &mut ResourceScope,
 ) -> Result<Outputs, RenderError> {
     let (width, height) = (plan.width, plan.height);
@@ -611,6 +630,7 @@ fn record_and_submit(
             scene.camera.position,
             view_projection,
             channel,
+            faults,
         );
         let uniform = scope.buffer(
             backend,

@@ -4,7 +4,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Mat4};
 
-use super::{object_matrices, CameraMatrices};
+use super::{object_matrices, CameraMatrices, Faults};
 use crate::plan::{MaskChannel, MAX_LIGHTS_PER_DRAW};
 use crate::scene::{EnvironmentImage, Light, Object, Scene, Transform};
 
@@ -72,6 +72,7 @@ pub(super) fn object_uniforms(
     camera_position: DVec3,
     view_projection: Mat4,
     channel: MaskChannel,
+    faults: &Faults,
 ) -> Vec<f32> {
     let (model, normal) = object_matrices(transform, camera_position);
     let m = &object.material;
@@ -89,7 +90,12 @@ pub(super) fn object_uniforms(
         m.anisotropy,
     ]);
     data.extend_from_slice(&[m.roughness, m.metallic, m.specular, m.clearcoat]);
-    data.extend_from_slice(&[m.clearcoat_roughness, m.specular_exponent, 0.0, 0.0]);
+    let swap = if faults.swap_albedo_red_blue {
+        1.0
+    } else {
+        0.0
+    };
+    data.extend_from_slice(&[m.clearcoat_roughness, m.specular_exponent, swap, 0.0]);
     data.extend_from_slice(&[
         flag(m.base_color_map),
         flag(m.normal_map),
