@@ -74,7 +74,7 @@ impl fmt::Display for Metric {
             Metric::FractionOver {
                 threshold,
                 shift: s,
-            } => write!(f, "fraction_over({threshold}{})", shift(s)),
+            } => write!(f, "fraction_over({threshold:.4}{})", shift(s)),
             Metric::Rmse => write!(f, "rmse"),
             Metric::Psnr => write!(f, "psnr"),
             Metric::Relative { percentile, floor } => {

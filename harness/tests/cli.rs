@@ -150,3 +150,152 @@ fn render_writes_every_pass_of_a_scene_file() {
     assert_eq!(code, 1);
     assert!(stderr.contains("no pass output `shadow`"), "{stderr}");
 }
+
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).unwrap();
+        }
+    }
+}
+
+fn snapshot(dir: &Path) -> std::collections::BTreeMap<PathBuf, (Vec<u8>, std::time::SystemTime)> {
+    let mut out = std::collections::BTreeMap::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let entry = entry.unwrap();
+        if entry.file_type().unwrap().is_dir() {
+            out.extend(snapshot(&entry.path()));
+        } else {
+            let meta = entry.metadata().unwrap();
+            out.insert(
+                entry.path(),
+                (
+                    std::fs::read(entry.path()).unwrap(),
+                    meta.modified().unwrap(),
+                ),
+            );
+        }
+    }
+    out
+}
+
+/// `bless --scene chess --pass final` rewrites that golden and chess's blessed.toml, and nothing
+/// else (run against a temporary copy of scenes/ and golden/ through HARNESS_ROOT).
+#[test]
+fn bless_rewrites_only_the_named_golden() {
+    if !engine::backend::probe(engine::BackendKind::Gl).available {
+        eprintln!("gl unavailable here; skipped");
+        return;
+    }
+    let root = tempfile::tempdir().unwrap();
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    copy_tree(&workspace.join("scenes"), &root.path().join("scenes"));
+    copy_tree(&workspace.join("golden"), &root.path().join("golden"));
+    let golden = root.path().join("golden");
+    let before = snapshot(&golden);
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    let output = Command::new(env!("CARGO_BIN_EXE_harness"))
+        .args(["bless", "--scene", "chess", "--pass", "final"])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(
+        stdout.contains("chess/final: within tolerance vs old golden"),
+        "{stdout}"
+    );
+    let after = snapshot(&golden);
+    assert_eq!(
+        before.keys().collect::<Vec<_>>(),
+        after.keys().collect::<Vec<_>>()
+    );
+    let changed: Vec<String> = after
+        .iter()
+        .filter(|(path, state)| before[*path] != **state)
+        .map(|(path, _)| path.strip_prefix(&golden).unwrap().display().to_string())
+        .collect();
+    assert_eq!(changed, ["chess/blessed.toml", "chess/final.png"]);
+    let record = std::fs::read_to_string(golden.join("chess/blessed.toml")).unwrap();
+    assert!(
+        record.contains("[passes.final]") && record.contains("driver = "),
+        "{record}"
+    );
+
+    // Without --scene or --all, bless refuses.
+    let output = Command::new(env!("CARGO_BIN_EXE_harness"))
+        .arg("bless")
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(1));
+}
+
+/// A changed golden fails `check` with the metrics and leaves actual, golden, diff and the HTML
+/// report on disk; a missing golden fails with the exact bless command.
+#[test]
+fn check_reports_failures_with_images_and_the_bless_command() {
+    if !engine::backend::probe(engine::BackendKind::Gl).available {
+        eprintln!("gl unavailable here; skipped");
+        return;
+    }
+    let root = tempfile::tempdir().unwrap();
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    copy_tree(&workspace.join("scenes"), &root.path().join("scenes"));
+    copy_tree(&workspace.join("golden"), &root.path().join("golden"));
+    // Darken the golden final image of `arrow` by 3/255: a change the tolerance must catch.
+    let final_png = root.path().join("golden/arrow/final.png");
+    let mut image = image::open(&final_png).unwrap().to_rgba8();
+    for pixel in image.pixels_mut() {
+        for c in 0..3 {
+            pixel[c] = pixel[c].saturating_sub(3);
+        }
+    }
+    image.save(&final_png).unwrap();
+    std::fs::remove_file(root.path().join("golden/arrow/light.exr")).unwrap();
+    let out = root.path().join("out");
+    let output = Command::new(env!("CARGO_BIN_EXE_harness"))
+        .args(["check", "--scene", "arrow", "--out", out.to_str().unwrap()])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(1), "{stdout}");
+    let line = |pass: &str| {
+        stdout
+            .lines()
+            .find(|l| l.starts_with("arrow") && l.contains(pass) && l.contains(" gl "))
+            .unwrap_or_default()
+            .to_owned()
+    };
+    assert!(
+        line("final").contains("FAILED") && line("final").contains("fraction_over"),
+        "{stdout}"
+    );
+    assert!(
+        line("light").contains("MISSING")
+            && line("light").contains("harness -- bless --scene arrow --pass light"),
+        "{stdout}"
+    );
+    assert!(line("mask").contains(" ok "), "{stdout}");
+    let failures = root.path().join("target/harness/failures/arrow/gl");
+    for file in [
+        "final_actual.png",
+        "final_golden.png",
+        "final_diff.png",
+        "light_actual.exr",
+    ] {
+        assert!(failures.join(file).is_file(), "{file} not written");
+    }
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(report.contains("data:image/png;base64,") && report.contains("FAILED"));
+}

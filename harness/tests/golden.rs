@@ -23,6 +23,8 @@ struct Suite {
     store: GoldenStore,
     frames: Mutex<HashMap<(usize, BackendKind), Rendered>>,
     update: bool,
+    /// Checks that did not pass, for the HTML report written at the end.
+    failures: Mutex<Vec<harness::suite::PassCheck>>,
 }
 
 impl Suite {
@@ -95,7 +97,12 @@ impl Suite {
         if check.outcome.passed() {
             Ok(())
         } else {
-            Err(check.message().into())
+            let message = check.message();
+            self.failures
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push(check);
+            Err(format!("{message}\n  report {}", report_path().display()).into())
         }
     }
 }
@@ -137,6 +144,7 @@ fn main() {
         store: GoldenStore::workspace(),
         frames: Mutex::default(),
         update: std::env::var("UPDATE_GOLDENS").is_ok_and(|v| v == "1"),
+        failures: Mutex::default(),
     });
     for (index, case) in suite.cases.iter().enumerate() {
         for pass in &case.passes {
@@ -152,5 +160,53 @@ fn main() {
             }
         }
     }
-    libtest_mimic::run(&arguments, trials).exit();
+    let conclusion = libtest_mimic::run(&arguments, trials);
+    write_failure_report(&suite);
+    conclusion.exit();
+}
+
+fn report_path() -> std::path::PathBuf {
+    harness::workspace_root().join("target/harness/report.html")
+}
+
+/// After a run with failures: the HTML report of the failed checks (golden | actual | diff).
+fn write_failure_report(suite: &Suite) {
+    let failures = suite.failures.lock().unwrap_or_else(|e| e.into_inner());
+    if failures.is_empty() {
+        return;
+    }
+    let frames = suite.frames.lock().unwrap_or_else(|e| e.into_inner());
+    let mut outputs = harness::report::Outputs::new();
+    for check in failures.iter() {
+        let Some(index) = suite.cases.iter().position(|c| c.name() == check.scene) else {
+            continue;
+        };
+        let Ok(kind) = check.backend.parse::<BackendKind>() else {
+            continue;
+        };
+        if let Some(Some(Ok(frame))) = frames.get(&(index, kind)).map(|cell| cell.get()) {
+            if let Some(image) = frame.outputs.get(&check.pass) {
+                outputs.insert(
+                    (
+                        check.scene.clone(),
+                        check.pass.clone(),
+                        check.backend.clone(),
+                    ),
+                    image.clone(),
+                );
+            }
+        }
+    }
+    let run = harness::check::CheckRun {
+        backends: vec![],
+        results: failures.clone(),
+        render_errors: vec![],
+        cross: vec![],
+        timings: vec![],
+    };
+    let html = harness::report::html(&run, &outputs, &suite.store);
+    match harness::images::write_atomically(&report_path(), html.as_bytes()) {
+        Ok(()) => eprintln!("report of the failures: {}", report_path().display()),
+        Err(e) => eprintln!("could not write the report: {e}"),
+    }
 }
