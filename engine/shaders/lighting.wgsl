@@ -42,6 +42,88 @@ struct LightingUniforms {
 @group(0) @binding(5) var gbuffer_material: texture_2d<f32>;
 @group(0) @binding(6) var shader_mask: texture_2d<f32>;
 
+// The shadow map of the one shadowed light of this draw (draws with a shadowed light hold only
+// that light, in slot 0); a 1x1 placeholder with `params.x = 0` otherwise.
+struct ShadowUniforms {
+    // Camera-relative world space to the light's clip space: [0] for a directional light, one
+    // per cube face (+X, -X, +Y, -Y, +Z, -Z) for a point light.
+    faces: array<mat4x4<f32>, 6>,
+    // x = kind (0 none, 1 directional, 2 point), y = constant bias (m), z = slope bias (texels),
+    // w = normal offset (texels).
+    params: vec4<f32>,
+    // x = filter (0 hard, 1 3x3 PCF), y = 1 / map width, z = 1 / map height,
+    // w = texel size in meters (directional) or per meter of distance (point).
+    map: vec4<f32>,
+}
+
+@group(0) @binding(7) var shadow_map: texture_depth_2d;
+@group(0) @binding(8) var shadow_sampler: sampler_comparison;
+@group(0) @binding(9) var<uniform> shadow: ShadowUniforms;
+
+// Filtered comparison at `uv` against `reference` depth, taps clamped inside `bounds`
+// (min uv, max uv) so point-light faces never read their neighbours in the atlas.
+fn shadow_lookup(uv: vec2<f32>, reference: f32, bounds: vec4<f32>) -> f32 {
+    if shadow.map.x < 0.5 {
+        return textureSampleCompareLevel(shadow_map, shadow_sampler, clamp(uv, bounds.xy, bounds.zw), reference);
+    }
+    var sum = 0.0;
+    for (var y = -1; y <= 1; y++) {
+        for (var x = -1; x <= 1; x++) {
+            let offset = vec2<f32>(f32(x), f32(y)) * shadow.map.yz;
+            sum += textureSampleCompareLevel(shadow_map, shadow_sampler, clamp(uv + offset, bounds.xy, bounds.zw), reference);
+        }
+    }
+    return sum / 9.0;
+}
+
+// Fraction of the light reaching the surface (1 = lit) for the draw's shadowed light.
+fn shadow_visibility(s: Surface, l: vec3<f32>, light: LightData) -> f32 {
+    let kind = shadow.params.x;
+    if kind < 0.5 {
+        return 1.0;
+    }
+    let n_dot_l = clamp(dot(s.normal, l), 0.0, 1.0);
+    let tan_theta = min(sqrt(max(1.0 - n_dot_l * n_dot_l, 0.0)) / max(n_dot_l, 1e-4), 10.0);
+    // Texel size at the receiver, in meters.
+    var texel = shadow.map.w;
+    if kind > 1.5 {
+        texel = shadow.map.w * length(light.position.xyz - s.position);
+    }
+    // Slope-scaled part in texels, times the filter's reach (PCF reads one texel further out).
+    let reach = select(1.0, 2.0, shadow.map.x > 0.5);
+    let bias = shadow.params.y + shadow.params.z * texel * tan_theta * reach;
+    if kind < 1.5 {
+        let p = s.position + s.normal * (shadow.params.w * texel) + l * bias;
+        let clip = shadow.faces[0] * vec4<f32>(p, 1.0);
+        let ndc = clip.xyz / clip.w;
+        let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+        if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
+            return 1.0;
+        }
+        // Receivers beyond the casters' far plane compare at the far plane.
+        return shadow_lookup(uv, min(ndc.z, 1.0), vec4<f32>(0.0, 0.0, 1.0, 1.0));
+    }
+    let p = s.position + s.normal * (shadow.params.w * texel) + l * bias;
+    let d = p - light.position.xyz;
+    let a = abs(d);
+    var face = 0u;
+    if a.x >= a.y && a.x >= a.z {
+        face = select(1u, 0u, d.x > 0.0);
+    } else if a.y >= a.z {
+        face = select(3u, 2u, d.y > 0.0);
+    } else {
+        face = select(5u, 4u, d.z > 0.0);
+    }
+    let clip = shadow.faces[face] * vec4<f32>(p, 1.0);
+    let ndc = clip.xyz / clip.w;
+    let tile = vec2<f32>(f32(face % 3u), f32(face / 3u));
+    let face_uv = clamp(vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5), vec2<f32>(0.0), vec2<f32>(1.0));
+    let uv = (tile + face_uv) / vec2<f32>(3.0, 2.0);
+    let half_texel = 0.5 * shadow.map.yz;
+    let bounds = vec4<f32>(tile / vec2<f32>(3.0, 2.0) + half_texel, (tile + 1.0) / vec2<f32>(3.0, 2.0) - half_texel);
+    return shadow_lookup(uv, clamp(ndc.z, 0.0, 1.0), bounds);
+}
+
 @vertex
 fn vs_fullscreen(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
     let corner = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u));
@@ -212,6 +294,14 @@ fn toon_times_cosine(s: Surface, l: vec3<f32>) -> vec3<f32> {
     return s.base_color * band;
 }
 
+// Shadow term of light slot `i`: only slot 0 of a draw can be shadowed.
+fn visibility(i: u32, s: Surface, l: vec3<f32>, light: LightData) -> f32 {
+    if i != 0u {
+        return 1.0;
+    }
+    return shadow_visibility(s, l, light);
+}
+
 fn finish(radiance: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(min(max(radiance, vec3<f32>(0.0)), vec3<f32>(FP16_SAFE_MAX)), 1.0);
 }
@@ -228,7 +318,7 @@ fn fs_pbr(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     var radiance = s.base_color * (1.0 - s.metallic) * u.ambient.rgb;
     for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
         let light = incoming(u.lights[i], s);
-        radiance += pbr_brdf_times_cosine(s, v, light.direction) * light.radiance;
+        radiance += pbr_brdf_times_cosine(s, v, light.direction) * light.radiance * visibility(i, s, light.direction, u.lights[i]);
     }
     return finish(radiance);
 }
@@ -244,7 +334,7 @@ fn fs_blinn_phong(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> 
     var radiance = s.base_color * u.ambient.rgb;
     for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
         let light = incoming(u.lights[i], s);
-        radiance += blinn_phong_times_cosine(s, v, light.direction) * light.radiance;
+        radiance += blinn_phong_times_cosine(s, v, light.direction) * light.radiance * visibility(i, s, light.direction, u.lights[i]);
     }
     return finish(radiance);
 }
@@ -259,7 +349,7 @@ fn fs_lambert(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     var radiance = s.base_color * u.ambient.rgb;
     for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
         let light = incoming(u.lights[i], s);
-        radiance += s.base_color * (max(dot(s.normal, light.direction), 0.0) / PI) * light.radiance;
+        radiance += s.base_color * (max(dot(s.normal, light.direction), 0.0) / PI) * light.radiance * visibility(i, s, light.direction, u.lights[i]);
     }
     return finish(radiance);
 }
@@ -274,7 +364,7 @@ fn fs_toon(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     var radiance = s.base_color * u.ambient.rgb;
     for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
         let light = incoming(u.lights[i], s);
-        radiance += toon_times_cosine(s, light.direction) * light.radiance;
+        radiance += toon_times_cosine(s, light.direction) * light.radiance * visibility(i, s, light.direction, u.lights[i]);
     }
     return finish(radiance);
 }

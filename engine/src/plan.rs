@@ -9,7 +9,7 @@
 use std::fmt;
 
 use crate::backend::TextureFormat;
-use crate::scene::{LightingModel, Scene};
+use crate::scene::{Light, LightingModel, Scene};
 
 /// Lights handled by one lighting draw (the size of the uniform array in `lighting.wgsl`).
 pub const MAX_LIGHTS_PER_DRAW: usize = 16;
@@ -21,6 +21,10 @@ pub struct TargetSpec {
     pub name: String,
     /// Texel format.
     pub format: TextureFormat,
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
     /// What the channels hold.
     pub contents: String,
 }
@@ -28,6 +32,12 @@ pub struct TargetSpec {
 /// What a pass does.
 #[derive(Clone, Debug, PartialEq)]
 pub enum PassKind {
+    /// Draws the shadow casters into the depth map of light `light` (all six faces of a point
+    /// light's atlas in one pass, one viewport per face).
+    Shadow {
+        /// Index into the scene's lights.
+        light: usize,
+    },
     /// Draws every object into the G-buffer and depth.
     Geometry,
     /// Draws every object's one-hot lighting-model channel into the mask targets.
@@ -101,6 +111,11 @@ pub const LIGHT: &str = "light";
 /// Name of the tone-mapped output.
 pub const FINAL: &str = "final";
 
+/// Name of the shadow map of light `index`.
+pub fn shadow_target_name(index: usize) -> String {
+    format!("shadow_{index}")
+}
+
 /// Name of mask target `index`.
 pub fn mask_target_name(index: usize) -> String {
     if index == 0 {
@@ -137,12 +152,16 @@ impl RenderPlan {
             .map(|(name, contents)| TargetSpec {
                 name: (*name).to_owned(),
                 format: TextureFormat::Rgba16Float,
+                width: scene.quality.width,
+                height: scene.quality.height,
                 contents: contents.to_owned(),
             })
             .collect();
         targets.push(TargetSpec {
             name: DEPTH.to_owned(),
             format: TextureFormat::Depth32Float,
+            width: scene.quality.width,
+            height: scene.quality.height,
             contents: "depth, 0 near .. 1 far".to_owned(),
         });
         for index in 0..mask_targets {
@@ -154,23 +173,67 @@ impl RenderPlan {
             targets.push(TargetSpec {
                 name: mask_target_name(index),
                 format: TextureFormat::Rgba8Unorm,
+                width: scene.quality.width,
+                height: scene.quality.height,
                 contents: channels.join(", "),
             });
         }
         targets.push(TargetSpec {
             name: LIGHT.to_owned(),
             format: TextureFormat::Rgba16Float,
+            width: scene.quality.width,
+            height: scene.quality.height,
             contents: format!("exposed radiance (exposure {})", scene.quality.exposure),
         });
         targets.push(TargetSpec {
             name: FINAL.to_owned(),
             format: TextureFormat::Rgba8UnormSrgb,
+            width: scene.quality.width,
+            height: scene.quality.height,
             contents: format!("{} tone-mapped, sRGB", scene.quality.tone_map.name()),
         });
+        let casters = scene.objects.iter().filter(|o| o.casts_shadows).count();
+        let mut shadow_passes = Vec::new();
+        for (index, light) in scene.lights.iter().enumerate() {
+            let (settings, point) = match light {
+                Light::Directional { shadow, .. } => (shadow, false),
+                Light::Point { shadow, .. } => (shadow, true),
+            };
+            let Some(settings) = settings.filter(|_| casters > 0) else {
+                continue;
+            };
+            let n = settings.map_size;
+            let name = shadow_target_name(index);
+            targets.push(TargetSpec {
+                name: name.clone(),
+                format: TextureFormat::Depth32Float,
+                width: if point { 3 * n } else { n },
+                height: if point { 2 * n } else { n },
+                contents: if point {
+                    format!("point light {index}: six {n}x{n} faces (+X -X +Y / -Y +Z -Z), perspective depth")
+                } else {
+                    format!("directional light {index}: orthographic depth fitted to the casters")
+                },
+            });
+            shadow_passes.push(PassSpec {
+                name: name.clone(),
+                kind: PassKind::Shadow { light: index },
+                reads: vec![],
+                writes: vec![name],
+                detail: format!(
+                    "{casters} casters{}, filter {}, bias {} m, slope {} texels, normal offset {} texels",
+                    if point { " x 6 faces" } else { "" },
+                    settings.filter.name(),
+                    settings.bias,
+                    settings.slope_bias,
+                    settings.normal_offset
+                ),
+            });
+        }
 
         let masks: Vec<String> = (0..mask_targets).map(mask_target_name).collect();
         let gbuffer: Vec<String> = GBUFFER_TARGETS.iter().map(|s| (*s).to_owned()).collect();
-        let mut passes = Vec::new();
+        let mut passes = shadow_passes;
         let objects = scene.objects.len();
         let triangles: usize = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
         passes.push(PassSpec {
@@ -210,10 +273,17 @@ impl RenderPlan {
                 ),
             });
         }
-        let batches = scene.lights.len().div_ceil(MAX_LIGHTS_PER_DRAW).max(1);
+        let shadow_maps: Vec<String> = targets
+            .iter()
+            .filter(|t| t.name.starts_with("shadow_"))
+            .map(|t| t.name.clone())
+            .collect();
         for channel in &mask_channels {
             let mut reads = gbuffer.clone();
             reads.push(mask_target_name(channel.target));
+            if channel.model != LightingModel::Unlit {
+                reads.extend(shadow_maps.iter().cloned());
+            }
             passes.push(PassSpec {
                 name: format!("lighting_{}", channel.model.name().replace('-', "_")),
                 kind: PassKind::Lighting(channel.model),
@@ -223,8 +293,9 @@ impl RenderPlan {
                     "1 draw, no lights".to_owned()
                 } else {
                     format!(
-                        "{} light(s) in {batches} draw(s), additive",
-                        scene.lights.len()
+                        "{} light(s) in {} draw(s), additive",
+                        scene.lights.len(),
+                        batches_with_shadows(scene, casters > 0)
                     )
                 },
             });
@@ -266,6 +337,18 @@ impl RenderPlan {
     }
 }
 
+/// Lighting draws per model: each shadowed light gets its own draw (its shadow map bound), the
+/// other lights go 16 to a draw; at least one draw (ambient).
+pub fn batches_with_shadows(scene: &Scene, any_casters: bool) -> usize {
+    let shadowed = scene
+        .lights
+        .iter()
+        .filter(|l| any_casters && l.casts_shadows())
+        .count();
+    let plain = scene.lights.len() - shadowed;
+    (shadowed + plain.div_ceil(MAX_LIGHTS_PER_DRAW)).max(1)
+}
+
 fn format_name(format: TextureFormat) -> &'static str {
     match format {
         TextureFormat::Rgba8Unorm => "rgba8",
@@ -284,9 +367,10 @@ impl fmt::Display for RenderPlan {
         for t in &self.targets {
             writeln!(
                 f,
-                "  {:<17} {:<10} {}",
+                "  {:<17} {:<10} {:<9} {}",
                 t.name,
                 format_name(t.format),
+                format!("{}x{}", t.width, t.height),
                 t.contents
             )?;
         }

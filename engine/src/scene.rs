@@ -246,23 +246,53 @@ pub struct Object {
     pub casts_shadows: bool,
 }
 
-/// Shadow-map settings of a light.
+/// How a shadow map is filtered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShadowFilter {
+    /// One depth comparison (hard shadows).
+    Hard,
+    /// 3x3 percentage-closer filtering (nine comparisons, one texel apart).
+    Pcf3,
+}
+
+impl ShadowFilter {
+    /// Name in scene files and plans.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadowFilter::Hard => "hard",
+            ShadowFilter::Pcf3 => "pcf3",
+        }
+    }
+}
+
+/// Shadow-map settings of a light. Biases are in world units (meters), so they mean the same
+/// for every map size and light type.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShadowSettings {
     /// Shadow map size in texels (square; per cube face for point lights).
     pub map_size: u32,
-    /// Constant depth bias.
+    /// Constant bias: the receiver is moved this far towards the light before comparing.
     pub bias: f32,
-    /// Slope-scaled bias.
+    /// Slope-scaled bias in shadow-map texels: adds `slope_bias * texel * tan(angle between
+    /// normal and light)` meters (tan clamped to 10), doubled for 3x3 PCF, whose outer taps
+    /// reach one texel further; grazing surfaces get more.
     pub slope_bias: f32,
+    /// Normal offset in shadow-map texels: the receiver is moved along its normal by this many
+    /// texel widths (at its distance) before projecting.
+    pub normal_offset: f32,
+    /// Filter.
+    pub filter: ShadowFilter,
 }
 
 impl Default for ShadowSettings {
     fn default() -> Self {
         Self {
             map_size: 1024,
-            bias: 0.002,
-            slope_bias: 2.0,
+            bias: 0.0005,
+            slope_bias: 1.0,
+            normal_offset: 1.0,
+            filter: ShadowFilter::Pcf3,
         }
     }
 }

@@ -211,8 +211,12 @@ pub struct ShadowSpec {
     pub map_size: Option<u32>,
     /// Constant bias.
     pub bias: Option<f32>,
-    /// Slope-scaled bias.
+    /// Slope-scaled bias (texels, scaled by tan(angle)).
     pub slope_bias: Option<f32>,
+    /// Normal offset in shadow-map texels.
+    pub normal_offset: Option<f32>,
+    /// `hard` or `pcf3` (default).
+    pub filter: Option<ShadowFilter>,
 }
 
 /// `[[lights]]`.
@@ -589,6 +593,8 @@ impl Resolver {
                         map_size: s.map_size.unwrap_or(d.map_size),
                         bias: s.bias.unwrap_or(d.bias),
                         slope_bias: s.slope_bias.unwrap_or(d.slope_bias),
+                        normal_offset: s.normal_offset.unwrap_or(d.normal_offset),
+                        filter: s.filter.unwrap_or(d.filter),
                     }
                 })
             };
@@ -623,9 +629,13 @@ impl Resolver {
             if let Some(s) = match &light {
                 Light::Directional { shadow, .. } | Light::Point { shadow, .. } => shadow,
             } {
-                if !(64..=8192).contains(&s.map_size) || !s.bias.is_finite() {
+                let biases = [s.bias, s.slope_bias, s.normal_offset];
+                if !(64..=8192).contains(&s.map_size)
+                    || !biases.iter().all(|b| b.is_finite() && *b >= 0.0)
+                {
                     return Err(self.invalid(format!(
-                        "light {index}: shadow map_size must be 64..8192 and bias finite"
+                        "light {index}: shadow map_size must be 64..8192 and biases finite and \
+                         non-negative"
                     )));
                 }
             }

@@ -41,6 +41,8 @@ pub const LIGHTING: ShaderSource = shader!("lighting.wgsl");
 pub const SKYBOX: ShaderSource = shader!("skybox.wgsl");
 /// Deferred renderer: HDR light buffer to the sRGB final image.
 pub const TONEMAP: ShaderSource = shader!("tonemap.wgsl");
+/// Deferred renderer: depth-only shadow-map pass.
+pub const SHADOW: ShaderSource = shader!("shadow.wgsl");
 /// Deferred renderer: axes and light markers over the final image.
 pub const GIZMO: ShaderSource = shader!("gizmo.wgsl");
 
@@ -54,6 +56,7 @@ pub const ALL: &[ShaderSource] = &[
     SKYBOX,
     TONEMAP,
     GIZMO,
+    SHADOW,
 ];
 
 /// A shader that failed to parse, validate or translate.

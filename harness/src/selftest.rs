@@ -24,7 +24,7 @@ pub enum Mutation {
     Roughness,
     /// Camera turned 0.25 degrees about its up axis.
     CameraYaw,
-    /// Every shadow's bias x4.
+    /// Every shadow's constant and slope-scaled bias x4.
     ShadowBias,
     /// Environment rotated 2 degrees.
     EnvironmentRotation,
@@ -92,6 +92,7 @@ impl Mutation {
                         Light::Directional { shadow, .. } | Light::Point { shadow, .. } => {
                             if let Some(shadow) = shadow {
                                 shadow.bias *= 4.0;
+                                shadow.slope_bias *= 4.0;
                                 any = true;
                             }
                         }
@@ -196,50 +197,86 @@ fn failed_passes(
         .collect())
 }
 
-/// Runs the self-test: unmodified renders on `backends`, mutations on `mutation_backend`.
+/// Runs the self-test: unmodified renders on `backends`, mutations on `mutation_backend`. Scenes
+/// run in parallel, one thread each (each with its own backends).
 pub fn run(
     cases: &[Case],
     store: &GoldenStore,
     backends: &[BackendKind],
     mutation_backend: BackendKind,
 ) -> SelfTest {
+    let per_case: Vec<SelfTest> = std::thread::scope(|scope| {
+        let handles: Vec<_> = cases
+            .iter()
+            .map(|case| scope.spawn(move || run_case(case, store, backends, mutation_backend)))
+            .collect();
+        handles
+            .into_iter()
+            .zip(cases)
+            .map(|(handle, case)| {
+                handle.join().unwrap_or_else(|_| SelfTest {
+                    false_alarms: vec![(
+                        case.name().to_owned(),
+                        "-".to_owned(),
+                        "self-test thread panicked".to_owned(),
+                    )],
+                    detections: vec![],
+                })
+            })
+            .collect()
+    });
+    let mut result = SelfTest {
+        false_alarms: vec![],
+        detections: vec![],
+    };
+    for part in per_case {
+        result.false_alarms.extend(part.false_alarms);
+        result.detections.extend(part.detections);
+    }
+    result
+}
+
+fn run_case(
+    case: &Case,
+    store: &GoldenStore,
+    backends: &[BackendKind],
+    mutation_backend: BackendKind,
+) -> SelfTest {
     let mut false_alarms = Vec::new();
     let mut detections = Vec::new();
-    for case in cases {
-        let scene = &case.loaded.scene;
-        for &kind in backends {
-            match failed_passes(store, case, kind, scene, &Faults::default()) {
-                Ok(failed) => false_alarms.extend(
-                    failed
-                        .into_iter()
-                        .map(|p| (case.name().to_owned(), kind.name().to_owned(), p)),
-                ),
-                Err(e) => false_alarms.push((case.name().to_owned(), kind.name().to_owned(), e)),
-            }
+    let scene = &case.loaded.scene;
+    for &kind in backends {
+        match failed_passes(store, case, kind, scene, &Faults::default()) {
+            Ok(failed) => false_alarms.extend(
+                failed
+                    .into_iter()
+                    .map(|p| (case.name().to_owned(), kind.name().to_owned(), p)),
+            ),
+            Err(e) => false_alarms.push((case.name().to_owned(), kind.name().to_owned(), e)),
         }
-        for mutation in Mutation::ALL {
-            let failed = match mutation.apply(scene) {
-                None => None,
-                Some((mutated, faults)) => {
-                    match failed_passes(store, case, mutation_backend, &mutated, &faults) {
-                        Ok(failed) => Some(failed),
-                        Err(e) => {
-                            false_alarms.push((
-                                case.name().to_owned(),
-                                mutation_backend.name().to_owned(),
-                                format!("render of mutation `{}` failed: {e}", mutation.describe()),
-                            ));
-                            Some(Vec::new())
-                        }
+    }
+    for mutation in Mutation::ALL {
+        let failed = match mutation.apply(scene) {
+            None => None,
+            Some((mutated, faults)) => {
+                match failed_passes(store, case, mutation_backend, &mutated, &faults) {
+                    Ok(failed) => Some(failed),
+                    Err(e) => {
+                        false_alarms.push((
+                            case.name().to_owned(),
+                            mutation_backend.name().to_owned(),
+                            format!("render of mutation `{}` failed: {e}", mutation.describe()),
+                        ));
+                        Some(Vec::new())
                     }
                 }
-            };
-            detections.push(Detection {
-                scene: case.name().to_owned(),
-                mutation,
-                failed_passes: failed,
-            });
-        }
+            }
+        };
+        detections.push(Detection {
+            scene: case.name().to_owned(),
+            mutation,
+            failed_passes: failed,
+        });
     }
     SelfTest {
         false_alarms,

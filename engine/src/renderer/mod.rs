@@ -10,6 +10,7 @@
 //! camera-relative positions, so a scene 10 km from the origin renders like one at the origin.
 
 mod gizmos;
+pub mod shadows;
 mod uniforms;
 
 use std::collections::{BTreeMap, HashMap};
@@ -417,12 +418,11 @@ fn record_and_submit(
     faults: &Faults,
     scope: &mut ResourceScope,
 ) -> Result<Outputs, RenderError> {
-    let (width, height) = (plan.width, plan.height);
     let mut targets: HashMap<String, Handle<Texture>> = HashMap::new();
     for spec in &plan.targets {
         let handle = scope.texture(
             backend,
-            &TextureDesc::d2(&spec.name, width, height, spec.format),
+            &TextureDesc::d2(&spec.name, spec.width, spec.height, spec.format),
         )?;
         targets.insert(spec.name.clone(), handle);
     }
@@ -520,6 +520,18 @@ fn record_and_submit(
         .collect();
 
     let mut passes = Vec::new();
+
+    // Shadow maps.
+    let views = shadows::shadow_views(scene);
+    shadows::record(
+        backend,
+        scope,
+        scene,
+        &views,
+        &|name| targets[name],
+        &|object| (&meshes[&Arc::as_ptr(&object.mesh)]).into(),
+        &mut passes,
+    )?;
 
     // Geometry and shader-mask passes.
     let gbuffer_shader = shader(scope, backend, shaders::GBUFFER)?;
@@ -781,7 +793,70 @@ fn record_and_submit(
     let lighting_shader = shader(scope, backend, shaders::LIGHTING)?;
     let mut lighting_bindings = vec![uniform_layout()];
     lighting_bindings.extend((1..=6).map(texture_layout));
+    lighting_bindings.extend([
+        BindingLayout {
+            binding: 7,
+            kind: BindingKind::Texture {
+                sample_type: TextureSampleType::Depth,
+                view: TextureViewKind::D2,
+            },
+        },
+        BindingLayout {
+            binding: 8,
+            kind: BindingKind::Sampler(SamplerBindingKind::Comparison),
+        },
+        BindingLayout {
+            binding: 9,
+            kind: BindingKind::UniformBuffer,
+        },
+    ]);
     let lights = light_uniforms(scene);
+    let shadow_sampler = scope.sampler(
+        backend,
+        &SamplerDesc {
+            compare: Some(CompareFunction::LessEqual),
+            ..SamplerDesc::nearest("shadow compare")
+        },
+    )?;
+    let no_shadow_map = scope.texture(
+        backend,
+        &TextureDesc::d2("no shadow", 1, 1, TextureFormat::Depth32Float),
+    )?;
+    let no_shadow_uniform = scope.buffer(
+        backend,
+        "no shadow uniforms",
+        BufferUsage::Uniform,
+        bytemuck::cast_slice(&shadows::shadow_uniforms(None)),
+    )?;
+    // Lighting draws: unshadowed lights 16 to a draw, then one draw per shadowed light.
+    let mut shadowed_draws = Vec::new();
+    for view in &views {
+        let uniform = scope.buffer(
+            backend,
+            &format!("shadow uniforms light {}", view.light),
+            BufferUsage::Uniform,
+            bytemuck::cast_slice(&shadows::shadow_uniforms(Some(view))),
+        )?;
+        shadowed_draws.push((
+            vec![lights[view.light]],
+            targets[&plan::shadow_target_name(view.light)],
+            uniform,
+        ));
+    }
+    let plain: Vec<uniforms::LightData> = lights
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !views.iter().any(|v| v.light == *i))
+        .map(|(_, l)| *l)
+        .collect();
+    let mut light_draws: Vec<(Vec<uniforms::LightData>, Handle<Texture>, Handle<Buffer>)> = plain
+        .chunks(MAX_LIGHTS_PER_DRAW)
+        .map(|c| (c.to_vec(), no_shadow_map, no_shadow_uniform))
+        .collect();
+    light_draws.extend(shadowed_draws);
+    if light_draws.is_empty() {
+        light_draws.push((vec![], no_shadow_map, no_shadow_uniform));
+    }
     for channel in &plan.mask_channels {
         let model = channel.model;
         let pipeline = scope.pipeline(
@@ -795,14 +870,14 @@ fn record_and_submit(
                 Some(BlendState::ADDITIVE),
             ),
         )?;
-        let batches: Vec<&[uniforms::LightData]> =
-            if model == LightingModel::Unlit || lights.is_empty() {
-                vec![&[]]
-            } else {
-                lights.chunks(MAX_LIGHTS_PER_DRAW).collect()
-            };
+        let unlit_draw = [(vec![], no_shadow_map, no_shadow_uniform)];
+        let batches = if model == LightingModel::Unlit {
+            &unlit_draw[..]
+        } else {
+            &light_draws[..]
+        };
         let mut draws = Vec::new();
-        for (index, batch) in batches.iter().enumerate() {
+        for (index, (batch, shadow_map, shadow_uniform)) in batches.iter().enumerate() {
             let data = uniforms::lighting_uniforms(scene, *channel, batch, index == 0);
             let uniform = scope.buffer(
                 backend,
@@ -821,6 +896,9 @@ fn record_and_submit(
                 6,
                 BindingResource::Texture(mask_targets[channel.target]),
             ));
+            bindings.push(binding(7, BindingResource::Texture(*shadow_map)));
+            bindings.push(binding(8, BindingResource::Sampler(shadow_sampler)));
+            bindings.push(binding(9, BindingResource::Buffer(*shadow_uniform)));
             draws.push(fullscreen_draw(pipeline, bindings));
         }
         let load = if light_cleared {

@@ -1,0 +1,306 @@
+//! Shadow maps: light-space matrices (directional: orthographic, fitted to the shadow casters'
+//! bounds; point: six 90-degree faces in a 3x2 atlas), the depth-only passes that fill them, and
+//! the uniform block the lighting pass samples them with.
+//!
+//! Everything is camera-relative and computed in f64, like the rest of the renderer.
+
+use glam::{DMat4, DVec3, Mat4};
+
+use crate::backend::*;
+use crate::plan;
+use crate::scene::{Light, Scene, ShadowFilter, ShadowSettings};
+use crate::shaders;
+
+use super::GpuMesh;
+
+/// A light's shadow-map views.
+#[derive(Clone, Debug)]
+pub struct ShadowView {
+    /// Index of the light.
+    pub light: usize,
+    /// Camera-relative world to light clip space: one (directional) or six (point) matrices.
+    pub faces: Vec<DMat4>,
+    /// Point light (atlas of six faces) or directional.
+    pub point: bool,
+    /// Face size in texels.
+    pub size: u32,
+    /// Texel size in meters (directional) or in meters per meter of distance (point).
+    pub texel_world: f64,
+    /// The light's settings.
+    pub settings: ShadowSettings,
+}
+
+/// Cube faces in atlas order: +X, -X, +Y, -Y, +Z, -Z (direction, up).
+const FACES: [(DVec3, DVec3); 6] = [
+    (DVec3::X, DVec3::NEG_Y),
+    (DVec3::NEG_X, DVec3::NEG_Y),
+    (DVec3::Y, DVec3::Z),
+    (DVec3::NEG_Y, DVec3::NEG_Z),
+    (DVec3::Z, DVec3::NEG_Y),
+    (DVec3::NEG_Z, DVec3::NEG_Y),
+];
+
+/// Camera-relative corners of every shadow caster's bounds.
+fn caster_corners(scene: &Scene) -> Vec<DVec3> {
+    let mut corners = Vec::new();
+    for object in scene.objects.iter().filter(|o| o.casts_shadows) {
+        let m = object.transform.relative_to(scene.camera.position);
+        let (lo, hi) = (object.mesh.bounds.min, object.mesh.bounds.max);
+        for i in 0..8 {
+            let pick = |axis: usize| {
+                if i & (1 << axis) == 0 {
+                    f64::from(lo[axis])
+                } else {
+                    f64::from(hi[axis])
+                }
+            };
+            corners.push(m.transform_point3(DVec3::new(pick(0), pick(1), pick(2))));
+        }
+    }
+    corners
+}
+
+/// The shadow views of every light that casts shadows (when some object casts them).
+pub fn shadow_views(scene: &Scene) -> Vec<ShadowView> {
+    let corners = caster_corners(scene);
+    if corners.is_empty() {
+        return Vec::new();
+    }
+    let mut views = Vec::new();
+    for (index, light) in scene.lights.iter().enumerate() {
+        match light {
+            Light::Directional {
+                direction,
+                shadow: Some(settings),
+                ..
+            } => {
+                let (lo, hi) = corners.iter().fold(
+                    (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+                    |(lo, hi), c| (lo.min(*c), hi.max(*c)),
+                );
+                let center = (lo + hi) / 2.0;
+                let radius = ((hi - lo).length() / 2.0).max(1e-3);
+                let dir = direction.normalize();
+                let up = if dir.y.abs() > 0.99 {
+                    DVec3::Z
+                } else {
+                    DVec3::Y
+                };
+                let view = DMat4::look_at_rh(center + dir * radius * 2.0, center, up);
+                let (vlo, vhi) = corners.iter().fold(
+                    (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
+                    |(lo, hi), c| {
+                        let v = view.transform_point3(*c);
+                        (lo.min(v), hi.max(v))
+                    },
+                );
+                // A margin of one texel keeps casters' edges off the map border.
+                let size = f64::from(settings.map_size);
+                let margin = (vhi.x - vlo.x).max(vhi.y - vlo.y) / size;
+                let (left, right) = (vlo.x - margin, vhi.x + margin);
+                let (bottom, top) = (vlo.y - margin, vhi.y + margin);
+                let near = (-vhi.z - radius * 0.01).max(1e-4);
+                let far = -vlo.z + radius * 0.01;
+                let projection = DMat4::orthographic_rh(left, right, bottom, top, near, far);
+                views.push(ShadowView {
+                    light: index,
+                    faces: vec![projection * view],
+                    point: false,
+                    size: settings.map_size,
+                    texel_world: (right - left).max(top - bottom) / size,
+                    settings: *settings,
+                });
+            }
+            Light::Point {
+                position,
+                radius,
+                shadow: Some(settings),
+                ..
+            } => {
+                let eye = *position - scene.camera.position;
+                let far = f64::from(*radius);
+                let near = (far * 1e-2).min(far * 0.5);
+                let projection = DMat4::perspective_rh(std::f64::consts::FRAC_PI_2, 1.0, near, far);
+                let faces = FACES
+                    .iter()
+                    .map(|(dir, up)| projection * DMat4::look_at_rh(eye, eye + *dir, *up))
+                    .collect();
+                views.push(ShadowView {
+                    light: index,
+                    faces,
+                    point: true,
+                    size: settings.map_size,
+                    texel_world: 2.0 / f64::from(settings.map_size),
+                    settings: *settings,
+                });
+            }
+            _ => {}
+        }
+    }
+    views
+}
+
+/// `ShadowUniforms` of `lighting.wgsl` for a view (or the "no shadow" block), as floats.
+pub fn shadow_uniforms(view: Option<&ShadowView>) -> Vec<f32> {
+    let mut data = Vec::with_capacity(6 * 16 + 8);
+    let Some(view) = view else {
+        data.resize(6 * 16 + 8, 0.0);
+        return data;
+    };
+    for face in 0..6 {
+        let m = view.faces.get(face).unwrap_or(&view.faces[0]).as_mat4();
+        data.extend_from_slice(&m.to_cols_array());
+    }
+    let s = &view.settings;
+    data.extend_from_slice(&[
+        if view.point { 2.0 } else { 1.0 },
+        s.bias,
+        s.slope_bias,
+        s.normal_offset,
+    ]);
+    let (w, h) = if view.point {
+        (3 * view.size, 2 * view.size)
+    } else {
+        (view.size, view.size)
+    };
+    data.extend_from_slice(&[
+        match s.filter {
+            ShadowFilter::Hard => 0.0,
+            ShadowFilter::Pcf3 => 1.0,
+        },
+        1.0 / w as f32,
+        1.0 / h as f32,
+        view.texel_world as f32,
+    ]);
+    data
+}
+
+/// Records the shadow passes of every view into `passes`.
+pub(super) fn record(
+    backend: &mut dyn Backend,
+    scope: &mut ResourceScope,
+    scene: &Scene,
+    views: &[ShadowView],
+    targets: &dyn Fn(&str) -> Handle<Texture>,
+    meshes: &dyn Fn(&crate::scene::Object) -> GpuMeshRef,
+    passes: &mut Vec<RenderPass>,
+) -> Result<()> {
+    if views.is_empty() {
+        return Ok(());
+    }
+    let shader = scope.shader(
+        backend,
+        &ShaderDesc {
+            name: shaders::SHADOW.name.to_owned(),
+            wgsl: shaders::SHADOW.wgsl.to_owned(),
+        },
+    )?;
+    let pipeline = scope.pipeline(
+        backend,
+        &PipelineDesc {
+            label: "shadow".to_owned(),
+            shader,
+            vertex_entry: "vs_shadow".to_owned(),
+            fragment_entry: None,
+            vertex_buffers: vec![VertexBufferLayout {
+                stride: std::mem::size_of::<crate::mesh::Vertex>() as u32,
+                attributes: vec![VertexAttribute {
+                    location: 0,
+                    format: VertexFormat::Float32x3,
+                    offset: 0,
+                }],
+            }],
+            bindings: vec![BindingLayout {
+                binding: 0,
+                kind: BindingKind::UniformBuffer,
+            }],
+            color_targets: vec![],
+            depth: Some(DepthState {
+                format: TextureFormat::Depth32Float,
+                write: true,
+                compare: CompareFunction::Less,
+            }),
+            topology: Topology::TriangleList,
+            cull: CullMode::None,
+        },
+    )?;
+    const FACE_NAMES: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
+    for view in views {
+        let name = plan::shadow_target_name(view.light);
+        let texture = targets(&name);
+        for (face, matrix) in view.faces.iter().enumerate() {
+            let mut draws = Vec::new();
+            for object in scene.objects.iter().filter(|o| o.casts_shadows) {
+                let model = object.transform.relative_to(scene.camera.position);
+                let mvp: Mat4 = (*matrix * model).as_mat4();
+                let uniform = scope.buffer(
+                    backend,
+                    &format!("{name} {} face {face}", object.name),
+                    BufferUsage::Uniform,
+                    bytemuck::cast_slice(&mvp.to_cols_array()),
+                )?;
+                let mesh = meshes(object);
+                draws.push(Draw {
+                    pipeline,
+                    bindings: vec![Binding {
+                        binding: 0,
+                        resource: BindingResource::Buffer(uniform),
+                    }],
+                    vertex_buffers: vec![mesh.vertices],
+                    index_buffer: Some((mesh.indices, IndexFormat::U32)),
+                    count: mesh.count,
+                });
+            }
+            let (x, y) = if view.point {
+                ((face % 3) as u32 * view.size, (face / 3) as u32 * view.size)
+            } else {
+                (0, 0)
+            };
+            passes.push(RenderPass {
+                name: if view.point {
+                    format!("{name}{}", FACE_NAMES[face])
+                } else {
+                    name.clone()
+                },
+                color_attachments: vec![],
+                depth_attachment: Some(DepthAttachment {
+                    texture,
+                    subresource: Subresource::default(),
+                    load: if face == 0 {
+                        LoadOp::Clear(1.0)
+                    } else {
+                        LoadOp::Load
+                    },
+                }),
+                viewport: Some(Viewport {
+                    x: x as f32,
+                    y: y as f32,
+                    width: view.size as f32,
+                    height: view.size as f32,
+                    min_depth: 0.0,
+                    max_depth: 1.0,
+                }),
+                draws,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Buffers of an uploaded mesh.
+#[derive(Clone, Copy)]
+pub(super) struct GpuMeshRef {
+    pub vertices: Handle<Buffer>,
+    pub indices: Handle<Buffer>,
+    pub count: u32,
+}
+
+impl From<&GpuMesh> for GpuMeshRef {
+    fn from(m: &GpuMesh) -> Self {
+        Self {
+            vertices: m.vertices,
+            indices: m.indices,
+            count: m.count,
+        }
+    }
+}

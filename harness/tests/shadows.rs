@@ -1,0 +1,134 @@
+//! Shadow maps: no acne on an open plane at any sun elevation, for every filter and both light
+//! types, on every available backend.
+
+mod common;
+
+use std::sync::Arc;
+
+use engine::mesh;
+use engine::renderer::{self, Readback};
+use engine::scene::*;
+use glam::DVec3;
+
+/// A 4 m ground plane (the only shadow caster, so nothing can occlude it) under one light.
+fn plane_scene(light: Light) -> Scene {
+    Scene {
+        name: "acne".to_owned(),
+        camera: Camera {
+            position: DVec3::new(0.0, 2.5, 3.0),
+            target: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_degrees: 50.0,
+            near: 0.05,
+            far: 50.0,
+        },
+        objects: vec![Object {
+            name: "ground".to_owned(),
+            mesh: Arc::new(mesh::plane(4.0, 4.0)),
+            transform: Transform::default(),
+            material: Material::default(),
+            lighting: LightingModel::Pbr,
+            casts_shadows: true,
+        }],
+        lights: vec![light],
+        ambient: [0.0; 3],
+        environment: None,
+        textures: vec![],
+        quality: Quality {
+            width: 256,
+            height: 256,
+            ..Quality::default()
+        },
+    }
+}
+
+fn without_shadow(light: &Light) -> Light {
+    let mut light = light.clone();
+    match &mut light {
+        Light::Directional { shadow, .. } | Light::Point { shadow, .. } => *shadow = None,
+    }
+    light
+}
+
+/// The fraction of covered pixels whose light-buffer value is unchanged by the shadow map (shadow
+/// term exactly 1).
+fn fully_lit_fraction(backend: &mut dyn engine::Backend, light: Light) -> f64 {
+    let mut render = |light: Light| {
+        renderer::render(
+            backend,
+            &plane_scene(light),
+            Readback::Only(&["light", "mask"]),
+        )
+        .unwrap()
+    };
+    let shadowed = render(light.clone());
+    let plain = render(without_shadow(&light));
+    assert!(shadowed.plan.target("shadow_0").is_some());
+    let mask = plain.outputs["mask"].as_u8().unwrap();
+    let a = shadowed.outputs["light"].as_f32().unwrap();
+    let b = plain.outputs["light"].as_f32().unwrap();
+    let (mut covered, mut same) = (0usize, 0usize);
+    for i in 0..mask.len() / 4 {
+        if mask[i * 4] == 0 {
+            continue;
+        }
+        covered += 1;
+        if a[i * 4..i * 4 + 3] == b[i * 4..i * 4 + 3] {
+            same += 1;
+        }
+    }
+    assert!(covered > 10_000, "plane covers only {covered} pixels");
+    same as f64 / covered as f64
+}
+
+#[test]
+fn open_plane_has_no_shadow_acne() {
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        for filter in [ShadowFilter::Hard, ShadowFilter::Pcf3] {
+            let shadow = Some(ShadowSettings {
+                filter,
+                ..ShadowSettings::default()
+            });
+            for elevation in [5.0f64, 15.0, 45.0, 90.0] {
+                let e = elevation.to_radians();
+                let azimuth = 0.6f64;
+                let direction =
+                    DVec3::new(e.cos() * azimuth.cos(), e.sin(), e.cos() * azimuth.sin());
+                let fraction = fully_lit_fraction(
+                    backend.as_mut(),
+                    Light::Directional {
+                        direction,
+                        color: [1.0; 3],
+                        intensity: 3.0,
+                        shadow,
+                    },
+                );
+                eprintln!("{kind} {filter:?} directional {elevation} deg: {fraction:.6} fully lit");
+                assert!(
+                    fraction >= 0.9999,
+                    "{kind}: {filter:?} directional light at {elevation} deg: only {:.4}% fully lit",
+                    fraction * 100.0
+                );
+                let height = 1.5 * e.sin().max(0.05);
+                let fraction = fully_lit_fraction(
+                    backend.as_mut(),
+                    Light::Point {
+                        position: DVec3::new(0.3, height, 0.2),
+                        color: [1.0; 3],
+                        intensity: 3.0,
+                        radius: 6.0,
+                        falloff: 1.0,
+                        shadow,
+                    },
+                );
+                eprintln!("{kind} {filter:?} point at height {height:.3}: {fraction:.6} fully lit");
+                assert!(
+                    fraction >= 0.9999,
+                    "{kind}: {filter:?} point light at height {height:.3}: only {:.4}% fully lit",
+                    fraction * 100.0
+                );
+            }
+        }
+    }
+}
