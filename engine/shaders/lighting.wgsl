@@ -89,11 +89,12 @@ fn shadow_visibility(s: Surface, l: vec3<f32>, light: LightData) -> f32 {
     if kind > 1.5 {
         texel = shadow.map.w * length(light.position.xyz - s.position);
     }
-    // Slope-scaled part in texels, times the filter's reach (PCF reads one texel further out).
+    // Slope-scaled and normal-offset parts are in texels, times the filter's reach (3x3 PCF
+    // reads one texel further out than a single tap).
     let reach = select(1.0, 2.0, shadow.map.x > 0.5);
     let bias = shadow.params.y + shadow.params.z * texel * tan_theta * reach;
     if kind < 1.5 {
-        let p = s.position + s.normal * (shadow.params.w * texel) + l * bias;
+        let p = s.position + s.normal * (shadow.params.w * texel * reach) + l * bias;
         let clip = shadow.faces[0] * vec4<f32>(p, 1.0);
         let ndc = clip.xyz / clip.w;
         let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
@@ -103,7 +104,7 @@ fn shadow_visibility(s: Surface, l: vec3<f32>, light: LightData) -> f32 {
         // Receivers beyond the casters' far plane compare at the far plane.
         return shadow_lookup(uv, min(ndc.z, 1.0), vec4<f32>(0.0, 0.0, 1.0, 1.0));
     }
-    let p = s.position + s.normal * (shadow.params.w * texel) + l * bias;
+    let p = s.position + s.normal * (shadow.params.w * texel * reach) + l * bias;
     let d = p - light.position.xyz;
     let a = abs(d);
     var face = 0u;
@@ -367,6 +368,15 @@ fn fs_toon(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         radiance += toon_times_cosine(s, light.direction) * light.radiance * visibility(i, s, light.direction, u.lights[i]);
     }
     return finish(radiance);
+}
+
+// Debug output: the shadow term of the draw's shadowed light (slot 0), as the passes above use it.
+@fragment
+fn fs_shadow_term(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let s = load_surface(vec2<i32>(frag.xy));
+    let light = incoming(u.lights[0], s);
+    let v = shadow_visibility(s, light.direction, u.lights[0]);
+    return vec4<f32>(v, v, v, 1.0);
 }
 
 @fragment

@@ -46,6 +46,11 @@ pub enum PassKind {
     Skybox,
     /// Shades one lighting model's pixels into the light buffer.
     Lighting(LightingModel),
+    /// Debug: writes light `light`'s shadow term per pixel.
+    ShadowTerm {
+        /// Index into the scene's lights.
+        light: usize,
+    },
     /// Exposed HDR light buffer to the sRGB final image.
     ToneMap,
     /// Lines over the final image.
@@ -114,6 +119,11 @@ pub const FINAL: &str = "final";
 /// Name of the shadow map of light `index`.
 pub fn shadow_target_name(index: usize) -> String {
     format!("shadow_{index}")
+}
+
+/// Name of the shadow-term debug output of light `index`.
+pub fn shadow_term_target_name(index: usize) -> String {
+    format!("shadow_term_{index}")
 }
 
 /// Name of mask target `index`.
@@ -299,6 +309,28 @@ impl RenderPlan {
                     )
                 },
             });
+        }
+        if scene.quality.debug_shadow_terms {
+            for map in &shadow_maps {
+                let light: usize = map.trim_start_matches("shadow_").parse().unwrap_or(0);
+                let name = shadow_term_target_name(light);
+                targets.push(TargetSpec {
+                    name: name.clone(),
+                    format: TextureFormat::Rgba16Float,
+                    width: scene.quality.width,
+                    height: scene.quality.height,
+                    contents: format!("debug: light {light}'s shadow term (1 = lit)"),
+                });
+                let mut reads = gbuffer.clone();
+                reads.push(map.clone());
+                passes.push(PassSpec {
+                    name: name.clone(),
+                    kind: PassKind::ShadowTerm { light },
+                    reads,
+                    writes: vec![name],
+                    detail: "debug output of the lighting pass's shadow lookup".to_owned(),
+                });
+            }
         }
         passes.push(PassSpec {
             name: "tonemap".to_owned(),

@@ -289,9 +289,9 @@ impl Default for ShadowSettings {
     fn default() -> Self {
         Self {
             map_size: 1024,
-            bias: 0.0005,
-            slope_bias: 1.0,
-            normal_offset: 1.0,
+            bias: 0.0002,
+            slope_bias: 0.5,
+            normal_offset: 0.5,
             filter: ShadowFilter::Pcf3,
         }
     }
@@ -385,6 +385,9 @@ pub struct Quality {
     pub tone_map: ToneMap,
     /// Whether the gizmos pass runs (axes, light directions, point-light markers).
     pub gizmos: bool,
+    /// Debug outputs `shadow_term_<light>`: each shadowed light's shadow term per pixel, as the
+    /// lighting pass computes it (for the ray-cast reference).
+    pub debug_shadow_terms: bool,
 }
 
 impl Default for Quality {
@@ -395,6 +398,7 @@ impl Default for Quality {
             exposure: 1.0,
             tone_map: ToneMap::Aces,
             gizmos: false,
+            debug_shadow_terms: false,
         }
     }
 }

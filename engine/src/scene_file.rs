@@ -124,6 +124,8 @@ pub struct QualitySpec {
     pub tone_map: Option<ToneMap>,
     /// Draw gizmos (default false).
     pub gizmos: Option<bool>,
+    /// Write `shadow_term_<light>` debug outputs (default false).
+    pub debug_shadow_terms: Option<bool>,
 }
 
 /// `[environment]`.
@@ -288,6 +290,7 @@ impl QualitySpec {
             exposure: None,
             tone_map: None,
             gizmos: None,
+            debug_shadow_terms: None,
         }
     }
 }
@@ -491,6 +494,7 @@ impl Resolver {
             exposure: q.exposure.unwrap_or(defaults.exposure),
             tone_map: q.tone_map.unwrap_or(defaults.tone_map),
             gizmos: q.gizmos.unwrap_or(defaults.gizmos),
+            debug_shadow_terms: q.debug_shadow_terms.unwrap_or(defaults.debug_shadow_terms),
         };
         let environment = match &file.environment {
             Some(spec) => {

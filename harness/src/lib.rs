@@ -11,6 +11,7 @@ pub mod metrics;
 pub mod reference;
 pub mod report;
 pub mod selftest;
+pub mod shadow_reference;
 pub mod suite;
 pub mod test_scenes;
 pub mod tolerance;

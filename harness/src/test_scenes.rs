@@ -57,6 +57,7 @@ fn empty_scene(name: &str, size: u32, camera: Camera) -> Scene {
             exposure: 1.0,
             tone_map: ToneMap::Aces,
             gizmos: false,
+            debug_shadow_terms: false,
         },
     }
 }

@@ -930,6 +930,56 @@ fn record_and_submit(
         });
     }
 
+    // Debug: each shadowed light's shadow term, through the lighting shader's own lookup.
+    if scene.quality.debug_shadow_terms && !views.is_empty() {
+        let pipeline = scope.pipeline(
+            backend,
+            &fullscreen_pipeline(
+                "shadow term",
+                lighting_shader,
+                "fs_shadow_term",
+                lighting_bindings.clone(),
+                TextureFormat::Rgba16Float,
+                None,
+            ),
+        )?;
+        for view in &views {
+            let name = plan::shadow_term_target_name(view.light);
+            let Some((batch, shadow_map, shadow_uniform)) = light_draws
+                .iter()
+                .find(|(_, map, _)| *map == targets[&plan::shadow_target_name(view.light)])
+            else {
+                continue;
+            };
+            let channel = plan.mask_channels[0];
+            let data = uniforms::lighting_uniforms(scene, channel, batch, false);
+            let uniform = scope.buffer(
+                backend,
+                &format!("{name} uniforms"),
+                BufferUsage::Uniform,
+                bytemuck::cast_slice(&data),
+            )?;
+            let mut bindings = vec![binding(0, BindingResource::Buffer(uniform))];
+            bindings.extend(
+                plan::GBUFFER_TARGETS
+                    .iter()
+                    .enumerate()
+                    .map(|(i, n)| binding(i as u32 + 1, BindingResource::Texture(target(n)))),
+            );
+            bindings.push(binding(6, BindingResource::Texture(mask_targets[0])));
+            bindings.push(binding(7, BindingResource::Texture(*shadow_map)));
+            bindings.push(binding(8, BindingResource::Sampler(shadow_sampler)));
+            bindings.push(binding(9, BindingResource::Buffer(*shadow_uniform)));
+            passes.push(RenderPass {
+                name: name.clone(),
+                color_attachments: vec![attachment(target(&name), LoadOp::Clear([0.0; 4]))],
+                depth_attachment: None,
+                viewport: None,
+                draws: vec![fullscreen_draw(pipeline, bindings)],
+            });
+        }
+    }
+
     // Tone mapping.
     let tonemap_shader = shader(scope, backend, shaders::TONEMAP)?;
     let tonemap_pipeline = scope.pipeline(
