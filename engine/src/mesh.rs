@@ -132,6 +132,42 @@ pub fn uv_sphere(segments: u32, rings: u32) -> MeshData {
     MeshData::new("uv_sphere", vertices, indices)
 }
 
+/// An axis-aligned box from -1 to 1 with flat faces (four vertices each), outward normals,
+/// per-face UVs 0..1 and tangents along +u.
+pub fn cube() -> MeshData {
+    let faces = [
+        Vec3::X,
+        Vec3::NEG_X,
+        Vec3::Y,
+        Vec3::NEG_Y,
+        Vec3::Z,
+        Vec3::NEG_Z,
+    ];
+    let mut vertices = Vec::with_capacity(24);
+    let mut indices = Vec::with_capacity(36);
+    for (face, n) in faces.into_iter().enumerate() {
+        // v runs along `up` (or -Z on the top and bottom faces), u along up x n.
+        let up = if n.y.abs() > 0.5 {
+            Vec3::new(0.0, 0.0, -n.y)
+        } else {
+            Vec3::Y
+        };
+        let u_axis = up.cross(n);
+        for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+            let p = n + u_axis * a + up * b;
+            vertices.push(Vertex {
+                position: p.into(),
+                normal: n.into(),
+                uv: [(a + 1.0) / 2.0, (b + 1.0) / 2.0],
+                tangent: [u_axis.x, u_axis.y, u_axis.z, 1.0],
+            });
+        }
+        let base = face as u32 * 4;
+        indices.extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+    }
+    MeshData::new("cube", vertices, indices)
+}
+
 /// A square in the XZ plane, `size` wide, facing +Y, with UVs 0..`uv_scale`.
 pub fn plane(size: f32, uv_scale: f32) -> MeshData {
     let h = size / 2.0;
@@ -178,6 +214,13 @@ mod tests {
         let mesh = uv_sphere(16, 8);
         check_winding_and_frames(&mesh);
         assert_eq!(mesh.triangle_count(), 16 * 8 * 2 - 2 * 16);
+    }
+
+    #[test]
+    fn cube_is_closed_and_outward() {
+        let mesh = cube();
+        check_winding_and_frames(&mesh);
+        assert_eq!(mesh.triangle_count(), 12);
     }
 
     #[test]

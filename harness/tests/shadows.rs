@@ -172,3 +172,128 @@ fn hard_shadows_match_the_ray_cast_reference() {
         }
     }
 }
+
+/// A 0.4 m box standing on a plane under a 30-degree sun, hard filter, default bias: in the
+/// contact zone (plane points whose ray to the sun enters the box within 10 texels of its base),
+/// the points the GPU lights although the box shadows them (peter-panning) lie at most two
+/// shadow-map texels (plus one pixel's footprint) from the box's base.
+#[test]
+fn box_on_a_plane_shows_at_most_a_two_texel_contact_gap() {
+    let elevation = 30f64.to_radians();
+    let azimuth = 0.6f64;
+    let direction = DVec3::new(
+        elevation.cos() * azimuth.cos(),
+        elevation.sin(),
+        elevation.cos() * azimuth.sin(),
+    );
+    let mut scene = plane_scene(Light::Directional {
+        direction,
+        color: [1.0; 3],
+        intensity: 3.0,
+        shadow: Some(ShadowSettings {
+            filter: ShadowFilter::Hard,
+            ..ShadowSettings::default()
+        }),
+    });
+    scene.objects.push(Object {
+        name: "box".to_owned(),
+        mesh: Arc::new(mesh::cube()),
+        transform: Transform {
+            translation: DVec3::new(0.0, 0.2, 0.0),
+            scale: DVec3::splat(0.2),
+            ..Transform::default()
+        },
+        material: Material::default(),
+        lighting: LightingModel::Pbr,
+        casts_shadows: true,
+    });
+    // Look down at the shadowed side of the box, close enough for ~1.5 mm pixels.
+    scene.camera.position = DVec3::new(-0.9, 1.1, -0.7);
+    scene.camera.target = DVec3::new(-0.3, 0.0, -0.25);
+    scene.quality.width = 512;
+    scene.quality.height = 512;
+    scene.quality.debug_shadow_terms = true;
+    let texel = renderer::shadows::shadow_views(&scene)[0].texel_world;
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        let frame = renderer::render(backend.as_mut(), &scene, Readback::All).unwrap();
+        let term = frame.outputs["shadow_term_0"].as_f32().unwrap();
+        let position = frame.outputs["gbuffer_position"].as_f32().unwrap();
+        let depth = frame.outputs["depth"].as_f32().unwrap();
+        let (mut gap, mut shadowed, mut pixel, mut contact) = (0.0f64, 0usize, 0.0f64, 0usize);
+        for i in 0..depth.len() {
+            if depth[i] >= 1.0 {
+                continue;
+            }
+            let p = DVec3::new(
+                position[i * 4] as f64,
+                position[i * 4 + 1] as f64,
+                position[i * 4 + 2] as f64,
+            ) + scene.camera.position;
+            if p.y.abs() > 1e-3 {
+                continue; // on the box, not the plane
+            }
+            if p.x.abs() < 0.3 && p.z.abs() < 0.3 && i + 1 < depth.len() && depth[i + 1] < 1.0 {
+                // Pixel footprint near the box.
+                let q = DVec3::new(
+                    position[i * 4 + 4] as f64,
+                    position[i * 4 + 5] as f64,
+                    position[i * 4 + 6] as f64,
+                ) + scene.camera.position;
+                if q.y.abs() < 1e-3 {
+                    pixel = pixel.max((q - p).length());
+                }
+            }
+            // Where does the ray to the light enter the box (slab test)?
+            let d = direction.normalize();
+            let (lo, hi) = (DVec3::new(-0.2, 0.0, -0.2), DVec3::new(0.2, 0.4, 0.2));
+            let t0 = (lo - p) / d;
+            let t1 = (hi - p) / d;
+            let near = t0.min(t1).max_element();
+            let far = t0.max(t1).min_element();
+            if near > far || far <= 0.0 {
+                continue; // not in the box's shadow
+            }
+            shadowed += 1;
+            let entry = p + d * near.max(0.0);
+            // The contact zone: points whose shadow comes from the bottom 10 texels of a side
+            // face, away from its vertical edges (there a shadow edge runs past, not a contact).
+            let lateral = if (entry.x.abs() - 0.2).abs() < 1e-9 {
+                0.2 - entry.z.abs()
+            } else {
+                0.2 - entry.x.abs()
+            };
+            if entry.y > 10.0 * texel || lateral < 2.0 * texel {
+                continue;
+            }
+            contact += 1;
+            if term[i * 4] > 0.5 {
+                let dx = (p.x.abs() - 0.2).max(0.0);
+                let dz = (p.z.abs() - 0.2).max(0.0);
+                gap = gap.max((dx * dx + dz * dz).sqrt());
+            }
+        }
+        eprintln!(
+            "{kind}: contact gap {:.2} mm = {:.2} texels (texel {:.2} mm, pixel {:.2} mm), {shadowed} shadowed plane pixels, {contact} in the contact zone",
+            gap * 1e3,
+            gap / texel,
+            texel * 1e3,
+            pixel * 1e3
+        );
+        assert!(
+            shadowed > 5000,
+            "{kind}: only {shadowed} shadowed plane pixels in view"
+        );
+        assert!(
+            contact > 500,
+            "{kind}: only {contact} pixels in the contact zone"
+        );
+        assert!(
+            gap <= 2.0 * texel + pixel,
+            "{kind}: contact gap {:.2} mm > 2 texels ({:.2} mm) + 1 pixel ({:.2} mm)",
+            gap * 1e3,
+            2.0 * texel * 1e3,
+            pixel * 1e3
+        );
+    }
+}
