@@ -51,18 +51,55 @@ struct ShadowUniforms {
     // x = kind (0 none, 1 directional, 2 point), y = constant bias (m), z = slope bias (texels),
     // w = normal offset (texels).
     params: vec4<f32>,
-    // x = filter (0 hard, 1 3x3 PCF), y = 1 / map width, z = 1 / map height,
+    // x = filter (0 hard, 1 3x3 PCF, 2 stratified soft, 3 stratified soft without early-out),
+    // y = 1 / map width, z = 1 / map height,
     // w = texel size in meters (directional) or per meter of distance (point).
     map: vec4<f32>,
+    // x = soft radius (texels), y = reach of the filter in texels (scales the biases).
+    soft: vec4<f32>,
 }
 
 @group(0) @binding(7) var shadow_map: texture_depth_2d;
 @group(0) @binding(8) var shadow_sampler: sampler_comparison;
 @group(0) @binding(9) var<uniform> shadow: ShadowUniforms;
+// Stratified soft shadows: per-pixel jittered sample offsets (unit disk), 32x32 tile, 8 layers;
+// layer 2r + k holds two samples of ring r (ring 3 is the outer one) as (x, y, x, y).
+@group(0) @binding(10) var shadow_jitter: texture_2d_array<f32>;
+
+fn shadow_tap(uv: vec2<f32>, reference: f32, bounds: vec4<f32>) -> f32 {
+    return textureSampleCompareLevel(shadow_map, shadow_sampler, clamp(uv, bounds.xy, bounds.zw), reference);
+}
+
+// The seed's stratified soft shadows (GPU Gems 2 ch. 17): the outer ring's four samples first;
+// if they agree (all lit or all shadowed) and early-out is on, that is the answer; otherwise all
+// sixteen samples are averaged.
+fn shadow_soft(uv: vec2<f32>, reference: f32, bounds: vec4<f32>, pixel: vec2<i32>, early_out: bool) -> f32 {
+    let cell = vec2<i32>(pixel.x & 31, pixel.y & 31);
+    let scale = shadow.soft.x * shadow.map.yz;
+    var outer = 0.0;
+    for (var k = 0; k < 2; k++) {
+        let o = textureLoad(shadow_jitter, cell, 6 + k, 0);
+        outer += shadow_tap(uv + o.xy * scale, reference, bounds);
+        outer += shadow_tap(uv + o.zw * scale, reference, bounds);
+    }
+    if early_out && (outer == 0.0 || outer == 4.0) {
+        return outer * 0.25;
+    }
+    var sum = outer;
+    for (var layer = 0; layer < 6; layer++) {
+        let o = textureLoad(shadow_jitter, cell, layer, 0);
+        sum += shadow_tap(uv + o.xy * scale, reference, bounds);
+        sum += shadow_tap(uv + o.zw * scale, reference, bounds);
+    }
+    return sum / 16.0;
+}
 
 // Filtered comparison at `uv` against `reference` depth, taps clamped inside `bounds`
 // (min uv, max uv) so point-light faces never read their neighbours in the atlas.
-fn shadow_lookup(uv: vec2<f32>, reference: f32, bounds: vec4<f32>) -> f32 {
+fn shadow_lookup(uv: vec2<f32>, reference: f32, bounds: vec4<f32>, pixel: vec2<i32>) -> f32 {
+    if shadow.map.x > 1.5 {
+        return shadow_soft(uv, reference, bounds, pixel, shadow.map.x < 2.5);
+    }
     if shadow.map.x < 0.5 {
         return textureSampleCompareLevel(shadow_map, shadow_sampler, clamp(uv, bounds.xy, bounds.zw), reference);
     }
@@ -90,8 +127,8 @@ fn shadow_visibility(s: Surface, l: vec3<f32>, light: LightData) -> f32 {
         texel = shadow.map.w * length(light.position.xyz - s.position);
     }
     // Slope-scaled and normal-offset parts are in texels, times the filter's reach (3x3 PCF
-    // reads one texel further out than a single tap).
-    let reach = select(1.0, 2.0, shadow.map.x > 0.5);
+    // reads one texel further out than a single tap, the soft filters their radius further).
+    let reach = shadow.soft.y;
     let bias = shadow.params.y + shadow.params.z * texel * tan_theta * reach;
     if kind < 1.5 {
         let p = s.position + s.normal * (shadow.params.w * texel * reach) + l * bias;
@@ -102,7 +139,7 @@ fn shadow_visibility(s: Surface, l: vec3<f32>, light: LightData) -> f32 {
             return 1.0;
         }
         // Receivers beyond the casters' far plane compare at the far plane.
-        return shadow_lookup(uv, min(ndc.z, 1.0), vec4<f32>(0.0, 0.0, 1.0, 1.0));
+        return shadow_lookup(uv, min(ndc.z, 1.0), vec4<f32>(0.0, 0.0, 1.0, 1.0), s.pixel);
     }
     let p = s.position + s.normal * (shadow.params.w * texel * reach) + l * bias;
     let d = p - light.position.xyz;
@@ -122,7 +159,7 @@ fn shadow_visibility(s: Surface, l: vec3<f32>, light: LightData) -> f32 {
     let uv = (tile + face_uv) / vec2<f32>(3.0, 2.0);
     let half_texel = 0.5 * shadow.map.yz;
     let bounds = vec4<f32>(tile / vec2<f32>(3.0, 2.0) + half_texel, (tile + 1.0) / vec2<f32>(3.0, 2.0) - half_texel);
-    return shadow_lookup(uv, clamp(ndc.z, 0.0, 1.0), bounds);
+    return shadow_lookup(uv, clamp(ndc.z, 0.0, 1.0), bounds, s.pixel);
 }
 
 @vertex
@@ -132,6 +169,7 @@ fn vs_fullscreen(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f
 }
 
 struct Surface {
+    pixel: vec2<i32>,
     position: vec3<f32>,
     roughness: f32,
     normal: vec3<f32>,
@@ -157,6 +195,7 @@ fn load_surface(pixel: vec2<i32>) -> Surface {
     let a = textureLoad(gbuffer_albedo, pixel, 0);
     let m = textureLoad(gbuffer_material, pixel, 0);
     var s: Surface;
+    s.pixel = pixel;
     s.position = p.xyz;
     s.roughness = clamp(p.w, 0.0, 1.0);
     s.normal = normalize(n.xyz);

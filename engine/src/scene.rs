@@ -254,6 +254,13 @@ pub enum ShadowFilter {
     Hard,
     /// 3x3 percentage-closer filtering (nine comparisons, one texel apart).
     Pcf3,
+    /// The seed's stratified soft shadows (GPU Gems 2, ch. 17): 16 samples in 4 concentric rings
+    /// of 4 sectors within `soft_radius` texels, jittered per pixel from a precomputed texture;
+    /// the outer ring is tested first and, when its 4 samples agree, that answer is returned.
+    Soft,
+    /// [`ShadowFilter::Soft`] without the early-out (all 16 samples always), for tests and
+    /// benchmarks.
+    SoftFull,
 }
 
 impl ShadowFilter {
@@ -262,6 +269,17 @@ impl ShadowFilter {
         match self {
             ShadowFilter::Hard => "hard",
             ShadowFilter::Pcf3 => "pcf3",
+            ShadowFilter::Soft => "soft",
+            ShadowFilter::SoftFull => "soft-full",
+        }
+    }
+
+    /// How many texels beyond the centre the filter reads (scales the slope and normal biases).
+    pub fn reach(self, soft_radius: f32) -> f32 {
+        match self {
+            ShadowFilter::Hard => 1.0,
+            ShadowFilter::Pcf3 => 2.0,
+            ShadowFilter::Soft | ShadowFilter::SoftFull => 1.0 + soft_radius.max(0.0),
         }
     }
 }
@@ -283,6 +301,8 @@ pub struct ShadowSettings {
     pub normal_offset: f32,
     /// Filter.
     pub filter: ShadowFilter,
+    /// Radius of the soft filters' sample disk, in texels.
+    pub soft_radius: f32,
 }
 
 impl Default for ShadowSettings {
@@ -293,6 +313,7 @@ impl Default for ShadowSettings {
             slope_bias: 0.5,
             normal_offset: 0.5,
             filter: ShadowFilter::Pcf3,
+            soft_radius: 2.5,
         }
     }
 }

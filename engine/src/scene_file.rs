@@ -217,8 +217,10 @@ pub struct ShadowSpec {
     pub slope_bias: Option<f32>,
     /// Normal offset in shadow-map texels.
     pub normal_offset: Option<f32>,
-    /// `hard` or `pcf3` (default).
+    /// `hard`, `pcf3` (default), `soft` or `soft-full`.
     pub filter: Option<ShadowFilter>,
+    /// Sample-disk radius of the soft filters, in texels (default 2.5).
+    pub soft_radius: Option<f32>,
 }
 
 /// `[[lights]]`.
@@ -599,6 +601,7 @@ impl Resolver {
                         slope_bias: s.slope_bias.unwrap_or(d.slope_bias),
                         normal_offset: s.normal_offset.unwrap_or(d.normal_offset),
                         filter: s.filter.unwrap_or(d.filter),
+                        soft_radius: s.soft_radius.unwrap_or(d.soft_radius),
                     }
                 })
             };
@@ -633,7 +636,7 @@ impl Resolver {
             if let Some(s) = match &light {
                 Light::Directional { shadow, .. } | Light::Point { shadow, .. } => shadow,
             } {
-                let biases = [s.bias, s.slope_bias, s.normal_offset];
+                let biases = [s.bias, s.slope_bias, s.normal_offset, s.soft_radius];
                 if !(64..=8192).contains(&s.map_size)
                     || !biases.iter().all(|b| b.is_finite() && *b >= 0.0)
                 {

@@ -85,7 +85,7 @@ fn fully_lit_fraction(backend: &mut dyn engine::Backend, light: Light) -> f64 {
 fn open_plane_has_no_shadow_acne() {
     for kind in common::available_backends() {
         let mut backend = engine::backend::create(kind).unwrap();
-        for filter in [ShadowFilter::Hard, ShadowFilter::Pcf3] {
+        for filter in [ShadowFilter::Hard, ShadowFilter::Pcf3, ShadowFilter::Soft] {
             let shadow = Some(ShadowSettings {
                 filter,
                 ..ShadowSettings::default()
@@ -294,6 +294,49 @@ fn box_on_a_plane_shows_at_most_a_two_texel_contact_gap() {
             gap * 1e3,
             2.0 * texel * 1e3,
             pixel * 1e3
+        );
+    }
+}
+
+/// Stratified soft shadows: with the outer-ring early-out, the shadow term equals the full
+/// 16-sample kernel on every pixel outside the penumbrae (where the full kernel is exactly 0 or
+/// 1), and the penumbrae are really soft (fractional terms exist).
+#[test]
+fn soft_shadow_early_out_matches_the_full_kernel_outside_penumbrae() {
+    let term = |backend: &mut dyn engine::Backend, filter: ShadowFilter| {
+        let mut scene = harness::load_scene("chess").unwrap().scene;
+        scene.quality.debug_shadow_terms = true;
+        for l in &mut scene.lights {
+            if let Light::Directional {
+                shadow: Some(s), ..
+            }
+            | Light::Point {
+                shadow: Some(s), ..
+            } = l
+            {
+                s.filter = filter;
+            }
+        }
+        let frame = renderer::render(backend, &scene, Readback::Only(&["shadow_term_0"])).unwrap();
+        frame.outputs["shadow_term_0"].as_f32().unwrap().to_vec()
+    };
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        let early = term(backend.as_mut(), ShadowFilter::Soft);
+        let full = term(backend.as_mut(), ShadowFilter::SoftFull);
+        let (mut outside, mut penumbra) = (0usize, 0usize);
+        for (i, (e, f)) in early.iter().zip(&full).enumerate().step_by(4) {
+            if *f == 0.0 || *f == 1.0 {
+                outside += 1;
+                assert_eq!(e, f, "{kind}: pixel {} differs outside the penumbra", i / 4);
+            } else {
+                penumbra += 1;
+            }
+        }
+        eprintln!("{kind}: {outside} pixels outside penumbrae agree; {penumbra} penumbra pixels");
+        assert!(
+            penumbra > 500,
+            "{kind}: only {penumbra} penumbra pixels: not soft"
         );
     }
 }

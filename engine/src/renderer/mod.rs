@@ -809,7 +809,41 @@ fn record_and_submit(
             binding: 9,
             kind: BindingKind::UniformBuffer,
         },
+        BindingLayout {
+            binding: 10,
+            kind: BindingKind::Texture {
+                sample_type: TextureSampleType::UnfilterableFloat,
+                view: TextureViewKind::D2Array,
+            },
+        },
     ]);
+    let jitter_layers = (shadows::SOFT_RINGS * shadows::SOFT_SECTORS / 2) as u32;
+    let jitter = scope.texture(
+        backend,
+        &TextureDesc {
+            kind: TextureKind::D2Array {
+                layers: jitter_layers,
+            },
+            ..TextureDesc::d2(
+                "shadow jitter",
+                shadows::JITTER_TILE,
+                shadows::JITTER_TILE,
+                TextureFormat::Rgba16Float,
+            )
+        },
+    )?;
+    let jitter_texels = shadows::jitter_texels();
+    let layer_len = (shadows::JITTER_TILE * shadows::JITTER_TILE * 4) as usize;
+    for (layer, texels) in jitter_texels.chunks(layer_len).enumerate() {
+        backend.write_texture(
+            jitter,
+            Subresource {
+                mip: 0,
+                layer: layer as u32,
+            },
+            bytemuck::cast_slice(texels),
+        )?;
+    }
     let lights = light_uniforms(scene);
     let shadow_sampler = scope.sampler(
         backend,
@@ -899,6 +933,7 @@ fn record_and_submit(
             bindings.push(binding(7, BindingResource::Texture(*shadow_map)));
             bindings.push(binding(8, BindingResource::Sampler(shadow_sampler)));
             bindings.push(binding(9, BindingResource::Buffer(*shadow_uniform)));
+            bindings.push(binding(10, BindingResource::Texture(jitter)));
             draws.push(fullscreen_draw(pipeline, bindings));
         }
         let load = if light_cleared {
@@ -970,6 +1005,7 @@ fn record_and_submit(
             bindings.push(binding(7, BindingResource::Texture(*shadow_map)));
             bindings.push(binding(8, BindingResource::Sampler(shadow_sampler)));
             bindings.push(binding(9, BindingResource::Buffer(*shadow_uniform)));
+            bindings.push(binding(10, BindingResource::Texture(jitter)));
             passes.push(RenderPass {
                 name: name.clone(),
                 color_attachments: vec![attachment(target(&name), LoadOp::Clear([0.0; 4]))],

@@ -142,9 +142,9 @@ pub fn shadow_views(scene: &Scene) -> Vec<ShadowView> {
 
 /// `ShadowUniforms` of `lighting.wgsl` for a view (or the "no shadow" block), as floats.
 pub fn shadow_uniforms(view: Option<&ShadowView>) -> Vec<f32> {
-    let mut data = Vec::with_capacity(6 * 16 + 8);
+    let mut data = Vec::with_capacity(6 * 16 + 12);
     let Some(view) = view else {
-        data.resize(6 * 16 + 8, 0.0);
+        data.resize(6 * 16 + 12, 0.0);
         return data;
     };
     for face in 0..6 {
@@ -167,12 +167,60 @@ pub fn shadow_uniforms(view: Option<&ShadowView>) -> Vec<f32> {
         match s.filter {
             ShadowFilter::Hard => 0.0,
             ShadowFilter::Pcf3 => 1.0,
+            ShadowFilter::Soft => 2.0,
+            ShadowFilter::SoftFull => 3.0,
         },
         1.0 / w as f32,
         1.0 / h as f32,
         view.texel_world as f32,
     ]);
+    data.extend_from_slice(&[s.soft_radius, s.filter.reach(s.soft_radius), 0.0, 0.0]);
     data
+}
+
+/// Sectors per ring of the stratified soft filter.
+pub const SOFT_SECTORS: usize = 4;
+/// Rings of the stratified soft filter.
+pub const SOFT_RINGS: usize = 4;
+/// Size of the per-pixel jitter tile (pixels are mapped to it modulo this size).
+pub const JITTER_TILE: u32 = 32;
+
+/// The jitter texture of the stratified soft filter: a `JITTER_TILE`-square 2D array with one
+/// layer per pair of samples (8 layers); layer `2r + k` holds samples `2k` and `2k + 1` of ring
+/// `r` (ring 3 is the outer one) as (x, y, x, y) offsets in the unit disk. Each sample lies in
+/// its own ring x sector cell, jittered by a fixed-seed PCG hash: deterministic.
+pub fn jitter_texels() -> Vec<u16> {
+    let layers = SOFT_RINGS * SOFT_SECTORS / 2;
+    let tile = JITTER_TILE as usize;
+    let mut out = Vec::with_capacity(layers * tile * tile * 4);
+    let hash = |mut x: u32| {
+        // PCG-style integer hash.
+        x = x.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+        let word = ((x >> ((x >> 28) + 4)) ^ x).wrapping_mul(277_803_737);
+        ((word >> 22) ^ word) as f32 / u32::MAX as f32
+    };
+    for layer in 0..layers {
+        let ring = layer / 2;
+        for y in 0..tile {
+            for x in 0..tile {
+                for k in 0..2 {
+                    let sector = (layer % 2) * 2 + k;
+                    let seed = (((y * tile + x) * 64 + ring * 4 + sector) as u32).wrapping_mul(2);
+                    let (u, v) = (hash(seed), hash(seed + 1));
+                    // Uniform area within the ring: radius from the squared-radius interval.
+                    let (r0, r1) = (
+                        ring as f32 / SOFT_RINGS as f32,
+                        (ring + 1) as f32 / SOFT_RINGS as f32,
+                    );
+                    let radius = (r0 * r0 + u * (r1 * r1 - r0 * r0)).sqrt();
+                    let angle = (sector as f32 + v) * std::f32::consts::TAU / SOFT_SECTORS as f32;
+                    out.push(half::f16::from_f32(radius * angle.cos()).to_bits());
+                    out.push(half::f16::from_f32(radius * angle.sin()).to_bits());
+                }
+            }
+        }
+    }
+    out
 }
 
 /// Records the shadow passes of every view into `passes`.
