@@ -96,7 +96,22 @@ fn shadow_soft(uv: vec2<f32>, reference: f32, bounds: vec4<f32>, pixel: vec2<i32
 
 // Filtered comparison at `uv` against `reference` depth, taps clamped inside `bounds`
 // (min uv, max uv) so point-light faces never read their neighbours in the atlas.
+// The converged soft filter for sweeps: 1024 samples on a golden-angle (Vogel) disk.
+fn shadow_soft_reference(uv: vec2<f32>, reference: f32, bounds: vec4<f32>) -> f32 {
+    let scale = shadow.soft.x * shadow.map.yz;
+    var sum = 0.0;
+    for (var i = 0; i < 1024; i++) {
+        let r = sqrt((f32(i) + 0.5) / 1024.0);
+        let angle = f32(i) * 2.39996323;
+        sum += shadow_tap(uv + vec2<f32>(cos(angle), sin(angle)) * r * scale, reference, bounds);
+    }
+    return sum / 1024.0;
+}
+
 fn shadow_lookup(uv: vec2<f32>, reference: f32, bounds: vec4<f32>, pixel: vec2<i32>) -> f32 {
+    if shadow.map.x > 3.5 {
+        return shadow_soft_reference(uv, reference, bounds);
+    }
     if shadow.map.x > 1.5 {
         return shadow_soft(uv, reference, bounds, pixel, shadow.map.x < 2.5);
     }

@@ -261,6 +261,9 @@ pub enum ShadowFilter {
     /// [`ShadowFilter::Soft`] without the early-out (all 16 samples always), for tests and
     /// benchmarks.
     SoftFull,
+    /// The converged soft filter: 1024 samples on a Vogel (golden-angle) disk of `soft_radius`
+    /// texels, no jitter. The reference the soft filters' error is measured against in sweeps.
+    SoftReference,
 }
 
 impl ShadowFilter {
@@ -271,6 +274,7 @@ impl ShadowFilter {
             ShadowFilter::Pcf3 => "pcf3",
             ShadowFilter::Soft => "soft",
             ShadowFilter::SoftFull => "soft-full",
+            ShadowFilter::SoftReference => "soft-reference",
         }
     }
 
@@ -279,7 +283,9 @@ impl ShadowFilter {
         match self {
             ShadowFilter::Hard => 1.0,
             ShadowFilter::Pcf3 => 2.0,
-            ShadowFilter::Soft | ShadowFilter::SoftFull => 1.0 + soft_radius.max(0.0),
+            ShadowFilter::Soft | ShadowFilter::SoftFull | ShadowFilter::SoftReference => {
+                1.0 + soft_radius.max(0.0)
+            }
         }
     }
 }

@@ -13,6 +13,7 @@ pub mod report;
 pub mod selftest;
 pub mod shadow_reference;
 pub mod suite;
+pub mod sweep;
 pub mod test_scenes;
 pub mod tolerance;
 

@@ -95,6 +95,25 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Speed against error for a quality knob (`shadow`: filter x map size), timed with GPU
+    /// timestamps and measured against ray casting and the converged soft filter.
+    Sweep {
+        /// Canonical scene name or scene file.
+        #[arg(long, default_value = "chess")]
+        scene: String,
+        /// The knob: shadow.
+        #[arg(long, default_value = "shadow")]
+        knob: String,
+        /// Backend.
+        #[arg(long, default_value = "gl")]
+        backend: BackendKind,
+        /// Renders per setting (timings are their median).
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// List the canonical scenes with their descriptions.
     Scenes,
     /// List every backend with its availability, the reason and fix when unavailable, and the
@@ -144,6 +163,13 @@ fn main() -> ExitCode {
         Command::Inspect { path, json } => inspect(&path, json),
         Command::Scenes => scenes(),
         Command::Selftest { json } => selftest(json),
+        Command::Sweep {
+            scene,
+            knob,
+            backend,
+            repeats,
+            json,
+        } => sweep(&scene, &knob, backend, repeats, json),
     };
     match result {
         Ok(code) => code,
@@ -491,4 +517,30 @@ fn selftest(json: bool) -> anyhow::Result<ExitCode> {
             ExitCode::FAILURE
         },
     )
+}
+
+fn sweep(
+    scene: &str,
+    knob: &str,
+    kind: BackendKind,
+    repeats: usize,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    if knob != "shadow" {
+        return Err(harness::sweep::SweepError::UnknownKnob(knob.to_owned()).into());
+    }
+    let loaded = harness::load_scene(scene)?;
+    let rows = harness::sweep::shadow_sweep(&loaded.scene, kind, repeats, |what| {
+        eprintln!("  {what} ...");
+    })?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    } else {
+        println!(
+            "shadow sweep of {} on {kind} ({repeats} renders per setting, median GPU time)",
+            loaded.scene.name
+        );
+        print!("{}", harness::sweep::table(&rows));
+    }
+    Ok(ExitCode::SUCCESS)
 }

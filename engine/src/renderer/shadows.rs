@@ -169,6 +169,7 @@ pub fn shadow_uniforms(view: Option<&ShadowView>) -> Vec<f32> {
             ShadowFilter::Pcf3 => 1.0,
             ShadowFilter::Soft => 2.0,
             ShadowFilter::SoftFull => 3.0,
+            ShadowFilter::SoftReference => 4.0,
         },
         1.0 / w as f32,
         1.0 / h as f32,

@@ -1,0 +1,194 @@
+//! Speed against error for one quality knob: `harness sweep --scene chess --knob shadow` renders
+//! the scene once per setting (shadow filter x map size), times the passes from GPU timestamps
+//! (median of several renders), and measures the error of the shadow term against
+//!
+//! - exact hard visibility by ray casting ([`crate::shadow_reference`]): the fraction of
+//!   lit-surface pixels whose term is on the wrong side of 0.5, and the mean absolute difference;
+//! - the converged soft filter (`soft-reference`, 1024 samples) for the soft filters: mean
+//!   absolute difference.
+
+use engine::backend::{self, BackendKind};
+use engine::plan;
+use engine::renderer::{self, Frame, Readback};
+use engine::scene::{Light, Scene, ShadowFilter};
+
+use crate::shadow_reference;
+
+/// One setting of the sweep.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SweepRow {
+    /// Filter.
+    pub filter: String,
+    /// Shadow map size (per face).
+    pub map_size: u32,
+    /// Median GPU time of the shadow-map pass(es), ms.
+    pub shadow_ms: Option<f64>,
+    /// Median GPU time of the lighting passes, ms.
+    pub lighting_ms: Option<f64>,
+    /// Fraction of lit-surface pixels misclassified against ray casting (term > 0.5 = lit).
+    pub misclassified: f64,
+    /// Mean |term - soft reference| over lit-surface pixels (soft filters only).
+    pub error_vs_soft_reference: Option<f64>,
+}
+
+/// Why a sweep failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    /// The knob is not one the sweep knows.
+    #[error("unknown knob `{0}` (known: shadow)")]
+    UnknownKnob(String),
+    /// The scene has no shadowed light.
+    #[error("scene `{0}` has no light with shadows")]
+    NoShadows(String),
+    /// Rendering failed.
+    #[error("{0}")]
+    Render(String),
+}
+
+fn with_shadow(scene: &Scene, filter: ShadowFilter, map_size: u32) -> Scene {
+    let mut scene = scene.clone();
+    scene.quality.debug_shadow_terms = true;
+    for light in &mut scene.lights {
+        if let Light::Directional {
+            shadow: Some(s), ..
+        }
+        | Light::Point {
+            shadow: Some(s), ..
+        } = light
+        {
+            s.filter = filter;
+            s.map_size = map_size;
+        }
+    }
+    scene
+}
+
+fn median(mut values: Vec<f64>) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_by(f64::total_cmp);
+    Some(values[values.len() / 2])
+}
+
+fn pass_ms(frames: &[Frame], prefix: &str) -> Option<f64> {
+    median(
+        frames
+            .iter()
+            .filter_map(|f| {
+                let ns: Vec<f64> = f
+                    .timings
+                    .iter()
+                    .filter(|t| t.name.starts_with(prefix) && !t.name.starts_with("shadow_term"))
+                    .filter_map(|t| t.gpu_ns)
+                    .collect();
+                (!ns.is_empty()).then(|| ns.iter().sum::<f64>() / 1e6)
+            })
+            .collect(),
+    )
+}
+
+/// Runs the shadow sweep on one backend. `repeats` renders per setting for the timing median.
+pub fn shadow_sweep(
+    scene: &Scene,
+    kind: BackendKind,
+    repeats: usize,
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<SweepRow>, SweepError> {
+    let light = scene
+        .lights
+        .iter()
+        .position(Light::casts_shadows)
+        .ok_or_else(|| SweepError::NoShadows(scene.name.clone()))?;
+    let mut backend = backend::create(kind).map_err(|e| SweepError::Render(e.to_string()))?;
+    let term_name = plan::shadow_term_target_name(light);
+    let wanted = [
+        term_name.as_str(),
+        plan::GBUFFER_TARGETS[0],
+        plan::GBUFFER_TARGETS[1],
+        "mask",
+    ];
+    let mut render = |scene: &Scene| {
+        renderer::render(backend.as_mut(), scene, Readback::Only(&wanted))
+            .map_err(|e| SweepError::Render(e.to_string()))
+    };
+    let mut rows = Vec::new();
+    for map_size in [512u32, 1024, 2048] {
+        progress(&format!("soft reference at {map_size}"));
+        let reference_scene = with_shadow(scene, ShadowFilter::SoftReference, map_size);
+        let reference = render(&reference_scene)?;
+        for filter in [
+            ShadowFilter::Hard,
+            ShadowFilter::Pcf3,
+            ShadowFilter::Soft,
+            ShadowFilter::SoftFull,
+        ] {
+            progress(&format!("{} at {map_size}", filter.name()));
+            let mutated = with_shadow(scene, filter, map_size);
+            let frames = (0..repeats.max(1))
+                .map(|_| render(&mutated))
+                .collect::<Result<Vec<_>, _>>()?;
+            let frame = &frames[0];
+            let visibility = shadow_reference::visibility_error(&mutated, frame, light, 1e-4)
+                .map_err(SweepError::Render)?;
+            let soft = matches!(filter, ShadowFilter::Soft | ShadowFilter::SoftFull).then(|| {
+                mean_abs_difference(
+                    frame.outputs[&term_name].as_f32().unwrap_or_default(),
+                    reference.outputs[&term_name].as_f32().unwrap_or_default(),
+                    frame,
+                )
+            });
+            rows.push(SweepRow {
+                filter: filter.name().to_owned(),
+                map_size,
+                shadow_ms: pass_ms(&frames, "shadow_"),
+                lighting_ms: pass_ms(&frames, "lighting_"),
+                misclassified: visibility.fraction,
+                error_vs_soft_reference: soft,
+            });
+        }
+    }
+    Ok(rows)
+}
+
+/// Mean absolute difference of two shadow terms over the covered pixels.
+fn mean_abs_difference(a: &[f32], b: &[f32], frame: &Frame) -> f64 {
+    let mask = frame
+        .outputs
+        .get("mask")
+        .and_then(|m| m.as_u8())
+        .unwrap_or_default();
+    let (mut sum, mut n) = (0.0, 0usize);
+    for i in 0..a.len().min(b.len()) / 4 {
+        if mask
+            .get(i * 4..i * 4 + 4)
+            .is_some_and(|m| m.iter().any(|&v| v > 127))
+        {
+            sum += f64::from((a[i * 4] - b[i * 4]).abs());
+            n += 1;
+        }
+    }
+    sum / n.max(1) as f64
+}
+
+/// The sweep as a table.
+pub fn table(rows: &[SweepRow]) -> String {
+    let mut out = format!(
+        "{:<10} {:>6} {:>11} {:>13} {:>14} {:>16}\n",
+        "filter", "map", "shadow ms", "lighting ms", "misclassified", "vs soft ref"
+    );
+    let ms = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.2}"));
+    for r in rows {
+        out.push_str(&format!(
+            "{:<10} {:>6} {:>11} {:>13} {:>13.3}% {:>16}\n",
+            r.filter,
+            r.map_size,
+            ms(r.shadow_ms),
+            ms(r.lighting_ms),
+            r.misclassified * 100.0,
+            r.error_vs_soft_reference
+                .map_or("-".to_owned(), |e| format!("{e:.4}"))
+        ));
+    }
+    out
+}
