@@ -361,21 +361,45 @@ fn finish(radiance: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(min(max(radiance, vec3<f32>(0.0)), vec3<f32>(FP16_SAFE_MAX)), 1.0);
 }
 
+const MODEL_PBR: u32 = 0u;
+const MODEL_BLINN_PHONG: u32 = 1u;
+const MODEL_LAMBERT: u32 = 2u;
+const MODEL_TOON: u32 = 3u;
+
+// One light's contribution (BRDF times N.L) for a lighting model.
+fn brdf_times_cosine(model: u32, s: Surface, v: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
+    switch model {
+        case MODEL_PBR: { return pbr_brdf_times_cosine(s, v, l); }
+        case MODEL_BLINN_PHONG: { return blinn_phong_times_cosine(s, v, l); }
+        case MODEL_LAMBERT: { return s.base_color * (max(dot(s.normal, l), 0.0) / PI); }
+        default: { return toon_times_cosine(s, l); }
+    }
+}
+
+// Exposed radiance of a masked pixel under the draw's ambient and lights. Ambient is diffuse:
+// PBR scales it by (1 - metallic), the other models by the base color alone.
+fn shade(model: u32, pixel: vec2<i32>) -> vec4<f32> {
+    let s = load_surface(pixel);
+    let v = safe_normalize(-s.position, s.normal);
+    var radiance = s.base_color * u.ambient.rgb;
+    if model == MODEL_PBR {
+        radiance *= 1.0 - s.metallic;
+    }
+    for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
+        let light = incoming(u.lights[i], s);
+        radiance += brdf_times_cosine(model, s, v, light.direction) * light.radiance
+            * visibility(i, s, light.direction, u.lights[i]);
+    }
+    return finish(radiance);
+}
+
 @fragment
 fn fs_pbr(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let pixel = vec2<i32>(frag.xy);
     if masked(pixel) {
         discard;
     }
-    let s = load_surface(pixel);
-    let v = safe_normalize(-s.position, s.normal);
-    // Uniform ambient: diffuse only (the IBL pass adds specular from an environment).
-    var radiance = s.base_color * (1.0 - s.metallic) * u.ambient.rgb;
-    for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
-        let light = incoming(u.lights[i], s);
-        radiance += pbr_brdf_times_cosine(s, v, light.direction) * light.radiance * visibility(i, s, light.direction, u.lights[i]);
-    }
-    return finish(radiance);
+    return shade(MODEL_PBR, pixel);
 }
 
 @fragment
@@ -384,14 +408,7 @@ fn fs_blinn_phong(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> 
     if masked(pixel) {
         discard;
     }
-    let s = load_surface(pixel);
-    let v = safe_normalize(-s.position, s.normal);
-    var radiance = s.base_color * u.ambient.rgb;
-    for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
-        let light = incoming(u.lights[i], s);
-        radiance += blinn_phong_times_cosine(s, v, light.direction) * light.radiance * visibility(i, s, light.direction, u.lights[i]);
-    }
-    return finish(radiance);
+    return shade(MODEL_BLINN_PHONG, pixel);
 }
 
 @fragment
@@ -400,13 +417,7 @@ fn fs_lambert(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     if masked(pixel) {
         discard;
     }
-    let s = load_surface(pixel);
-    var radiance = s.base_color * u.ambient.rgb;
-    for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
-        let light = incoming(u.lights[i], s);
-        radiance += s.base_color * (max(dot(s.normal, light.direction), 0.0) / PI) * light.radiance * visibility(i, s, light.direction, u.lights[i]);
-    }
-    return finish(radiance);
+    return shade(MODEL_LAMBERT, pixel);
 }
 
 @fragment
@@ -415,13 +426,7 @@ fn fs_toon(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     if masked(pixel) {
         discard;
     }
-    let s = load_surface(pixel);
-    var radiance = s.base_color * u.ambient.rgb;
-    for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
-        let light = incoming(u.lights[i], s);
-        radiance += toon_times_cosine(s, light.direction) * light.radiance * visibility(i, s, light.direction, u.lights[i]);
-    }
-    return finish(radiance);
+    return shade(MODEL_TOON, pixel);
 }
 
 // Debug output: the shadow term of the draw's shadowed light (slot 0), as the passes above use it.

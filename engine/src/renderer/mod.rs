@@ -852,6 +852,24 @@ fn record_and_submit(
             ..SamplerDesc::nearest("shadow compare")
         },
     )?;
+    // Bind group of a lighting-shader draw (`lighting.wgsl` bindings 0..10).
+    let lighting_bind_group = |uniform, mask, shadow_map, shadow_uniform| {
+        let mut bindings = vec![binding(0, BindingResource::Buffer(uniform))];
+        bindings.extend(
+            plan::GBUFFER_TARGETS
+                .iter()
+                .enumerate()
+                .map(|(i, name)| binding(i as u32 + 1, BindingResource::Texture(targets[*name]))),
+        );
+        bindings.extend([
+            binding(6, BindingResource::Texture(mask)),
+            binding(7, BindingResource::Texture(shadow_map)),
+            binding(8, BindingResource::Sampler(shadow_sampler)),
+            binding(9, BindingResource::Buffer(shadow_uniform)),
+            binding(10, BindingResource::Texture(jitter)),
+        ]);
+        bindings
+    };
     let no_shadow_map = scope.texture(
         backend,
         &TextureDesc::d2("no shadow", 1, 1, TextureFormat::Depth32Float),
@@ -919,21 +937,12 @@ fn record_and_submit(
                 BufferUsage::Uniform,
                 bytemuck::cast_slice(&data),
             )?;
-            let mut bindings = vec![binding(0, BindingResource::Buffer(uniform))];
-            bindings.extend(
-                plan::GBUFFER_TARGETS
-                    .iter()
-                    .enumerate()
-                    .map(|(i, name)| binding(i as u32 + 1, BindingResource::Texture(target(name)))),
+            let bindings = lighting_bind_group(
+                uniform,
+                mask_targets[channel.target],
+                *shadow_map,
+                *shadow_uniform,
             );
-            bindings.push(binding(
-                6,
-                BindingResource::Texture(mask_targets[channel.target]),
-            ));
-            bindings.push(binding(7, BindingResource::Texture(*shadow_map)));
-            bindings.push(binding(8, BindingResource::Sampler(shadow_sampler)));
-            bindings.push(binding(9, BindingResource::Buffer(*shadow_uniform)));
-            bindings.push(binding(10, BindingResource::Texture(jitter)));
             draws.push(fullscreen_draw(pipeline, bindings));
         }
         let load = if light_cleared {
@@ -994,18 +1003,8 @@ fn record_and_submit(
                 BufferUsage::Uniform,
                 bytemuck::cast_slice(&data),
             )?;
-            let mut bindings = vec![binding(0, BindingResource::Buffer(uniform))];
-            bindings.extend(
-                plan::GBUFFER_TARGETS
-                    .iter()
-                    .enumerate()
-                    .map(|(i, n)| binding(i as u32 + 1, BindingResource::Texture(target(n)))),
-            );
-            bindings.push(binding(6, BindingResource::Texture(mask_targets[0])));
-            bindings.push(binding(7, BindingResource::Texture(*shadow_map)));
-            bindings.push(binding(8, BindingResource::Sampler(shadow_sampler)));
-            bindings.push(binding(9, BindingResource::Buffer(*shadow_uniform)));
-            bindings.push(binding(10, BindingResource::Texture(jitter)));
+            let bindings =
+                lighting_bind_group(uniform, mask_targets[0], *shadow_map, *shadow_uniform);
             passes.push(RenderPass {
                 name: name.clone(),
                 color_attachments: vec![attachment(target(&name), LoadOp::Clear([0.0; 4]))],
