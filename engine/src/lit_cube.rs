@@ -222,6 +222,7 @@ fn render_with(
             }),
             topology: Topology::TriangleList,
             cull: CullMode::Back,
+            geometry: None,
         },
     )?;
 
@@ -245,7 +246,7 @@ fn render_with(
             subresource: Subresource::default(),
             load: LoadOp::Clear(1.0),
         }),
-        viewport: None,
+        viewports: vec![],
         draws: vec![Draw {
             pipeline,
             bindings: vec![

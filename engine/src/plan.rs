@@ -9,7 +9,7 @@
 use std::fmt;
 
 use crate::backend::TextureFormat;
-use crate::scene::{Light, LightingModel, Scene};
+use crate::scene::{Light, LightingModel, Scene, ShadowFilter};
 
 /// Lights handled by one lighting draw (the size of the uniform array in `lighting.wgsl`).
 pub const MAX_LIGHTS_PER_DRAW: usize = 16;
@@ -32,9 +32,14 @@ pub struct TargetSpec {
 /// What a pass does.
 #[derive(Clone, Debug, PartialEq)]
 pub enum PassKind {
-    /// Draws the shadow casters into the depth map of light `light` (all six faces of a point
-    /// light's atlas in one pass, one viewport per face).
+    /// Draws the shadow casters into the depth map of light `light` (a point light's six atlas
+    /// faces are six passes, one viewport each), and for VSM into its moments too.
     Shadow {
+        /// Index into the scene's lights.
+        light: usize,
+    },
+    /// VSM: one direction of the separable Gaussian blur of light `light`'s moments.
+    ShadowBlur {
         /// Index into the scene's lights.
         light: usize,
     },
@@ -121,6 +126,16 @@ pub fn shadow_target_name(index: usize) -> String {
     format!("shadow_{index}")
 }
 
+/// Name of the VSM moments target of light `index` (filter `vsm` only).
+pub fn shadow_moments_target_name(index: usize) -> String {
+    format!("shadow_{index}_moments")
+}
+
+/// Name of the VSM blur's intermediate target of light `index`.
+pub fn shadow_blur_target_name(index: usize) -> String {
+    format!("shadow_{index}_blur")
+}
+
 /// Name of the shadow-term debug output of light `index`.
 pub fn shadow_term_target_name(index: usize) -> String {
     format!("shadow_term_{index}")
@@ -204,6 +219,9 @@ impl RenderPlan {
         });
         let casters = scene.objects.iter().filter(|o| o.casts_shadows).count();
         let mut shadow_passes = Vec::new();
+        // The shadowed lights, and the maps the lighting passes read.
+        let mut shadowed = Vec::new();
+        let mut shadow_maps = Vec::new();
         for (index, light) in scene.lights.iter().enumerate() {
             let (settings, point) = match light {
                 Light::Directional { shadow, .. } => (shadow, false),
@@ -225,20 +243,63 @@ impl RenderPlan {
                     format!("directional light {index}: orthographic depth fitted to the casters")
                 },
             });
+            shadowed.push(index);
+            shadow_maps.push(name.clone());
+            let mut writes = vec![name.clone()];
+            let vsm = settings.filter == ShadowFilter::Vsm;
+            if vsm {
+                let moments = shadow_moments_target_name(index);
+                targets.push(TargetSpec {
+                    name: moments.clone(),
+                    format: TextureFormat::Rgba16Float,
+                    width: n,
+                    height: n,
+                    contents: format!(
+                        "light {index} VSM moments: depth (r + g), depth^2 (b + a), blurred"
+                    ),
+                });
+                writes.push(moments.clone());
+                shadow_maps.push(moments);
+            }
             shadow_passes.push(PassSpec {
                 name: name.clone(),
                 kind: PassKind::Shadow { light: index },
                 reads: vec![],
-                writes: vec![name],
+                writes,
                 detail: format!(
                     "{casters} casters{}, filter {}, bias {} m, slope {} texels, normal offset {} texels",
-                    if point { " x 6 faces" } else { "" },
+                    if point {
+                        format!(" x 6 faces ({})", scene.quality.point_shadows.name())
+                    } else {
+                        String::new()
+                    },
                     settings.filter.name(),
                     settings.bias,
                     settings.slope_bias,
                     settings.normal_offset
                 ),
             });
+            if vsm && settings.vsm_blur_radius > 0 {
+                let moments = shadow_moments_target_name(index);
+                let blur = shadow_blur_target_name(index);
+                targets.push(TargetSpec {
+                    name: blur.clone(),
+                    format: TextureFormat::Rgba16Float,
+                    width: n,
+                    height: n,
+                    contents: format!("light {index} VSM moments blurred along x"),
+                });
+                let radius = settings.vsm_blur_radius;
+                for (axis, reads, writes) in [("x", &moments, &blur), ("y", &blur, &moments)] {
+                    shadow_passes.push(PassSpec {
+                        name: format!("{name}_blur_{axis}"),
+                        kind: PassKind::ShadowBlur { light: index },
+                        reads: vec![reads.clone()],
+                        writes: vec![writes.clone()],
+                        detail: format!("Gaussian along {axis}, radius {radius} texels"),
+                    });
+                }
+            }
         }
 
         let masks: Vec<String> = (0..mask_targets).map(mask_target_name).collect();
@@ -283,11 +344,6 @@ impl RenderPlan {
                 ),
             });
         }
-        let shadow_maps: Vec<String> = targets
-            .iter()
-            .filter(|t| t.name.starts_with("shadow_"))
-            .map(|t| t.name.clone())
-            .collect();
         for channel in &mask_channels {
             let mut reads = gbuffer.clone();
             reads.push(mask_target_name(channel.target));
@@ -311,8 +367,7 @@ impl RenderPlan {
             });
         }
         if scene.quality.debug_shadow_terms {
-            for map in &shadow_maps {
-                let light: usize = map.trim_start_matches("shadow_").parse().unwrap_or(0);
+            for &light in &shadowed {
                 let name = shadow_term_target_name(light);
                 targets.push(TargetSpec {
                     name: name.clone(),
@@ -322,7 +377,11 @@ impl RenderPlan {
                     contents: format!("debug: light {light}'s shadow term (1 = lit)"),
                 });
                 let mut reads = gbuffer.clone();
-                reads.push(map.clone());
+                reads.push(shadow_target_name(light));
+                let moments = shadow_moments_target_name(light);
+                if shadow_maps.contains(&moments) {
+                    reads.push(moments);
+                }
                 passes.push(PassSpec {
                     name: name.clone(),
                     kind: PassKind::ShadowTerm { light },

@@ -264,6 +264,10 @@ pub enum ShadowFilter {
     /// The converged soft filter: 1024 samples on a Vogel (golden-angle) disk of `soft_radius`
     /// texels, no jitter. The reference the soft filters' error is measured against in sweeps.
     SoftReference,
+    /// Variance shadow maps (the r2 seed; directional lights only): the map stores depth and
+    /// depth squared, blurred by a separable Gaussian, sampled bilinearly, and turned into a
+    /// visibility by Chebyshev's bound with a minimum variance and light-bleeding reduction.
+    Vsm,
 }
 
 impl ShadowFilter {
@@ -275,17 +279,7 @@ impl ShadowFilter {
             ShadowFilter::Soft => "soft",
             ShadowFilter::SoftFull => "soft-full",
             ShadowFilter::SoftReference => "soft-reference",
-        }
-    }
-
-    /// How many texels beyond the centre the filter reads (scales the slope and normal biases).
-    pub fn reach(self, soft_radius: f32) -> f32 {
-        match self {
-            ShadowFilter::Hard => 1.0,
-            ShadowFilter::Pcf3 => 2.0,
-            ShadowFilter::Soft | ShadowFilter::SoftFull | ShadowFilter::SoftReference => {
-                1.0 + soft_radius.max(0.0)
-            }
+            ShadowFilter::Vsm => "vsm",
         }
     }
 }
@@ -309,6 +303,30 @@ pub struct ShadowSettings {
     pub filter: ShadowFilter,
     /// Radius of the soft filters' sample disk, in texels.
     pub soft_radius: f32,
+    /// VSM: radius of the Gaussian blur of the moments, in texels (0: no blur passes).
+    pub vsm_blur_radius: u32,
+    /// VSM: the smallest variance Chebyshev's bound uses, in squared map depth (0..1) units;
+    /// hides the moments' rounding on lit surfaces.
+    pub vsm_min_variance: f32,
+    /// VSM: light-bleeding reduction; visibilities below this are cut to 0 and the rest
+    /// rescaled to 0..1 (0 = off).
+    pub vsm_bleeding_reduction: f32,
+}
+
+impl ShadowSettings {
+    /// How many texels beyond the centre the filter reads (scales the slope and normal biases).
+    pub fn reach(&self) -> f32 {
+        match self.filter {
+            ShadowFilter::Hard => 1.0,
+            ShadowFilter::Pcf3 => 2.0,
+            ShadowFilter::Soft | ShadowFilter::SoftFull | ShadowFilter::SoftReference => {
+                1.0 + self.soft_radius.max(0.0)
+            }
+            // Chebyshev's bound is soft near the mean, so VSM needs only the hard filter's bias
+            // (measured: a larger reach adds peter-panning and no acne goes away).
+            ShadowFilter::Vsm => 1.0,
+        }
+    }
 }
 
 impl Default for ShadowSettings {
@@ -320,6 +338,9 @@ impl Default for ShadowSettings {
             normal_offset: 0.5,
             filter: ShadowFilter::Pcf3,
             soft_radius: 2.5,
+            vsm_blur_radius: 2,
+            vsm_min_variance: 1e-6,
+            vsm_bleeding_reduction: 0.2,
         }
     }
 }
@@ -399,6 +420,28 @@ impl ToneMap {
     }
 }
 
+/// How a point light's six shadow-map faces are drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PointShadowPass {
+    /// Six depth-only passes, one viewport (atlas tile) each: every backend.
+    SixPasses,
+    /// The seed's single pass: a geometry shader emits each caster triangle once per face and
+    /// routes it to that face's viewport (`gl_ViewportIndex`). Backends with geometry shaders
+    /// only (`gl`); the same depth values as six passes.
+    GeometryShader,
+}
+
+impl PointShadowPass {
+    /// Name in scene files and plans.
+    pub fn name(self) -> &'static str {
+        match self {
+            PointShadowPass::SixPasses => "six-passes",
+            PointShadowPass::GeometryShader => "geometry-shader",
+        }
+    }
+}
+
 /// Output size and the knobs that trade time for error.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Quality {
@@ -415,6 +458,8 @@ pub struct Quality {
     /// Debug outputs `shadow_term_<light>`: each shadowed light's shadow term per pixel, as the
     /// lighting pass computes it (for the ray-cast reference).
     pub debug_shadow_terms: bool,
+    /// How point-light shadow faces are drawn (default: six passes, the faster on llvmpipe).
+    pub point_shadows: PointShadowPass,
 }
 
 impl Default for Quality {
@@ -426,6 +471,7 @@ impl Default for Quality {
             tone_map: ToneMap::Aces,
             gizmos: false,
             debug_shadow_terms: false,
+            point_shadows: PointShadowPass::SixPasses,
         }
     }
 }

@@ -126,6 +126,8 @@ pub struct QualitySpec {
     pub gizmos: Option<bool>,
     /// Write `shadow_term_<light>` debug outputs (default false).
     pub debug_shadow_terms: Option<bool>,
+    /// `six-passes` (default) or `geometry-shader` (gl only).
+    pub point_shadows: Option<PointShadowPass>,
 }
 
 /// `[environment]`.
@@ -217,10 +219,16 @@ pub struct ShadowSpec {
     pub slope_bias: Option<f32>,
     /// Normal offset in shadow-map texels.
     pub normal_offset: Option<f32>,
-    /// `hard`, `pcf3` (default), `soft` or `soft-full`.
+    /// `hard`, `pcf3` (default), `soft`, `soft-full`, `soft-reference` or `vsm`.
     pub filter: Option<ShadowFilter>,
     /// Sample-disk radius of the soft filters, in texels (default 2.5).
     pub soft_radius: Option<f32>,
+    /// VSM blur radius in texels (default 2).
+    pub vsm_blur_radius: Option<u32>,
+    /// VSM minimum variance (default 1e-6).
+    pub vsm_min_variance: Option<f32>,
+    /// VSM light-bleeding reduction, 0..1 (default 0.2).
+    pub vsm_bleeding_reduction: Option<f32>,
 }
 
 /// `[[lights]]`.
@@ -293,6 +301,7 @@ impl QualitySpec {
             tone_map: None,
             gizmos: None,
             debug_shadow_terms: None,
+            point_shadows: None,
         }
     }
 }
@@ -497,6 +506,7 @@ impl Resolver {
             tone_map: q.tone_map.unwrap_or(defaults.tone_map),
             gizmos: q.gizmos.unwrap_or(defaults.gizmos),
             debug_shadow_terms: q.debug_shadow_terms.unwrap_or(defaults.debug_shadow_terms),
+            point_shadows: q.point_shadows.unwrap_or(defaults.point_shadows),
         };
         let environment = match &file.environment {
             Some(spec) => {
@@ -602,6 +612,11 @@ impl Resolver {
                         normal_offset: s.normal_offset.unwrap_or(d.normal_offset),
                         filter: s.filter.unwrap_or(d.filter),
                         soft_radius: s.soft_radius.unwrap_or(d.soft_radius),
+                        vsm_blur_radius: s.vsm_blur_radius.unwrap_or(d.vsm_blur_radius),
+                        vsm_min_variance: s.vsm_min_variance.unwrap_or(d.vsm_min_variance),
+                        vsm_bleeding_reduction: s
+                            .vsm_bleeding_reduction
+                            .unwrap_or(d.vsm_bleeding_reduction),
                     }
                 })
             };
@@ -633,18 +648,8 @@ impl Resolver {
                     shadow: shadow(s),
                 },
             };
-            if let Some(s) = match &light {
-                Light::Directional { shadow, .. } | Light::Point { shadow, .. } => shadow,
-            } {
-                let biases = [s.bias, s.slope_bias, s.normal_offset, s.soft_radius];
-                if !(64..=8192).contains(&s.map_size)
-                    || !biases.iter().all(|b| b.is_finite() && *b >= 0.0)
-                {
-                    return Err(self.invalid(format!(
-                        "light {index}: shadow map_size must be 64..8192 and biases finite and \
-                         non-negative"
-                    )));
-                }
+            if let Some(problem) = crate::renderer::shadows::settings_problem(&light) {
+                return Err(self.invalid(format!("light {index}: {problem}")));
             }
             lights.push(light);
         }

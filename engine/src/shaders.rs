@@ -46,6 +46,10 @@ pub const SHADOW: ShaderSource = shader!("shadow.wgsl");
 /// Deferred renderer: axes and light markers over the final image.
 pub const GIZMO: ShaderSource = shader!("gizmo.wgsl");
 
+/// GL-only geometry stage of the single-pass point-light shadow (GLSL: WGSL has no geometry
+/// shaders); pairs with `vs_shadow_object` in `shadow.wgsl`.
+pub const POINT_SHADOW_FACES_GEOMETRY: &str = include_str!("../shaders/gl/point_shadow_faces.geom");
+
 /// Every shader in `engine/shaders/` (a test checks the folder and this list agree).
 pub const ALL: &[ShaderSource] = &[
     LIT_CUBE,

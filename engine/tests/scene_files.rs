@@ -104,6 +104,18 @@ fn bad_values_and_missing_assets_are_errors_naming_the_file() {
     );
     let e = scene_file::load(&path).err().unwrap().to_string();
     assert!(e.contains("nan.toml") && e.contains("finite"), "{e}");
+    let path = write(
+        "vsm.toml",
+        &format!(
+            "{CAMERA}[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\nradius = 5\n\
+             shadow = {{ filter = \"vsm\" }}\n"
+        ),
+    );
+    let e = scene_file::load(&path).err().unwrap().to_string();
+    assert!(
+        e.contains("vsm.toml") && e.contains("light 0") && e.contains("directional"),
+        "{e}"
+    );
     let e = scene_file::load(&dir.path().join("absent.toml"))
         .err()
         .unwrap()

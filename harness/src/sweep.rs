@@ -4,8 +4,8 @@
 //!
 //! - exact hard visibility by ray casting ([`crate::shadow_reference`]): the fraction of
 //!   lit-surface pixels whose term is on the wrong side of 0.5, and the mean absolute difference;
-//! - the converged soft filter (`soft-reference`, 1024 samples) for the soft filters: mean
-//!   absolute difference.
+//! - the converged soft filter (`soft-reference`, 1024 samples) for the soft filters and VSM
+//!   (directional lights only): mean absolute difference.
 
 use engine::backend::{self, BackendKind};
 use engine::plan;
@@ -100,6 +100,15 @@ pub fn shadow_sweep(
         .iter()
         .position(Light::casts_shadows)
         .ok_or_else(|| SweepError::NoShadows(scene.name.clone()))?;
+    let any_point_shadows = scene.lights.iter().any(|l| {
+        matches!(
+            l,
+            Light::Point {
+                shadow: Some(_),
+                ..
+            }
+        )
+    });
     let mut backend = backend::create(kind).map_err(|e| SweepError::Render(e.to_string()))?;
     let term_name = plan::shadow_term_target_name(light);
     let wanted = [
@@ -122,7 +131,11 @@ pub fn shadow_sweep(
             ShadowFilter::Pcf3,
             ShadowFilter::Soft,
             ShadowFilter::SoftFull,
+            ShadowFilter::Vsm,
         ] {
+            if filter == ShadowFilter::Vsm && any_point_shadows {
+                continue; // VSM is for directional lights
+            }
             progress(&format!("{} at {map_size}", filter.name()));
             let mutated = with_shadow(scene, filter, map_size);
             let frames = (0..repeats.max(1))
@@ -131,7 +144,11 @@ pub fn shadow_sweep(
             let frame = &frames[0];
             let visibility = shadow_reference::visibility_error(&mutated, frame, light, 1e-4)
                 .map_err(SweepError::Render)?;
-            let soft = matches!(filter, ShadowFilter::Soft | ShadowFilter::SoftFull).then(|| {
+            let soft = matches!(
+                filter,
+                ShadowFilter::Soft | ShadowFilter::SoftFull | ShadowFilter::Vsm
+            )
+            .then(|| {
                 mean_abs_difference(
                     frame.outputs[&term_name].as_f32().unwrap_or_default(),
                     reference.outputs[&term_name].as_f32().unwrap_or_default(),

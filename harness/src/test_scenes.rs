@@ -56,8 +56,7 @@ fn empty_scene(name: &str, size: u32, camera: Camera) -> Scene {
             height: size,
             exposure: 1.0,
             tone_map: ToneMap::Aces,
-            gizmos: false,
-            debug_shadow_terms: false,
+            ..Quality::default()
         },
     }
 }

@@ -153,6 +153,7 @@ fn probe_pipeline(
             depth: None,
             topology: Topology::TriangleList,
             cull: CullMode::Back,
+            geometry: None,
         })
         .unwrap()
 }
@@ -166,7 +167,7 @@ fn pass(name: &str, target: Handle<Texture>, draw: Draw) -> RenderPass {
             load: LoadOp::Clear([0.0, 0.0, 0.0, 1.0]),
         }],
         depth_attachment: None,
-        viewport: None,
+        viewports: vec![],
         draws: vec![draw],
     }
 }

@@ -53,3 +53,25 @@ fn plans_contain_only_what_the_scene_needs() {
     assert!(five.target("mask_1").is_some());
     assert_eq!(five.mask_channels.len(), 5);
 }
+
+/// Shadow variants: chess's sun with variance shadow maps (moments target, two blur passes) and
+/// arrow's point light drawn in one pass through the geometry shader.
+#[test]
+fn shadow_variant_plans() {
+    let mut chess = harness::load_scene("chess").unwrap().scene;
+    for light in &mut chess.lights {
+        if let engine::scene::Light::Directional {
+            shadow: Some(s), ..
+        } = light
+        {
+            s.filter = engine::scene::ShadowFilter::Vsm;
+        }
+    }
+    insta::assert_snapshot!("plan_chess_vsm", RenderPlan::new(&chess).to_string());
+    let mut arrow = harness::load_scene("arrow").unwrap().scene;
+    arrow.quality.point_shadows = engine::scene::PointShadowPass::GeometryShader;
+    insta::assert_snapshot!(
+        "plan_arrow_geometry_shader",
+        RenderPlan::new(&arrow).to_string()
+    );
+}

@@ -526,6 +526,28 @@ pub struct PipelineDesc {
     pub topology: Topology,
     /// Culling; front faces are counter-clockwise in normalized device coordinates (y up).
     pub cull: CullMode,
+    /// A geometry stage between vertex and fragment; only backends whose
+    /// [`Features::geometry_shaders`] is true accept one (the others return
+    /// [`BackendError::Unsupported`](super::BackendError::Unsupported)).
+    pub geometry: Option<GeometryStage>,
+}
+
+/// A geometry stage. WGSL has none, so it is GLSL 4.50 core, for the GL backend only; it reads
+/// the vertex stage's `gl_Position` and may route primitives with `gl_ViewportIndex`.
+#[derive(Clone, Debug)]
+pub struct GeometryStage {
+    /// File name, for messages.
+    pub name: String,
+    /// GLSL source.
+    pub glsl: String,
+}
+
+/// Optional capabilities of a backend.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Features {
+    /// Geometry stages ([`PipelineDesc::geometry`]) and viewport arrays (passes with more than
+    /// one entry in [`RenderPass::viewports`]).
+    pub geometry_shaders: bool,
 }
 
 /// What happens to an attachment when a pass starts.
@@ -629,8 +651,10 @@ pub struct RenderPass {
     pub color_attachments: Vec<ColorAttachment>,
     /// Depth attachment.
     pub depth_attachment: Option<DepthAttachment>,
-    /// Viewport; `None` covers the whole first attachment.
-    pub viewport: Option<Viewport>,
+    /// Viewports: none covers the whole first attachment; one is the viewport; more are a
+    /// viewport array, chosen per primitive by a geometry stage's `gl_ViewportIndex` (only with
+    /// [`Features::geometry_shaders`]; every entry must share the first one's depth range).
+    pub viewports: Vec<Viewport>,
     /// Draws, in order.
     pub draws: Vec<Draw>,
 }

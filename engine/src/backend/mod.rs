@@ -203,6 +203,8 @@ pub trait Backend {
     fn kind(&self) -> BackendKind;
     /// The driver fingerprint.
     fn info(&self) -> &DriverInfo;
+    /// Optional capabilities.
+    fn features(&self) -> Features;
 
     /// Creates a texture (contents undefined until written or rendered).
     fn create_texture(&mut self, desc: &TextureDesc) -> Result<Handle<Texture>>;

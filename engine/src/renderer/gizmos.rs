@@ -97,6 +97,7 @@ pub(super) fn pass(
             depth: None,
             topology: Topology::LineList,
             cull: CullMode::None,
+            geometry: None,
         },
     )?;
     let uniform = scope.buffer(
@@ -119,7 +120,7 @@ pub(super) fn pass(
             load: LoadOp::Load,
         }],
         depth_attachment: None,
-        viewport: None,
+        viewports: vec![],
         draws: vec![Draw {
             pipeline,
             bindings: vec![Binding {

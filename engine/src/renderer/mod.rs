@@ -287,6 +287,9 @@ pub fn validate(scene: &Scene) -> Result<(), RenderError> {
                  falloff positive"
             )));
         }
+        if let Some(problem) = shadows::settings_problem(light) {
+            return Err(invalid(format!("light {i}: {problem}")));
+        }
     }
     if let Some(env) = &scene.environment {
         if !(env.intensity.is_finite() && env.intensity >= 0.0 && env.rotation_degrees.is_finite())
@@ -339,6 +342,17 @@ struct GpuMesh {
 
 type Outputs = (BTreeMap<String, Image>, Vec<PassTiming>);
 
+/// One lighting draw: up to 16 unshadowed lights, or one shadowed light with its maps.
+struct LightDraw {
+    lights: Vec<uniforms::LightData>,
+    /// The shadowed light's index in the scene, if this draw has one.
+    shadow_light: Option<usize>,
+    shadow_map: Handle<Texture>,
+    /// The VSM moments (a placeholder unless the light's filter is `vsm`).
+    moments: Handle<Texture>,
+    shadow_uniform: Handle<Buffer>,
+}
+
 fn binding(binding: u32, resource: BindingResource) -> Binding {
     Binding { binding, resource }
 }
@@ -389,6 +403,7 @@ fn fullscreen_pipeline(
         depth: None,
         topology: Topology::TriangleList,
         cull: CullMode::None,
+        geometry: None,
     }
 }
 
@@ -589,6 +604,7 @@ fn record_and_submit(
             }),
             topology: Topology::TriangleList,
             cull: CullMode::Back,
+            geometry: None,
         },
     )?;
     let mask_pipeline = scope.pipeline(
@@ -621,6 +637,7 @@ fn record_and_submit(
             }),
             topology: Topology::TriangleList,
             cull: CullMode::Back,
+            geometry: None,
         },
     )?;
     let mut geometry_draws = Vec::new();
@@ -688,7 +705,7 @@ fn record_and_submit(
             subresource: Subresource::default(),
             load: LoadOp::Clear(1.0),
         }),
-        viewport: None,
+        viewports: vec![],
         draws: geometry_draws,
     });
     passes.push(RenderPass {
@@ -702,7 +719,7 @@ fn record_and_submit(
             subresource: Subresource::default(),
             load: LoadOp::Load,
         }),
-        viewport: None,
+        viewports: vec![],
         draws: mask_draws,
     });
 
@@ -772,7 +789,7 @@ fn record_and_submit(
             name: "skybox".to_owned(),
             color_attachments: vec![attachment(light_buffer, LoadOp::Clear([0.0; 4]))],
             depth_attachment: None,
-            viewport: None,
+            viewports: vec![],
             draws: vec![fullscreen_draw(
                 pipeline,
                 vec![
@@ -816,6 +833,11 @@ fn record_and_submit(
                 view: TextureViewKind::D2Array,
             },
         },
+        filterable_texture_layout(11),
+        BindingLayout {
+            binding: 12,
+            kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
+        },
     ]);
     let jitter_layers = (shadows::SOFT_RINGS * shadows::SOFT_SECTORS / 2) as u32;
     let jitter = scope.texture(
@@ -852,8 +874,15 @@ fn record_and_submit(
             ..SamplerDesc::nearest("shadow compare")
         },
     )?;
-    // Bind group of a lighting-shader draw (`lighting.wgsl` bindings 0..10).
-    let lighting_bind_group = |uniform, mask, shadow_map, shadow_uniform| {
+    let moments_sampler = scope.sampler(
+        backend,
+        &SamplerDesc {
+            mipmap_filter: FilterMode::Nearest,
+            ..SamplerDesc::linear("shadow moments", AddressMode::ClampToEdge)
+        },
+    )?;
+    // Bind group of a lighting-shader draw (`lighting.wgsl` bindings 0..12).
+    let lighting_bind_group = |uniform, mask, draw: &LightDraw| {
         let mut bindings = vec![binding(0, BindingResource::Buffer(uniform))];
         bindings.extend(
             plan::GBUFFER_TARGETS
@@ -863,10 +892,12 @@ fn record_and_submit(
         );
         bindings.extend([
             binding(6, BindingResource::Texture(mask)),
-            binding(7, BindingResource::Texture(shadow_map)),
+            binding(7, BindingResource::Texture(draw.shadow_map)),
             binding(8, BindingResource::Sampler(shadow_sampler)),
-            binding(9, BindingResource::Buffer(shadow_uniform)),
+            binding(9, BindingResource::Buffer(draw.shadow_uniform)),
             binding(10, BindingResource::Texture(jitter)),
+            binding(11, BindingResource::Texture(draw.moments)),
+            binding(12, BindingResource::Sampler(moments_sampler)),
         ]);
         bindings
     };
@@ -874,12 +905,23 @@ fn record_and_submit(
         backend,
         &TextureDesc::d2("no shadow", 1, 1, TextureFormat::Depth32Float),
     )?;
+    let no_moments = scope.texture(
+        backend,
+        &TextureDesc::d2("no moments", 1, 1, TextureFormat::Rgba16Float),
+    )?;
     let no_shadow_uniform = scope.buffer(
         backend,
         "no shadow uniforms",
         BufferUsage::Uniform,
         bytemuck::cast_slice(&shadows::shadow_uniforms(None)),
     )?;
+    let unshadowed = |lights: Vec<uniforms::LightData>| LightDraw {
+        lights,
+        shadow_light: None,
+        shadow_map: no_shadow_map,
+        moments: no_moments,
+        shadow_uniform: no_shadow_uniform,
+    };
     // Lighting draws: unshadowed lights 16 to a draw, then one draw per shadowed light.
     let mut shadowed_draws = Vec::new();
     for view in &views {
@@ -889,11 +931,14 @@ fn record_and_submit(
             BufferUsage::Uniform,
             bytemuck::cast_slice(&shadows::shadow_uniforms(Some(view))),
         )?;
-        shadowed_draws.push((
-            vec![lights[view.light]],
-            targets[&plan::shadow_target_name(view.light)],
-            uniform,
-        ));
+        let moments = plan::shadow_moments_target_name(view.light);
+        shadowed_draws.push(LightDraw {
+            lights: vec![lights[view.light]],
+            shadow_light: Some(view.light),
+            shadow_map: targets[&plan::shadow_target_name(view.light)],
+            moments: targets.get(&moments).copied().unwrap_or(no_moments),
+            shadow_uniform: uniform,
+        });
     }
     let plain: Vec<uniforms::LightData> = lights
         .iter()
@@ -901,13 +946,13 @@ fn record_and_submit(
         .filter(|(i, _)| !views.iter().any(|v| v.light == *i))
         .map(|(_, l)| *l)
         .collect();
-    let mut light_draws: Vec<(Vec<uniforms::LightData>, Handle<Texture>, Handle<Buffer>)> = plain
+    let mut light_draws: Vec<LightDraw> = plain
         .chunks(MAX_LIGHTS_PER_DRAW)
-        .map(|c| (c.to_vec(), no_shadow_map, no_shadow_uniform))
+        .map(|c| unshadowed(c.to_vec()))
         .collect();
     light_draws.extend(shadowed_draws);
     if light_draws.is_empty() {
-        light_draws.push((vec![], no_shadow_map, no_shadow_uniform));
+        light_draws.push(unshadowed(vec![]));
     }
     for channel in &plan.mask_channels {
         let model = channel.model;
@@ -922,27 +967,22 @@ fn record_and_submit(
                 Some(BlendState::ADDITIVE),
             ),
         )?;
-        let unlit_draw = [(vec![], no_shadow_map, no_shadow_uniform)];
+        let unlit_draw = [unshadowed(vec![])];
         let batches = if model == LightingModel::Unlit {
             &unlit_draw[..]
         } else {
             &light_draws[..]
         };
         let mut draws = Vec::new();
-        for (index, (batch, shadow_map, shadow_uniform)) in batches.iter().enumerate() {
-            let data = uniforms::lighting_uniforms(scene, *channel, batch, index == 0);
+        for (index, draw) in batches.iter().enumerate() {
+            let data = uniforms::lighting_uniforms(scene, *channel, &draw.lights, index == 0);
             let uniform = scope.buffer(
                 backend,
                 &format!("lighting {model} batch {index}"),
                 BufferUsage::Uniform,
                 bytemuck::cast_slice(&data),
             )?;
-            let bindings = lighting_bind_group(
-                uniform,
-                mask_targets[channel.target],
-                *shadow_map,
-                *shadow_uniform,
-            );
+            let bindings = lighting_bind_group(uniform, mask_targets[channel.target], draw);
             draws.push(fullscreen_draw(pipeline, bindings));
         }
         let load = if light_cleared {
@@ -959,7 +999,7 @@ fn record_and_submit(
                 .map_or_else(|| format!("lighting_{model}"), |p| p.name.clone()),
             color_attachments: vec![attachment(light_buffer, load)],
             depth_attachment: None,
-            viewport: None,
+            viewports: vec![],
             draws,
         });
     }
@@ -969,7 +1009,7 @@ fn record_and_submit(
             name: "clear_light".to_owned(),
             color_attachments: vec![attachment(light_buffer, LoadOp::Clear([0.0; 4]))],
             depth_attachment: None,
-            viewport: None,
+            viewports: vec![],
             draws: vec![],
         });
     }
@@ -989,27 +1029,26 @@ fn record_and_submit(
         )?;
         for view in &views {
             let name = plan::shadow_term_target_name(view.light);
-            let Some((batch, shadow_map, shadow_uniform)) = light_draws
+            let Some(draw) = light_draws
                 .iter()
-                .find(|(_, map, _)| *map == targets[&plan::shadow_target_name(view.light)])
+                .find(|d| d.shadow_light == Some(view.light))
             else {
                 continue;
             };
             let channel = plan.mask_channels[0];
-            let data = uniforms::lighting_uniforms(scene, channel, batch, false);
+            let data = uniforms::lighting_uniforms(scene, channel, &draw.lights, false);
             let uniform = scope.buffer(
                 backend,
                 &format!("{name} uniforms"),
                 BufferUsage::Uniform,
                 bytemuck::cast_slice(&data),
             )?;
-            let bindings =
-                lighting_bind_group(uniform, mask_targets[0], *shadow_map, *shadow_uniform);
+            let bindings = lighting_bind_group(uniform, mask_targets[0], draw);
             passes.push(RenderPass {
                 name: name.clone(),
                 color_attachments: vec![attachment(target(&name), LoadOp::Clear([0.0; 4]))],
                 depth_attachment: None,
-                viewport: None,
+                viewports: vec![],
                 draws: vec![fullscreen_draw(pipeline, bindings)],
             });
         }
@@ -1043,7 +1082,7 @@ fn record_and_submit(
         name: "tonemap".to_owned(),
         color_attachments: vec![attachment(target(plan::FINAL), LoadOp::Clear([0.0; 4]))],
         depth_attachment: None,
-        viewport: None,
+        viewports: vec![],
         draws: vec![fullscreen_draw(
             tonemap_pipeline,
             vec![

@@ -4,14 +4,59 @@
 //!
 //! Everything is camera-relative and computed in f64, like the rest of the renderer.
 
-use glam::{DMat4, DVec3, Mat4};
+use glam::{DMat4, DVec3};
 
 use crate::backend::*;
 use crate::plan;
-use crate::scene::{Light, Scene, ShadowFilter, ShadowSettings};
+use crate::scene::{Light, PointShadowPass, Scene, ShadowFilter, ShadowSettings};
 use crate::shaders;
 
 use super::GpuMesh;
+
+/// What is wrong with a light's shadow settings, if anything: map size 64..8192, biases and
+/// radii finite and non-negative, VSM only on directional lights with its blur radius at most 16
+/// texels and its light-bleeding reduction below 1.
+pub fn settings_problem(light: &Light) -> Option<String> {
+    let (Light::Directional {
+        shadow: Some(s), ..
+    }
+    | Light::Point {
+        shadow: Some(s), ..
+    }) = light
+    else {
+        return None;
+    };
+    let values = [
+        s.bias,
+        s.slope_bias,
+        s.normal_offset,
+        s.soft_radius,
+        s.vsm_min_variance,
+        s.vsm_bleeding_reduction,
+    ];
+    if !(64..=8192).contains(&s.map_size) || !values.iter().all(|b| b.is_finite() && *b >= 0.0) {
+        return Some(
+            "shadow map_size must be 64..8192 and biases, radii and VSM settings finite and \
+             non-negative"
+                .to_owned(),
+        );
+    }
+    if s.filter == ShadowFilter::Vsm {
+        if matches!(light, Light::Point { .. }) {
+            return Some(
+                "filter `vsm` is for directional lights; point lights take hard, pcf3 or soft"
+                    .to_owned(),
+            );
+        }
+        if s.vsm_blur_radius > 16 || s.vsm_bleeding_reduction >= 1.0 {
+            return Some(format!(
+                "vsm_blur_radius {} must be at most 16 and vsm_bleeding_reduction {} below 1",
+                s.vsm_blur_radius, s.vsm_bleeding_reduction
+            ));
+        }
+    }
+    None
+}
 
 /// A light's shadow-map views.
 #[derive(Clone, Debug)]
@@ -142,9 +187,9 @@ pub fn shadow_views(scene: &Scene) -> Vec<ShadowView> {
 
 /// `ShadowUniforms` of `lighting.wgsl` for a view (or the "no shadow" block), as floats.
 pub fn shadow_uniforms(view: Option<&ShadowView>) -> Vec<f32> {
-    let mut data = Vec::with_capacity(6 * 16 + 12);
+    let mut data = Vec::with_capacity(6 * 16 + 16);
     let Some(view) = view else {
-        data.resize(6 * 16 + 12, 0.0);
+        data.resize(6 * 16 + 16, 0.0);
         return data;
     };
     for face in 0..6 {
@@ -170,12 +215,14 @@ pub fn shadow_uniforms(view: Option<&ShadowView>) -> Vec<f32> {
             ShadowFilter::Soft => 2.0,
             ShadowFilter::SoftFull => 3.0,
             ShadowFilter::SoftReference => 4.0,
+            ShadowFilter::Vsm => 5.0,
         },
         1.0 / w as f32,
         1.0 / h as f32,
         view.texel_world as f32,
     ]);
-    data.extend_from_slice(&[s.soft_radius, s.filter.reach(s.soft_radius), 0.0, 0.0]);
+    data.extend_from_slice(&[s.soft_radius, s.reach(), 0.0, 0.0]);
+    data.extend_from_slice(&[s.vsm_min_variance, s.vsm_bleeding_reduction, 0.0, 0.0]);
     data
 }
 
@@ -244,49 +291,121 @@ pub(super) fn record(
             wgsl: shaders::SHADOW.wgsl.to_owned(),
         },
     )?;
-    let pipeline = scope.pipeline(
-        backend,
-        &PipelineDesc {
-            label: "shadow".to_owned(),
-            shader,
-            vertex_entry: "vs_shadow".to_owned(),
-            fragment_entry: None,
-            vertex_buffers: vec![VertexBufferLayout {
-                stride: std::mem::size_of::<crate::mesh::Vertex>() as u32,
-                attributes: vec![VertexAttribute {
-                    location: 0,
-                    format: VertexFormat::Float32x3,
-                    offset: 0,
-                }],
+    let caster_pipeline = |moments: bool| PipelineDesc {
+        label: if moments { "shadow moments" } else { "shadow" }.to_owned(),
+        shader,
+        vertex_entry: "vs_shadow".to_owned(),
+        fragment_entry: moments.then(|| "fs_shadow_moments".to_owned()),
+        vertex_buffers: vec![VertexBufferLayout {
+            stride: std::mem::size_of::<crate::mesh::Vertex>() as u32,
+            attributes: vec![VertexAttribute {
+                location: 0,
+                format: VertexFormat::Float32x3,
+                offset: 0,
             }],
-            bindings: vec![BindingLayout {
-                binding: 0,
-                kind: BindingKind::UniformBuffer,
-            }],
-            color_targets: vec![],
-            depth: Some(DepthState {
-                format: TextureFormat::Depth32Float,
-                write: true,
-                compare: CompareFunction::Less,
-            }),
-            topology: Topology::TriangleList,
-            cull: CullMode::None,
+        }],
+        bindings: vec![BindingLayout {
+            binding: 0,
+            kind: BindingKind::UniformBuffer,
+        }],
+        color_targets: if moments {
+            vec![ColorTarget {
+                format: TextureFormat::Rgba16Float,
+                blend: None,
+            }]
+        } else {
+            vec![]
         },
-    )?;
+        depth: Some(DepthState {
+            format: TextureFormat::Depth32Float,
+            write: true,
+            compare: CompareFunction::Less,
+        }),
+        topology: Topology::TriangleList,
+        cull: CullMode::None,
+        geometry: None,
+    };
+    let depth_pipeline = scope.pipeline(backend, &caster_pipeline(false))?;
+    let layered_pipeline = if scene.quality.point_shadows == PointShadowPass::GeometryShader
+        && views.iter().any(|v| v.point)
+    {
+        let desc = PipelineDesc {
+            label: "shadow six faces".to_owned(),
+            vertex_entry: "vs_shadow_object".to_owned(),
+            geometry: Some(GeometryStage {
+                name: "gl/point_shadow_faces.geom".to_owned(),
+                glsl: shaders::POINT_SHADOW_FACES_GEOMETRY.to_owned(),
+            }),
+            ..caster_pipeline(false)
+        };
+        Some(scope.pipeline(backend, &desc)?)
+    } else {
+        None
+    };
+    let vsm = |view: &ShadowView| view.settings.filter == ShadowFilter::Vsm;
+    let (moments_pipeline, blur_pipeline) = if views.iter().any(vsm) {
+        let blur = super::fullscreen_pipeline(
+            "shadow moments blur",
+            shader,
+            "fs_moments_blur",
+            vec![
+                BindingLayout {
+                    binding: 1,
+                    kind: BindingKind::UniformBuffer,
+                },
+                super::texture_layout(2),
+            ],
+            TextureFormat::Rgba16Float,
+            None,
+        );
+        (
+            Some(scope.pipeline(backend, &caster_pipeline(true))?),
+            Some(scope.pipeline(backend, &blur)?),
+        )
+    } else {
+        (None, None)
+    };
     const FACE_NAMES: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
     for view in views {
         let name = plan::shadow_target_name(view.light);
         let texture = targets(&name);
-        for (face, matrix) in view.faces.iter().enumerate() {
+        let (pipeline, color_attachments) = match moments_pipeline.filter(|_| vsm(view)) {
+            Some(pipeline) => (
+                pipeline,
+                vec![ColorAttachment {
+                    texture: targets(&plan::shadow_moments_target_name(view.light)),
+                    subresource: Subresource::default(),
+                    // Where no caster is drawn: depth 1 (the far plane), no variance.
+                    load: LoadOp::Clear([1.0, 0.0, 1.0, 0.0]),
+                }],
+            ),
+            None => (depth_pipeline, vec![]),
+        };
+        // Which faces each pass draws: one each, or all six through the geometry stage.
+        let single_pass =
+            view.point && scene.quality.point_shadows == PointShadowPass::GeometryShader;
+        let groups: Vec<Vec<usize>> = if single_pass {
+            vec![(0..view.faces.len()).collect()]
+        } else {
+            (0..view.faces.len()).map(|face| vec![face]).collect()
+        };
+        let pipeline = match layered_pipeline.filter(|_| single_pass) {
+            Some(layered) => layered,
+            None => pipeline,
+        };
+        for (group_index, faces) in groups.iter().enumerate() {
             let mut draws = Vec::new();
             for object in scene.objects.iter().filter(|o| o.casts_shadows) {
                 let model = object.transform.relative_to(scene.camera.position);
-                let mvp: Mat4 = (*matrix * model).as_mat4();
+                let matrices: Vec<f32> = faces
+                    .iter()
+                    .flat_map(|&face| (view.faces[face] * model).as_mat4().to_cols_array())
+                    .collect();
                 let uniform = scope.buffer(
                     backend,
-                    &format!("{name} {} face {face}", object.name),
+                    &format!("{name} {} faces {faces:?}", object.name),
                     BufferUsage::Uniform,
-                    bytemuck::cast_slice(&mvp.to_cols_array()),
+                    bytemuck::cast_slice(&matrices),
                 )?;
                 let mesh = meshes(object);
                 draws.push(Draw {
@@ -300,38 +419,91 @@ pub(super) fn record(
                     count: mesh.count,
                 });
             }
-            let (x, y) = if view.point {
-                ((face % 3) as u32 * view.size, (face / 3) as u32 * view.size)
-            } else {
-                (0, 0)
-            };
+            let viewports = faces
+                .iter()
+                .map(|&face| {
+                    let (x, y) = if view.point {
+                        ((face % 3) as u32 * view.size, (face / 3) as u32 * view.size)
+                    } else {
+                        (0, 0)
+                    };
+                    Viewport {
+                        x: x as f32,
+                        y: y as f32,
+                        width: view.size as f32,
+                        height: view.size as f32,
+                        min_depth: 0.0,
+                        max_depth: 1.0,
+                    }
+                })
+                .collect();
             passes.push(RenderPass {
-                name: if view.point {
-                    format!("{name}{}", FACE_NAMES[face])
+                name: if view.point && !single_pass {
+                    format!("{name}{}", FACE_NAMES[faces[0]])
                 } else {
                     name.clone()
                 },
-                color_attachments: vec![],
+                color_attachments: color_attachments.clone(),
                 depth_attachment: Some(DepthAttachment {
                     texture,
                     subresource: Subresource::default(),
-                    load: if face == 0 {
+                    load: if group_index == 0 {
                         LoadOp::Clear(1.0)
                     } else {
                         LoadOp::Load
                     },
                 }),
-                viewport: Some(Viewport {
-                    x: x as f32,
-                    y: y as f32,
-                    width: view.size as f32,
-                    height: view.size as f32,
-                    min_depth: 0.0,
-                    max_depth: 1.0,
-                }),
+                viewports,
                 draws,
             });
         }
+        if let Some(blur_pipeline) = blur_pipeline.filter(|_| vsm(view)) {
+            record_moments_blur(backend, scope, view, blur_pipeline, targets, passes)?;
+        }
+    }
+    Ok(())
+}
+
+/// The separable Gaussian blur of a VSM light's moments: along x into the intermediate target,
+/// then along y back into the moments.
+fn record_moments_blur(
+    backend: &mut dyn Backend,
+    scope: &mut ResourceScope,
+    view: &ShadowView,
+    pipeline: Handle<Pipeline>,
+    targets: &dyn Fn(&str) -> Handle<Texture>,
+    passes: &mut Vec<RenderPass>,
+) -> Result<()> {
+    let radius = view.settings.vsm_blur_radius;
+    if radius == 0 {
+        return Ok(());
+    }
+    let name = plan::shadow_target_name(view.light);
+    let moments = targets(&plan::shadow_moments_target_name(view.light));
+    let blurred_x = targets(&plan::shadow_blur_target_name(view.light));
+    for (axis, step, source, destination) in [
+        ("x", [1.0f32, 0.0], moments, blurred_x),
+        ("y", [0.0, 1.0], blurred_x, moments),
+    ] {
+        let uniform = scope.buffer(
+            backend,
+            &format!("{name} blur {axis}"),
+            BufferUsage::Uniform,
+            bytemuck::cast_slice(&[step[0], step[1], radius as f32, 0.0]),
+        )?;
+        passes.push(RenderPass {
+            name: format!("{name}_blur_{axis}"),
+            color_attachments: vec![super::attachment(destination, LoadOp::Clear([0.0; 4]))],
+            depth_attachment: None,
+            viewports: vec![],
+            draws: vec![super::fullscreen_draw(
+                pipeline,
+                vec![
+                    super::binding(1, BindingResource::Buffer(uniform)),
+                    super::binding(2, BindingResource::Texture(source)),
+                ],
+            )],
+        });
     }
     Ok(())
 }

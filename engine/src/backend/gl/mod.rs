@@ -417,15 +417,28 @@ impl GlBackend {
                 if let Some((begin, _)) = queries {
                     gl.query_counter(begin, glow::TIMESTAMP);
                 }
-                let v = pass.viewport.unwrap_or(Viewport {
+                let whole = [Viewport {
                     x: 0.0,
                     y: 0.0,
                     width: width as f32,
                     height: height as f32,
                     min_depth: 0.0,
                     max_depth: 1.0,
-                });
-                gl.viewport_f32_slice(0, 1, &[[v.x, v.y, v.width, v.height]]);
+                }];
+                let viewports = if pass.viewports.is_empty() {
+                    &whole[..]
+                } else {
+                    &pass.viewports[..]
+                };
+                let rects: Vec<[f32; 4]> = viewports
+                    .iter()
+                    .map(|v| [v.x, v.y, v.width, v.height])
+                    .collect();
+                // glViewport and glDepthRange set every viewport of the array; the array call
+                // then sets the first `len` rectangles.
+                let v = viewports[0];
+                gl.viewport(v.x as i32, v.y as i32, v.width as i32, v.height as i32);
+                gl.viewport_f32_slice(0, rects.len() as i32, &rects);
                 gl.depth_range_f32(v.min_depth, v.max_depth);
                 gl.disable(glow::SCISSOR_TEST);
                 for (index, attachment) in pass.color_attachments.iter().enumerate() {
@@ -468,6 +481,13 @@ impl Backend for GlBackend {
 
     fn info(&self) -> &DriverInfo {
         &self.info
+    }
+
+    fn features(&self) -> Features {
+        // OpenGL 4.5 core has geometry shaders (3.2) and viewport arrays (4.1).
+        Features {
+            geometry_shaders: true,
+        }
     }
 
     fn create_texture(&mut self, desc: &TextureDesc) -> Result<Handle<Texture>> {
@@ -719,9 +739,26 @@ impl Backend for GlBackend {
             .collect();
         sampler_units.sort();
         sampler_units.dedup();
+        let mut sources: Vec<(u32, String, &str)> = stages
+            .iter()
+            .map(|(stage, entry, glsl)| {
+                (
+                    *stage,
+                    format!("{}::{entry}", module.name),
+                    glsl.source.as_str(),
+                )
+            })
+            .collect();
+        if let Some(geometry) = &desc.geometry {
+            sources.push((
+                glow::GEOMETRY_SHADER,
+                geometry.name.clone(),
+                geometry.glsl.as_str(),
+            ));
+        }
         let mut compiled = Vec::new();
-        for (stage, entry, glsl) in &stages {
-            match self.compile(*stage, &format!("{}::{entry}", module.name), &glsl.source) {
+        for (stage, name, source) in &sources {
+            match self.compile(*stage, name, source) {
                 Ok(shader) => compiled.push(shader),
                 Err(e) => {
                     // SAFETY: see module docs; these shaders were created above.

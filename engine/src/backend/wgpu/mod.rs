@@ -408,6 +408,10 @@ impl Backend for WgpuBackend {
         &self.info
     }
 
+    fn features(&self) -> Features {
+        Features::default()
+    }
+
     fn create_texture(&mut self, desc: &TextureDesc) -> Result<Handle<Texture>> {
         check_texture_desc(desc)?;
         let texture = self.scoped(&format!("texture `{}`", desc.label), || {
@@ -556,6 +560,16 @@ impl Backend for WgpuBackend {
     }
 
     fn create_pipeline(&mut self, desc: &PipelineDesc) -> Result<Handle<Pipeline>> {
+        if let Some(geometry) = &desc.geometry {
+            return Err(BackendError::Unsupported {
+                backend: self.kind.name(),
+                what: format!("pipeline `{}`", desc.label),
+                message: format!(
+                    "geometry stage `{}`: wgpu has no geometry shaders (use the gl backend)",
+                    geometry.name
+                ),
+            });
+        }
         let module = self.shaders.get(desc.shader)?;
         let context = format!("pipeline `{}`", desc.label);
         let entries: Vec<wgpu::BindGroupLayoutEntry> = desc
@@ -683,6 +697,13 @@ impl Backend for WgpuBackend {
         }
         let mut prepared = Vec::with_capacity(passes.len());
         for pass in passes {
+            if pass.viewports.len() > 1 {
+                return Err(BackendError::Unsupported {
+                    backend: self.kind.name(),
+                    what: format!("pass `{}`", pass.name),
+                    message: "viewport arrays need a geometry stage, which wgpu lacks".to_owned(),
+                });
+            }
             let colors = pass
                 .color_attachments
                 .iter()
@@ -790,7 +811,7 @@ impl Backend for WgpuBackend {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                if let Some(v) = pass.viewport {
+                if let Some(v) = pass.viewports.first() {
                     render_pass.set_viewport(v.x, v.y, v.width, v.height, v.min_depth, v.max_depth);
                 }
                 for (draw, bind_group) in pass.draws.iter().zip(&views.bind_groups) {
