@@ -31,11 +31,13 @@ fn fs_shadow_moments(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f3
     return split_moments(vec2<f32>(depth, depth * depth));
 }
 
-// One direction of the separable Gaussian blur of the moments (sigma = radius / 2, taps clamped
-// to the map's edge), as a full-screen draw.
+// One direction of the separable Gaussian blur of the moments (taps clamped to the map's edge),
+// as a full-screen draw. The normalized weights come from the CPU (`shadows::blur_weights`).
 struct MomentsBlur {
-    // xy = texel step (1, 0) or (0, 1); z = radius in texels.
+    // xy = texel step (1, 0) or (0, 1); z = radius in texels (at most 16).
     step: vec4<f32>,
+    // Weight of the taps at distance 0..16, four to a vector.
+    weights: array<vec4<f32>, 5>,
 }
 
 @group(0) @binding(1) var<uniform> moments_blur: MomentsBlur;
@@ -53,16 +55,14 @@ fn fs_moments_blur(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32>
     let center = vec2<i32>(frag.xy);
     let step = vec2<i32>(moments_blur.step.xy);
     let radius = i32(moments_blur.step.z);
-    let sigma = max(f32(radius) * 0.5, 0.5);
     var sum = vec2<f32>(0.0);
-    var weights = 0.0;
     for (var k = -radius; k <= radius; k++) {
         let texel = textureLoad(moments_source, clamp(center + step * k, vec2<i32>(0), size - 1), 0);
-        let w = exp(-0.5 * f32(k * k) / (sigma * sigma));
+        let distance = u32(abs(k));
+        let w = moments_blur.weights[distance / 4u][distance % 4u];
         sum += w * vec2<f32>(texel.r + texel.g, texel.b + texel.a);
-        weights += w;
     }
-    return split_moments(sum / weights);
+    return split_moments(sum);
 }
 
 // The single-pass point-light path (gl only): object-space positions pass through to the

@@ -233,11 +233,17 @@ pub const SOFT_RINGS: usize = 4;
 /// Size of the per-pixel jitter tile (pixels are mapped to it modulo this size).
 pub const JITTER_TILE: u32 = 32;
 
+/// The jitter texture's texels ([`compute_jitter_texels`]), computed once per process.
+pub fn jitter_texels() -> &'static [u16] {
+    static TEXELS: std::sync::OnceLock<Vec<u16>> = std::sync::OnceLock::new();
+    TEXELS.get_or_init(compute_jitter_texels)
+}
+
 /// The jitter texture of the stratified soft filter: a `JITTER_TILE`-square 2D array with one
 /// layer per pair of samples (8 layers); layer `2r + k` holds samples `2k` and `2k + 1` of ring
 /// `r` (ring 3 is the outer one) as (x, y, x, y) offsets in the unit disk. Each sample lies in
 /// its own ring x sector cell, jittered by a fixed-seed PCG hash: deterministic.
-pub fn jitter_texels() -> Vec<u16> {
+pub fn compute_jitter_texels() -> Vec<u16> {
     let layers = SOFT_RINGS * SOFT_SECTORS / 2;
     let tile = JITTER_TILE as usize;
     let mut out = Vec::with_capacity(layers * tile * tile * 4);
@@ -464,6 +470,19 @@ pub(super) fn record(
     Ok(())
 }
 
+/// Weights of the VSM blur's taps at distance 0..=16 texels (20 floats, zero past `radius`): a
+/// Gaussian with sigma = radius / 2, normalized so the 2 radius + 1 taps sum to 1.
+pub fn blur_weights(radius: u32) -> Vec<f32> {
+    let sigma = (f64::from(radius) * 0.5).max(0.5);
+    let raw: Vec<f64> = (0..=radius.min(16))
+        .map(|k| (-0.5 * f64::from(k * k) / (sigma * sigma)).exp())
+        .collect();
+    let total: f64 = raw[0] + 2.0 * raw[1..].iter().sum::<f64>();
+    let mut weights: Vec<f32> = raw.iter().map(|w| (w / total) as f32).collect();
+    weights.resize(20, 0.0);
+    weights
+}
+
 /// The separable Gaussian blur of a VSM light's moments: along x into the intermediate target,
 /// then along y back into the moments.
 fn record_moments_blur(
@@ -485,11 +504,13 @@ fn record_moments_blur(
         ("x", [1.0f32, 0.0], moments, blurred_x),
         ("y", [0.0, 1.0], blurred_x, moments),
     ] {
+        let mut data = vec![step[0], step[1], radius as f32, 0.0];
+        data.extend(blur_weights(radius));
         let uniform = scope.buffer(
             backend,
             &format!("{name} blur {axis}"),
             BufferUsage::Uniform,
-            bytemuck::cast_slice(&[step[0], step[1], radius as f32, 0.0]),
+            bytemuck::cast_slice(&data),
         )?;
         passes.push(RenderPass {
             name: format!("{name}_blur_{axis}"),
@@ -523,5 +544,60 @@ impl From<&GpuMesh> for GpuMeshRef {
             indices: m.indices,
             count: m.count,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blur_weights_are_a_normalized_decreasing_gaussian() {
+        for radius in [1u32, 2, 5, 16] {
+            let w = blur_weights(radius);
+            assert_eq!(w.len(), 20);
+            let r = radius as usize;
+            let total: f32 = w[0] + 2.0 * w[1..=r].iter().sum::<f32>();
+            assert!((total - 1.0).abs() < 1e-6, "radius {radius}: sum {total}");
+            assert!(w[..=r].windows(2).all(|p| p[0] > p[1]), "radius {radius}");
+            assert!(w[r + 1..].iter().all(|&x| x == 0.0));
+        }
+    }
+
+    #[test]
+    fn vsm_is_refused_on_point_lights_and_checked_for_range() {
+        let point = |settings: ShadowSettings| Light::Point {
+            position: DVec3::ZERO,
+            color: [1.0; 3],
+            intensity: 1.0,
+            radius: 1.0,
+            falloff: 1.0,
+            shadow: Some(settings),
+        };
+        let vsm = ShadowSettings {
+            filter: ShadowFilter::Vsm,
+            ..ShadowSettings::default()
+        };
+        assert!(settings_problem(&point(vsm))
+            .unwrap()
+            .contains("directional"));
+        assert!(settings_problem(&point(ShadowSettings::default())).is_none());
+        let directional = |settings: ShadowSettings| Light::Directional {
+            direction: DVec3::Y,
+            color: [1.0; 3],
+            intensity: 1.0,
+            shadow: Some(settings),
+        };
+        assert!(settings_problem(&directional(vsm)).is_none());
+        let wide = ShadowSettings {
+            vsm_blur_radius: 17,
+            ..vsm
+        };
+        assert!(settings_problem(&directional(wide)).is_some());
+        let nan = ShadowSettings {
+            vsm_min_variance: f32::NAN,
+            ..vsm
+        };
+        assert!(settings_problem(&directional(nan)).is_some());
     }
 }
