@@ -84,6 +84,48 @@ impl MeshData {
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
     }
+
+    /// The same surface with four times the triangles: each triangle split at its edge
+    /// midpoints (attributes interpolated linearly, normals and tangents renormalized; midpoints
+    /// are not shared between triangles). For benchmarks of triangle cost.
+    pub fn subdivided(&self) -> MeshData {
+        let mut vertices = Vec::with_capacity(self.indices.len() * 2);
+        let mut indices = Vec::with_capacity(self.indices.len() * 4);
+        let midpoint = |a: &Vertex, b: &Vertex| {
+            let mix = |x: &[f32], y: &[f32]| -> Vec<f32> {
+                x.iter().zip(y).map(|(x, y)| 0.5 * (x + y)).collect()
+            };
+            let normal = Vec3::from_slice(&mix(&a.normal, &b.normal)).normalize_or_zero();
+            let tangent =
+                Vec3::from_slice(&mix(&a.tangent[..3], &b.tangent[..3])).normalize_or_zero();
+            let p = mix(&a.position, &b.position);
+            let uv = mix(&a.uv, &b.uv);
+            Vertex {
+                position: [p[0], p[1], p[2]],
+                normal: normal.into(),
+                uv: [uv[0], uv[1]],
+                tangent: [tangent.x, tangent.y, tangent.z, a.tangent[3]],
+            }
+        };
+        for triangle in self.indices.chunks_exact(3) {
+            let [a, b, c] = [0, 1, 2].map(|i| self.vertices[triangle[i] as usize]);
+            let base = vertices.len() as u32;
+            vertices.extend([
+                a,
+                b,
+                c,
+                midpoint(&a, &b),
+                midpoint(&b, &c),
+                midpoint(&c, &a),
+            ]);
+            let [ia, ib, ic, iab, ibc, ica] = [0, 1, 2, 3, 4, 5].map(|i| base + i);
+            indices.extend([ia, iab, ica, iab, ib, ibc, ica, ibc, ic, iab, ibc, ica]);
+        }
+        MeshData {
+            material: self.material,
+            ..MeshData::new(&self.name, vertices, indices)
+        }
+    }
 }
 
 /// A UV sphere of radius 1 at the origin: `segments` around, `rings` from pole to pole, with the

@@ -46,6 +46,9 @@ pub const SHADOW: ShaderSource = shader!("shadow.wgsl");
 /// Deferred renderer: axes and light markers over the final image.
 pub const GIZMO: ShaderSource = shader!("gizmo.wgsl");
 
+/// Benchmarks: floor passes (constants written to a pass's attachments, 1 to 5 color targets).
+pub const FLOOR: ShaderSource = shader!("floor.wgsl");
+
 /// GL-only geometry stage of the single-pass point-light shadow (GLSL: WGSL has no geometry
 /// shaders); pairs with `vs_shadow_object` in `shadow.wgsl`.
 pub const POINT_SHADOW_FACES_GEOMETRY: &str = include_str!("../shaders/gl/point_shadow_faces.geom");
@@ -61,6 +64,7 @@ pub const ALL: &[ShaderSource] = &[
     TONEMAP,
     GIZMO,
     SHADOW,
+    FLOOR,
 ];
 
 /// A shader that failed to parse, validate or translate.

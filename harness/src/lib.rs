@@ -1,6 +1,7 @@
 //! The harness library: image comparison, cross-backend checks, and (growing) goldens, bless and
 //! reports. The `harness` binary is a thin command line over it.
 
+pub mod bench;
 pub mod check;
 pub mod compare;
 pub mod first_scene;

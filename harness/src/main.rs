@@ -114,6 +114,30 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Time every pass of every canonical scene on every available backend (GPU timestamps,
+    /// median of a few frames) against its floor: a trivial pass writing the same targets.
+    /// A quick version of `cargo bench`.
+    Bench {
+        /// Only these scenes (canonical names or scene files; repeatable).
+        #[arg(long = "scene")]
+        scenes: Vec<String>,
+        /// Only this backend (repeatable). Default: every available one.
+        #[arg(long = "backend")]
+        backends: Vec<BackendKind>,
+        /// Frames timed per scene and backend, after one warm-up frame.
+        #[arg(long, default_value_t = 5)]
+        frames: usize,
+        /// Instead of the scenes, a scaling series: resolution, lights, triangles, shadow-map,
+        /// or all (repeatable).
+        #[arg(long = "series")]
+        series: Vec<String>,
+        /// Where to keep the results (bench.json, bench_series.json) for the check report.
+        #[arg(long, default_value_os_t = default_out_dir())]
+        out: PathBuf,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// List the canonical scenes with their descriptions.
     Scenes,
     /// List every backend with its availability, the reason and fix when unavailable, and the
@@ -170,6 +194,20 @@ fn main() -> ExitCode {
             repeats,
             json,
         } => sweep(&scene, &knob, backend, repeats, json),
+        Command::Bench {
+            scenes,
+            backends,
+            frames,
+            series,
+            out,
+            json,
+        } => {
+            if series.is_empty() {
+                bench(&scenes, &backends, frames, &out, json)
+            } else {
+                bench_series(&series, &backends, frames, &out, json)
+            }
+        }
     };
     match result {
         Ok(code) => code,
@@ -240,7 +278,7 @@ fn check(out: &std::path::Path, scenes: &[String], json: bool) -> anyhow::Result
     if run.backends.iter().all(|b| b.unavailable.is_some()) {
         anyhow::bail!("no backend is available; run `harness backends` for the reasons");
     }
-    let html = harness::report::html(&run, &outputs, &store);
+    let html = harness::report::html(&run, &outputs, &store, Some(out));
     let report = out.join("report.html");
     harness::images::write_atomically(&report, html.as_bytes())?;
     if json {
@@ -543,4 +581,126 @@ fn sweep(
         print!("{}", harness::sweep::table(&rows));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+fn bench(
+    scenes: &[String],
+    backends: &[BackendKind],
+    frames: usize,
+    out: &std::path::Path,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    let names: Vec<String> = if scenes.is_empty() {
+        engine::scene_file::canonical_scenes(&harness::scenes_dir())
+    } else {
+        scenes.to_vec()
+    };
+    let loaded = names
+        .iter()
+        .map(|n| harness::load_scene(n).map(|l| l.scene))
+        .collect::<Result<Vec<_>, _>>()?;
+    let kinds: Vec<BackendKind> = if backends.is_empty() {
+        BackendKind::ALL.to_vec()
+    } else {
+        backends.to_vec()
+    };
+    let mut results = Vec::new();
+    let mut failed = false;
+    for kind in kinds {
+        if let Err(e) = engine::backend::create(kind) {
+            eprintln!("skipping {kind}: {e}");
+            if !backends.is_empty() {
+                failed = true;
+            }
+            continue;
+        }
+        for scene in &loaded {
+            eprintln!("timing {} on {kind} ({frames} frames) ...", scene.name);
+            match harness::bench::bench_scene(scene, kind, frames) {
+                Ok(result) => {
+                    if !json {
+                        println!("{}", harness::bench::table(&result));
+                    }
+                    results.push(result);
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    failed = true;
+                }
+            }
+        }
+    }
+    let precompute = harness::bench::precompute();
+    if !json {
+        println!("precomputation (apart from frames):");
+        for p in &precompute {
+            println!("  {:<44} {:>8.3} ms  ({})", p.what, p.ms, p.on);
+        }
+        println!("  {:<44} {:>8}     (not built yet)", "IBL maps", "-");
+    }
+    let text = serde_json::to_string_pretty(
+        &serde_json::json!({ "precompute": precompute, "scenes": results }),
+    )?;
+    save_bench_json(out, harness::bench::BENCH_JSON, &text)?;
+    if json {
+        println!("{text}");
+    }
+    Ok(if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+fn bench_series(
+    names: &[String],
+    backends: &[BackendKind],
+    frames: usize,
+    out: &std::path::Path,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    let names: Vec<String> = if names.iter().any(|n| n == "all") {
+        harness::bench::SERIES
+            .iter()
+            .map(|s| (*s).to_owned())
+            .collect()
+    } else {
+        names.to_vec()
+    };
+    let kinds: Vec<BackendKind> = if backends.is_empty() {
+        vec![BackendKind::Gl]
+    } else {
+        backends.to_vec()
+    };
+    let mut all = Vec::new();
+    for kind in kinds {
+        for name in &names {
+            let points = harness::bench::series(name, kind, frames, |what| {
+                eprintln!("  {kind}: {what} ...");
+            })?;
+            if !json {
+                println!("{name} series on {kind} (median of {frames} frames, GPU ms)");
+                println!("{}", harness::bench::series_table(&points));
+            }
+            all.push(serde_json::json!({ "backend": kind.name(), "points": points }));
+        }
+    }
+    let text = serde_json::to_string_pretty(&all)?;
+    save_bench_json(out, harness::bench::SERIES_JSON, &text)?;
+    if json {
+        println!("{text}");
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Keeps the latest bench results (in target/harness/ by default) for the check report.
+fn save_bench_json(dir: &std::path::Path, name: &str, text: &str) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    let path = dir.join(name);
+    harness::images::write_atomically(&path, text.as_bytes())?;
+    eprintln!(
+        "wrote {} (shown in the next `harness check` report)",
+        path.display()
+    );
+    Ok(())
 }

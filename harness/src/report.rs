@@ -114,7 +114,15 @@ fn figure(label: &str, image: Option<&Image>, pass: &str) -> String {
 pub type Outputs = std::collections::BTreeMap<(String, String, String), Image>;
 
 /// Writes the report as one HTML string.
-pub fn html(run: &CheckRun, outputs: &Outputs, store: &GoldenStore) -> String {
+///
+/// With `bench_dir`, the latest `harness bench` results found there are added (pass times
+/// against floors, scaling-series plots).
+pub fn html(
+    run: &CheckRun,
+    outputs: &Outputs,
+    store: &GoldenStore,
+    bench_dir: Option<&std::path::Path>,
+) -> String {
     let failed = run.results.iter().filter(|r| !r.outcome.passed()).count();
     let mut out = String::new();
     let _ = write!(
@@ -277,6 +285,10 @@ figcaption{{font-size:12px}} code{{font-size:12px}}
             t.ms.map_or("-".to_owned(), |ms| format!("{ms:.3}"))
         );
     }
-    out.push_str("</table></body></html>\n");
+    out.push_str("</table>");
+    if let Some(dir) = bench_dir {
+        out.push_str(&crate::bench::report_sections(dir));
+    }
+    out.push_str("</body></html>\n");
     out
 }

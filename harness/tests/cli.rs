@@ -299,3 +299,57 @@ fn check_reports_failures_with_images_and_the_bless_command() {
     let report = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(report.contains("data:image/png;base64,") && report.contains("FAILED"));
 }
+
+/// `harness bench --json`: for each scene, backend and pass, the median GPU time and its ratio
+/// to the floor (a trivial pass writing the same targets), kept for the check report.
+#[test]
+fn bench_json_gives_each_pass_its_time_and_ratio_to_the_floor() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let (code, stdout, stderr) = harness(&[
+        "bench",
+        "--scene",
+        "arrow",
+        "--backend",
+        "gl",
+        "--frames",
+        "1",
+        "--json",
+        "--out",
+        out,
+    ]);
+    if code != 0 && stderr.contains("unavailable") && std::env::var("REQUIRE_BACKENDS").is_err() {
+        eprintln!("skipping: gl unavailable: {stderr}");
+        return;
+    }
+    assert_eq!(code, 0, "{stderr}");
+    let json: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let scenes = json["scenes"].as_array().unwrap();
+    assert_eq!(scenes.len(), 1);
+    let arrow = &scenes[0];
+    assert_eq!(arrow["backend"], "gl");
+    let passes = arrow["passes"].as_array().unwrap();
+    let names: Vec<&str> = passes.iter().map(|p| p["pass"].as_str().unwrap()).collect();
+    assert_eq!(
+        names,
+        [
+            "shadow_0",
+            "geometry",
+            "mask",
+            "lighting_pbr",
+            "lighting_blinn_phong",
+            "tonemap"
+        ]
+    );
+    for p in passes {
+        let (ms, floor, ratio) = (
+            p["median_ms"].as_f64().unwrap(),
+            p["floor_ms"].as_f64().unwrap(),
+            p["ratio"].as_f64().unwrap(),
+        );
+        assert!(ms > 0.0 && floor > 0.0, "{p}");
+        assert!((ratio - ms / floor).abs() < 1e-9 * ratio, "{p}");
+    }
+    assert!(json["precompute"][0]["ms"].as_f64().unwrap() >= 0.0);
+    assert!(dir.path().join("bench.json").is_file());
+}

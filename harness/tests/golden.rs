@@ -204,7 +204,7 @@ fn write_failure_report(suite: &Suite) {
         cross: vec![],
         timings: vec![],
     };
-    let html = harness::report::html(&run, &outputs, &suite.store);
+    let html = harness::report::html(&run, &outputs, &suite.store, None);
     match harness::images::write_atomically(&report_path(), html.as_bytes()) {
         Ok(()) => eprintln!("report of the failures: {}", report_path().display()),
         Err(e) => eprintln!("could not write the report: {e}"),

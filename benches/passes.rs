@@ -1,0 +1,107 @@
+//! Per-pass benchmarks (`cargo bench --bench passes`): for every canonical scene on every
+//! available backend, group `<scene>/<backend>` times
+//!
+//! - `<pass>`: each pass of the scene's plan, GPU time from timestamp queries (a point light's
+//!   six face passes count as its shadow pass), one full render per iteration;
+//! - `<pass>/floor`: that pass's floor, a trivial full-screen pass writing the same targets
+//!   (`harness::bench::Floors`), submitted alone;
+//! - `frame`: every pass of the frame together.
+//!
+//! Backends without timestamps are timed by wall clock around the whole render or submit, and
+//! say so. Flat sampling with ten samples keeps the whole run to a few minutes here; `harness
+//! bench` prints the same figures as a table with ratios, quicker.
+
+use std::time::{Duration, Instant};
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode};
+use engine::backend::{self, Backend, BackendKind};
+use engine::plan::RenderPlan;
+use engine::renderer::{self, Readback};
+use engine::scene::Scene;
+use harness::bench::{pass_time, Floors};
+
+/// Renders `scene` once and returns the GPU time of plan pass `pass` (every pass when `None`)
+/// (wall time of the render when the backend has no timestamps).
+fn timed_render(
+    backend: &mut dyn Backend,
+    scene: &Scene,
+    plan: &RenderPlan,
+    pass: Option<&str>,
+) -> Duration {
+    let start = Instant::now();
+    let frame = renderer::render(backend, scene, Readback::Only(&[]))
+        .unwrap_or_else(|e| panic!("{}: {e}", scene.name));
+    let wall = start.elapsed();
+    let ns: Option<f64> = match pass {
+        Some(name) => plan
+            .passes
+            .iter()
+            .find(|p| p.name == name)
+            .and_then(|spec| pass_time(&frame.timings, spec)),
+        None => frame.timings.iter().map(|t| t.gpu_ns).sum(),
+    };
+    ns.map_or(wall, |ns| Duration::from_nanos(ns as u64))
+}
+
+fn passes(c: &mut Criterion) {
+    let names = engine::scene_file::canonical_scenes(&harness::scenes_dir());
+    let scenes: Vec<Scene> = names
+        .iter()
+        .map(|n| harness::load_scene(n).expect("canonical scene").scene)
+        .collect();
+    for kind in BackendKind::ALL {
+        let mut backend = match backend::create(kind) {
+            Ok(b) => b,
+            Err(e) => {
+                eprintln!("skipping {kind}: {e}");
+                continue;
+            }
+        };
+        if !backend.info().timestamps {
+            eprintln!("{kind}: no GPU timestamps; timing by wall clock");
+        }
+        for scene in &scenes {
+            let plan = RenderPlan::new(scene);
+            let floors = Floors::new(backend.as_mut(), &plan).expect("floor passes");
+            let mut group = c.benchmark_group(format!("{}/{kind}", scene.name));
+            group.sampling_mode(SamplingMode::Flat);
+            group.sample_size(10);
+            group.warm_up_time(Duration::from_millis(1));
+            group.measurement_time(Duration::from_millis(1));
+            group.bench_function("frame", |b| {
+                b.iter_custom(|iters| {
+                    (0..iters)
+                        .map(|_| timed_render(backend.as_mut(), scene, &plan, None))
+                        .sum()
+                })
+            });
+            for spec in &plan.passes {
+                group.bench_function(BenchmarkId::new(&spec.name, "pass"), |b| {
+                    b.iter_custom(|iters| {
+                        (0..iters)
+                            .map(|_| timed_render(backend.as_mut(), scene, &plan, Some(&spec.name)))
+                            .sum()
+                    })
+                });
+                group.bench_function(BenchmarkId::new(&spec.name, "floor"), |b| {
+                    b.iter_custom(|iters| {
+                        (0..iters)
+                            .map(|_| {
+                                let start = Instant::now();
+                                let ns = floors
+                                    .time(backend.as_mut(), &spec.name)
+                                    .expect("floor pass");
+                                ns.map_or(start.elapsed(), |ns| Duration::from_nanos(ns as u64))
+                            })
+                            .sum()
+                    })
+                });
+            }
+            group.finish();
+            floors.destroy(backend.as_mut());
+        }
+    }
+}
+
+criterion_group!(benches, passes);
+criterion_main!(benches);

@@ -1,0 +1,779 @@
+//! Per-pass timing against floors: where a frame's time goes, and how close each pass is to what
+//! the driver can do at all.
+//!
+//! A pass's time is its GPU time from timestamp queries (the sum over its render passes: a point
+//! light's six faces count as its shadow pass), the median over several frames. Its floor is the
+//! cheapest pass writing the same targets (same formats and sizes) over every pixel: a
+//! full-screen triangle writing constants (`floor.wgsl`), depth included where the pass writes
+//! depth, timed the same way in the same run. The ratio pass / floor is what compares across
+//! machines; the milliseconds do not.
+//!
+//! `harness bench` prints this per scene and backend, and the criterion benchmarks in `benches/`
+//! use the same [`Floors`] and [`pass_time`].
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use engine::backend::{
+    self, Backend, BackendKind, ColorAttachment, ColorTarget, CompareFunction, CullMode,
+    DepthAttachment, DepthState, Draw, Handle, LoadOp, Pipeline, PipelineDesc, RenderPass,
+    ResourceScope, ShaderDesc, Subresource, Texture, TextureDesc, Topology,
+};
+use engine::plan::{PassSpec, RenderPlan};
+use engine::renderer::{self, Readback};
+use engine::scene::Scene;
+use engine::shaders;
+
+/// Why a benchmark could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    /// The backend is missing or failed.
+    #[error("{backend}: {message}")]
+    Backend {
+        /// Backend name.
+        backend: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// Rendering the scene failed.
+    #[error("scene `{scene}` on {backend}: {message}")]
+    Render {
+        /// Scene name.
+        scene: String,
+        /// Backend name.
+        backend: String,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+/// Timing of one plan pass.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PassBench {
+    /// Plan pass name.
+    pub pass: String,
+    /// Median GPU time, ms (None without timestamps).
+    pub median_ms: Option<f64>,
+    /// Median GPU time of its floor, ms.
+    pub floor_ms: Option<f64>,
+    /// `median_ms / floor_ms`.
+    pub ratio: Option<f64>,
+}
+
+/// Timing of one scene on one backend.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SceneBench {
+    /// Scene name.
+    pub scene: String,
+    /// Backend name.
+    pub backend: String,
+    /// Output size.
+    pub width: u32,
+    /// Output height.
+    pub height: u32,
+    /// Frames timed (after one warm-up frame).
+    pub frames: usize,
+    /// Per plan pass, in plan order.
+    pub passes: Vec<PassBench>,
+    /// Median over frames of the sum of every pass, ms.
+    pub frame_ms: Option<f64>,
+    /// Median wall time of a whole render (setup, uploads, readback of nothing), ms.
+    pub wall_ms: f64,
+    /// The geometry pass's floor: writing the G-buffer and depth once, ms.
+    pub gbuffer_floor_ms: Option<f64>,
+    /// `frame_ms / gbuffer_floor_ms`.
+    pub frame_to_gbuffer_floor: Option<f64>,
+}
+
+/// Work done once, not per frame, timed apart from frames.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Precompute {
+    /// What is computed.
+    pub what: String,
+    /// Where it runs.
+    pub on: String,
+    /// Median time of a few runs, ms.
+    pub ms: f64,
+}
+
+/// The precomputation the renderer does once per process, timed (median of 5 runs): the
+/// stratified soft filter's jitter texture (CPU). The IBL maps join this list when they exist.
+pub fn precompute() -> Vec<Precompute> {
+    let runs: Vec<f64> = (0..5)
+        .map(|_| {
+            let start = Instant::now();
+            std::hint::black_box(engine::renderer::shadows::compute_jitter_texels());
+            start.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    vec![Precompute {
+        what: "shadow jitter texture (32x32x8 RGBA16F)".to_owned(),
+        on: "CPU, once per process".to_owned(),
+        ms: median(runs).unwrap_or(0.0),
+    }]
+}
+
+/// The median of some values (None when empty).
+pub fn median(mut values: Vec<f64>) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_by(f64::total_cmp);
+    Some(values[values.len() / 2])
+}
+
+/// GPU ns of plan pass `spec` in one frame's timings: the render passes named like it (a point
+/// light's faces are `<name>+x` .. `<name>-z`). None when the backend has no timestamps.
+pub fn pass_time(timings: &[backend::PassTiming], spec: &PassSpec) -> Option<f64> {
+    let mut matched = timings.iter().filter(|t| {
+        t.name == spec.name
+            || (t.name.starts_with(&spec.name)
+                && matches!(t.name.as_bytes().get(spec.name.len()), Some(b'+' | b'-')))
+    });
+    let first = matched.next()?.gpu_ns?;
+    matched.try_fold(first, |sum, t| t.gpu_ns.map(|ns| sum + ns))
+}
+
+/// Floor passes for every pass of a plan, created once on a backend and submitted on demand.
+pub struct Floors {
+    scope: ResourceScope,
+    passes: BTreeMap<String, RenderPass>,
+}
+
+impl Floors {
+    /// Creates the targets and pipelines of every pass's floor.
+    pub fn new(backend: &mut dyn Backend, plan: &RenderPlan) -> backend::Result<Self> {
+        let mut scope = ResourceScope::default();
+        let result = Self::record(backend, plan, &mut scope);
+        match result {
+            Ok(passes) => Ok(Self { scope, passes }),
+            Err(e) => {
+                scope.destroy(backend);
+                Err(e)
+            }
+        }
+    }
+
+    fn record(
+        backend: &mut dyn Backend,
+        plan: &RenderPlan,
+        scope: &mut ResourceScope,
+    ) -> backend::Result<BTreeMap<String, RenderPass>> {
+        let shader = scope.shader(
+            backend,
+            &ShaderDesc {
+                name: shaders::FLOOR.name.to_owned(),
+                wgsl: shaders::FLOOR.wgsl.to_owned(),
+            },
+        )?;
+        let mut pipelines: BTreeMap<String, Handle<Pipeline>> = BTreeMap::new();
+        let mut passes = BTreeMap::new();
+        for spec in &plan.passes {
+            let targets: Vec<_> = spec.writes.iter().filter_map(|w| plan.target(w)).collect();
+            let colors: Vec<_> = targets.iter().filter(|t| !t.format.is_depth()).collect();
+            let depth = targets.iter().find(|t| t.format.is_depth());
+            if colors.len() > 5 || (colors.is_empty() && depth.is_none()) {
+                continue;
+            }
+            let key = format!(
+                "{:?} {:?}",
+                colors.iter().map(|t| t.format).collect::<Vec<_>>(),
+                depth.map(|t| t.format)
+            );
+            let pipeline = match pipelines.get(&key) {
+                Some(p) => *p,
+                None => {
+                    let p = scope.pipeline(
+                        backend,
+                        &PipelineDesc {
+                            label: format!("floor {key}"),
+                            shader,
+                            vertex_entry: "vs_fullscreen".to_owned(),
+                            fragment_entry: (!colors.is_empty())
+                                .then(|| format!("fs_floor_{}", colors.len())),
+                            vertex_buffers: vec![],
+                            bindings: vec![],
+                            color_targets: colors
+                                .iter()
+                                .map(|t| ColorTarget {
+                                    format: t.format,
+                                    blend: None,
+                                })
+                                .collect(),
+                            depth: depth.map(|t| DepthState {
+                                format: t.format,
+                                write: true,
+                                compare: CompareFunction::Always,
+                            }),
+                            topology: Topology::TriangleList,
+                            cull: CullMode::None,
+                            geometry: None,
+                        },
+                    )?;
+                    pipelines.insert(key, p);
+                    p
+                }
+            };
+            let mut texture =
+                |spec: &engine::plan::TargetSpec| -> backend::Result<Handle<Texture>> {
+                    scope.texture(
+                        backend,
+                        &TextureDesc::d2(
+                            &format!("floor {}", spec.name),
+                            spec.width,
+                            spec.height,
+                            spec.format,
+                        ),
+                    )
+                };
+            let mut color_attachments = Vec::new();
+            for t in &colors {
+                color_attachments.push(ColorAttachment {
+                    texture: texture(t)?,
+                    subresource: Subresource::default(),
+                    load: LoadOp::Clear([0.0; 4]),
+                });
+            }
+            let depth_attachment = match depth {
+                Some(t) => Some(DepthAttachment {
+                    texture: texture(t)?,
+                    subresource: Subresource::default(),
+                    load: LoadOp::Clear(1.0),
+                }),
+                None => None,
+            };
+            passes.insert(
+                spec.name.clone(),
+                RenderPass {
+                    name: format!("{} floor", spec.name),
+                    color_attachments,
+                    depth_attachment,
+                    viewports: vec![],
+                    draws: vec![Draw {
+                        pipeline,
+                        bindings: vec![],
+                        vertex_buffers: vec![],
+                        index_buffer: None,
+                        count: 3,
+                    }],
+                },
+            );
+        }
+        Ok(passes)
+    }
+
+    /// Submits the floor of plan pass `pass` once; its GPU ns (None without timestamps or when
+    /// the pass has no floor).
+    pub fn time(&self, backend: &mut dyn Backend, pass: &str) -> backend::Result<Option<f64>> {
+        let Some(floor) = self.passes.get(pass) else {
+            return Ok(None);
+        };
+        let timings = backend.submit(std::slice::from_ref(floor))?;
+        Ok(timings.first().and_then(|t| t.gpu_ns))
+    }
+
+    /// Destroys the floors' resources.
+    pub fn destroy(self, backend: &mut dyn Backend) {
+        self.scope.destroy(backend);
+    }
+}
+
+/// Renders `scene` once to warm up, then `frames` times: each frame's pass timings and wall ms.
+fn time_frames(
+    backend: &mut dyn Backend,
+    scene: &Scene,
+    frames: usize,
+) -> Result<(Vec<Vec<backend::PassTiming>>, Vec<f64>), BenchError> {
+    let mut timings = Vec::with_capacity(frames);
+    let mut wall = Vec::with_capacity(frames);
+    for i in 0..=frames {
+        let start = Instant::now();
+        let frame = renderer::render(backend, scene, Readback::Only(&[])).map_err(|e| {
+            BenchError::Render {
+                scene: scene.name.clone(),
+                backend: backend.kind().name().to_owned(),
+                message: e.to_string(),
+            }
+        })?;
+        if i > 0 {
+            wall.push(start.elapsed().as_secs_f64() * 1e3);
+            timings.push(frame.timings);
+        }
+    }
+    Ok((timings, wall))
+}
+
+/// Median GPU ms of plan pass `name` over frames (None if the plan has no such pass or the
+/// backend no timestamps).
+fn median_pass_ms(
+    plan: &RenderPlan,
+    timings: &[Vec<backend::PassTiming>],
+    name: &str,
+) -> Option<f64> {
+    let spec = plan.passes.iter().find(|p| p.name == name)?;
+    median(
+        timings
+            .iter()
+            .filter_map(|t| pass_time(t, spec))
+            .map(|ns| ns / 1e6)
+            .collect(),
+    )
+}
+
+/// Median GPU ms of whole frames.
+fn median_frame_ms(timings: &[Vec<backend::PassTiming>]) -> Option<f64> {
+    median(
+        timings
+            .iter()
+            .filter_map(|t| {
+                t.iter()
+                    .map(|p| p.gpu_ns)
+                    .sum::<Option<f64>>()
+                    .map(|ns| ns / 1e6)
+            })
+            .collect(),
+    )
+}
+
+/// Times `scene` on `kind`: one warm-up frame, then `frames` frames, each pass and its floor.
+pub fn bench_scene(
+    scene: &Scene,
+    kind: BackendKind,
+    frames: usize,
+) -> Result<SceneBench, BenchError> {
+    let backend_error = |e: backend::BackendError| BenchError::Backend {
+        backend: kind.name().to_owned(),
+        message: e.to_string(),
+    };
+    let mut backend = backend::create(kind).map_err(backend_error)?;
+    let frames = frames.max(1);
+    let plan = RenderPlan::new(scene);
+    let (timings, wall) = time_frames(backend.as_mut(), scene, frames)?;
+    let floors = Floors::new(backend.as_mut(), &plan).map_err(backend_error)?;
+    let mut passes = Vec::with_capacity(plan.passes.len());
+    let mut floor_result = Ok(());
+    for spec in &plan.passes {
+        let median_ms = median_pass_ms(&plan, &timings, &spec.name);
+        let mut floor_times = Vec::with_capacity(frames);
+        for _ in 0..=frames {
+            match floors.time(backend.as_mut(), &spec.name) {
+                Ok(Some(ns)) => floor_times.push(ns / 1e6),
+                Ok(None) => {}
+                Err(e) => floor_result = Err(e),
+            }
+        }
+        // The first floor submit is the warm-up.
+        if !floor_times.is_empty() {
+            floor_times.remove(0);
+        }
+        let floor_ms = median(floor_times);
+        passes.push(PassBench {
+            pass: spec.name.clone(),
+            median_ms,
+            floor_ms,
+            ratio: median_ms.zip(floor_ms).map(|(p, f)| p / f),
+        });
+    }
+    floors.destroy(backend.as_mut());
+    floor_result.map_err(backend_error)?;
+    let frame_ms = median_frame_ms(&timings);
+    let gbuffer_floor_ms = passes
+        .iter()
+        .find(|p| p.pass == "geometry")
+        .and_then(|p| p.floor_ms);
+    Ok(SceneBench {
+        scene: scene.name.clone(),
+        backend: kind.name().to_owned(),
+        width: scene.quality.width,
+        height: scene.quality.height,
+        frames,
+        passes,
+        frame_ms,
+        wall_ms: median(wall).unwrap_or(0.0),
+        gbuffer_floor_ms,
+        frame_to_gbuffer_floor: frame_ms.zip(gbuffer_floor_ms).map(|(f, g)| f / g),
+    })
+}
+
+/// One scene's timings as a table.
+pub fn table(bench: &SceneBench) -> String {
+    let ms = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.2}"));
+    let ratio = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.1}x"));
+    let mut out = format!(
+        "{} on {} ({}x{}, median of {} frames, GPU ms)\n{:<22} {:>9} {:>9} {:>8}\n",
+        bench.scene,
+        bench.backend,
+        bench.width,
+        bench.height,
+        bench.frames,
+        "pass",
+        "time",
+        "floor",
+        "ratio"
+    );
+    for p in &bench.passes {
+        out.push_str(&format!(
+            "{:<22} {:>9} {:>9} {:>8}\n",
+            p.pass,
+            ms(p.median_ms),
+            ms(p.floor_ms),
+            ratio(p.ratio)
+        ));
+    }
+    out.push_str(&format!(
+        "{:<22} {:>9} {:>9} {:>8}   (floor: writing the G-buffer once)\n",
+        "frame",
+        ms(bench.frame_ms),
+        ms(bench.gbuffer_floor_ms),
+        ratio(bench.frame_to_gbuffer_floor)
+    ));
+    out.push_str(&format!(
+        "{:<22} {:>9.2}   wall time of a whole render\n",
+        "render (wall)", bench.wall_ms
+    ));
+    out
+}
+
+/// The scaling series `harness bench --series` knows.
+pub const SERIES: [&str; 4] = ["resolution", "lights", "triangles", "shadow-map"];
+
+/// One point of a scaling series.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct SeriesPoint {
+    /// Series name (see [`SERIES`]).
+    pub series: String,
+    /// The value varied: pixels per side, point lights, triangles, or shadow-map texels per side.
+    pub value: u64,
+    /// The pass the series is about.
+    pub pass: String,
+    /// Its median GPU time, ms.
+    pub pass_ms: Option<f64>,
+    /// Median GPU time of the whole frame, ms.
+    pub frame_ms: Option<f64>,
+}
+
+/// How a frame's cost grows: chess at 256..2048 pixels (frame, lighting), 1..256 point lights on
+/// a floor (lighting), chess's meshes subdivided 1x..64x (geometry), chess's sun with 512..4096
+/// shadow maps (shadow pass).
+pub fn series(
+    name: &str,
+    kind: BackendKind,
+    frames: usize,
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<SeriesPoint>, BenchError> {
+    let chess = || {
+        crate::load_scene("chess")
+            .map(|l| l.scene)
+            .map_err(|e| BenchError::Render {
+                scene: "chess".to_owned(),
+                backend: kind.name().to_owned(),
+                message: e.to_string(),
+            })
+    };
+    let settings: Vec<(u64, Scene, &str)> = match name {
+        "resolution" => [256u32, 512, 1024, 2048]
+            .into_iter()
+            .map(|size| {
+                let mut scene = chess()?;
+                scene.quality.width = size;
+                scene.quality.height = size;
+                Ok((u64::from(size), scene, "lighting_pbr"))
+            })
+            .collect::<Result<_, BenchError>>()?,
+        "lights" => [1usize, 8, 64, 256]
+            .into_iter()
+            .map(|n| {
+                (
+                    n as u64,
+                    crate::test_scenes::many_point_lights(512, n),
+                    "lighting_pbr",
+                )
+            })
+            .collect(),
+        "triangles" => {
+            let mut scene = chess()?;
+            let mut points = Vec::new();
+            for level in 0..4 {
+                if level > 0 {
+                    let mut subdivided = std::collections::HashMap::new();
+                    for object in &mut scene.objects {
+                        let key = std::sync::Arc::as_ptr(&object.mesh);
+                        let mesh = subdivided
+                            .entry(key)
+                            .or_insert_with(|| std::sync::Arc::new(object.mesh.subdivided()))
+                            .clone();
+                        object.mesh = mesh;
+                    }
+                }
+                let triangles: usize = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
+                points.push((triangles as u64, scene.clone(), "geometry"));
+            }
+            points
+        }
+        "shadow-map" => [512u32, 1024, 2048, 4096]
+            .into_iter()
+            .map(|size| {
+                let mut scene = chess()?;
+                for light in &mut scene.lights {
+                    if let engine::scene::Light::Directional {
+                        shadow: Some(s), ..
+                    } = light
+                    {
+                        s.map_size = size;
+                    }
+                }
+                Ok((u64::from(size), scene, "shadow_0"))
+            })
+            .collect::<Result<_, BenchError>>()?,
+        other => {
+            return Err(BenchError::Render {
+                scene: "-".to_owned(),
+                backend: kind.name().to_owned(),
+                message: format!("unknown series `{other}` (known: {})", SERIES.join(", ")),
+            })
+        }
+    };
+    let mut backend = backend::create(kind).map_err(|e| BenchError::Backend {
+        backend: kind.name().to_owned(),
+        message: e.to_string(),
+    })?;
+    let mut points = Vec::new();
+    for (value, scene, pass) in settings {
+        progress(&format!("{name} {value}"));
+        let plan = RenderPlan::new(&scene);
+        let (timings, _) = time_frames(backend.as_mut(), &scene, frames.max(1))?;
+        points.push(SeriesPoint {
+            series: name.to_owned(),
+            value,
+            pass: pass.to_owned(),
+            pass_ms: median_pass_ms(&plan, &timings, pass),
+            frame_ms: median_frame_ms(&timings),
+        });
+    }
+    Ok(points)
+}
+
+/// A series as a table, with each point's growth against the previous one.
+pub fn series_table(points: &[SeriesPoint]) -> String {
+    let ms = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.2}"));
+    let mut out = String::new();
+    if let Some(first) = points.first() {
+        out.push_str(&format!(
+            "{:<12} {:>10} {:>14} {:>10} {:>10} {:>12}\n",
+            "series",
+            "value",
+            format!("{} ms", first.pass),
+            "x value",
+            "x time",
+            "frame ms"
+        ));
+    }
+    for (i, p) in points.iter().enumerate() {
+        let (value_growth, time_growth) = match i.checked_sub(1).map(|j| &points[j]) {
+            Some(prev) => (
+                format!("{:.1}", p.value as f64 / prev.value as f64),
+                p.pass_ms
+                    .zip(prev.pass_ms)
+                    .map_or("-".to_owned(), |(a, b)| format!("{:.2}", a / b)),
+            ),
+            None => ("-".to_owned(), "-".to_owned()),
+        };
+        out.push_str(&format!(
+            "{:<12} {:>10} {:>14} {:>10} {:>10} {:>12}\n",
+            p.series,
+            p.value,
+            ms(p.pass_ms),
+            value_growth,
+            time_growth,
+            ms(p.frame_ms)
+        ));
+    }
+    out
+}
+
+/// File name of `harness bench`'s results in the output folder (read by the check report).
+pub const BENCH_JSON: &str = "bench.json";
+/// File name of `harness bench --series`'s results in the output folder.
+pub const SERIES_JSON: &str = "bench_series.json";
+
+fn escape(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// A small SVG line chart of a series' pass time against its value (log2 x axis).
+pub fn series_svg(points: &[SeriesPoint]) -> String {
+    let (w, h, left, bottom, top, right) = (360.0, 200.0, 50.0, 30.0, 20.0, 15.0);
+    let data: Vec<(f64, f64)> = points
+        .iter()
+        .filter_map(|p| p.pass_ms.map(|ms| ((p.value.max(1) as f64).log2(), ms)))
+        .collect();
+    let Some(first) = points.first() else {
+        return String::new();
+    };
+    let mut svg = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
+         style=\"background:#fff;border:1px solid #ccc\">\
+         <text x=\"{left}\" y=\"14\" font-size=\"12\">{} ms against {}</text>",
+        escape(&first.pass),
+        escape(&first.series)
+    );
+    if data.is_empty() {
+        svg.push_str("<text x=\"60\" y=\"100\" font-size=\"12\">no timestamps</text></svg>");
+        return svg;
+    }
+    let (x0, x1) = data.iter().fold((f64::MAX, f64::MIN), |(a, b), (x, _)| {
+        (a.min(*x), b.max(*x))
+    });
+    let y1 = data.iter().map(|(_, y)| *y).fold(0.0, f64::max).max(1e-9);
+    let sx = |x: f64| left + (x - x0) / (x1 - x0).max(1e-9) * (w - left - right);
+    let sy = |y: f64| h - bottom - y / y1 * (h - bottom - top);
+    svg.push_str(&format!(
+        "<line x1=\"{left}\" y1=\"{0}\" x2=\"{1}\" y2=\"{0}\" stroke=\"#888\"/>\
+         <line x1=\"{left}\" y1=\"{top}\" x2=\"{left}\" y2=\"{0}\" stroke=\"#888\"/>\
+         <text x=\"4\" y=\"{2}\" font-size=\"10\">{y1:.1}</text>\
+         <text x=\"4\" y=\"{0}\" font-size=\"10\">0</text>",
+        h - bottom,
+        w - right,
+        top + 4.0
+    ));
+    let line: Vec<String> = data
+        .iter()
+        .map(|(x, y)| format!("{:.1},{:.1}", sx(*x), sy(*y)))
+        .collect();
+    svg.push_str(&format!(
+        "<polyline fill=\"none\" stroke=\"#2a6\" stroke-width=\"2\" points=\"{}\"/>",
+        line.join(" ")
+    ));
+    for (p, (x, y)) in points.iter().filter(|p| p.pass_ms.is_some()).zip(&data) {
+        svg.push_str(&format!(
+            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"3\" fill=\"#2a6\"/>\
+             <text x=\"{:.1}\" y=\"{}\" font-size=\"10\" text-anchor=\"middle\">{}</text>",
+            sx(*x),
+            sy(*y),
+            sx(*x),
+            h - bottom + 14.0,
+            p.value
+        ));
+    }
+    svg.push_str("</svg>");
+    svg
+}
+
+/// HTML sections for the check report from the latest `harness bench` results in `dir`
+/// (per-pass times against floors, scaling series plots); empty when there are none.
+pub fn report_sections(dir: &std::path::Path) -> String {
+    let mut out = String::new();
+    if let Some(benches) = std::fs::read(dir.join(BENCH_JSON))
+        .ok()
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        .and_then(|v| v["scenes"].as_array().cloned())
+    {
+        out.push_str(
+            "<h2>Pass time against floor (latest <code>harness bench</code>)</h2>\
+             <table><tr><th>scene</th><th>backend</th><th>pass</th><th>ms</th><th>floor ms</th>\
+             <th>ratio</th></tr>",
+        );
+        let cell = |v: &serde_json::Value, digits: usize| {
+            v.as_f64()
+                .map_or("-".to_owned(), |x| format!("{x:.digits$}"))
+        };
+        for b in &benches {
+            let scene = escape(b["scene"].as_str().unwrap_or("?"));
+            let backend = escape(b["backend"].as_str().unwrap_or("?"));
+            for p in b["passes"].as_array().into_iter().flatten() {
+                out.push_str(&format!(
+                    "<tr><td>{scene}</td><td>{backend}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                    escape(p["pass"].as_str().unwrap_or("?")),
+                    cell(&p["median_ms"], 2),
+                    cell(&p["floor_ms"], 2),
+                    cell(&p["ratio"], 1)
+                ));
+            }
+            out.push_str(&format!(
+                "<tr><td>{scene}</td><td>{backend}</td><td><b>frame</b> (floor: G-buffer once)</td>\
+                 <td>{}</td><td>{}</td><td>{}</td></tr>",
+                cell(&b["frame_ms"], 2),
+                cell(&b["gbuffer_floor_ms"], 2),
+                cell(&b["frame_to_gbuffer_floor"], 1)
+            ));
+        }
+        out.push_str("</table>");
+    }
+    if let Some(series) = std::fs::read(dir.join(SERIES_JSON))
+        .ok()
+        .and_then(|b| serde_json::from_slice::<Vec<serde_json::Value>>(&b).ok())
+    {
+        out.push_str("<h2>How cost grows (latest <code>harness bench --series</code>)</h2>");
+        for s in &series {
+            let points: Vec<SeriesPoint> =
+                serde_json::from_value(s["points"].clone()).unwrap_or_default();
+            out.push_str(&format!(
+                "<figure>{}<figcaption>{}</figcaption></figure>",
+                series_svg(&points),
+                escape(s["backend"].as_str().unwrap_or("?"))
+            ));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use engine::backend::PassTiming;
+
+    fn timing(name: &str, ns: f64) -> PassTiming {
+        PassTiming {
+            name: name.to_owned(),
+            gpu_ns: Some(ns),
+        }
+    }
+
+    #[test]
+    fn a_pass_time_sums_its_faces_and_nothing_else() {
+        let spec = |name: &str| PassSpec {
+            name: name.to_owned(),
+            kind: engine::plan::PassKind::Geometry,
+            reads: vec![],
+            writes: vec![],
+            detail: String::new(),
+        };
+        let timings = [
+            timing("shadow_0+x", 1.0),
+            timing("shadow_0-x", 2.0),
+            timing("shadow_0_blur_x", 4.0),
+            timing("shadow_1", 8.0),
+            timing("geometry", 16.0),
+        ];
+        assert_eq!(pass_time(&timings, &spec("shadow_0")), Some(3.0));
+        assert_eq!(pass_time(&timings, &spec("shadow_0_blur_x")), Some(4.0));
+        assert_eq!(pass_time(&timings, &spec("shadow_1")), Some(8.0));
+        assert_eq!(pass_time(&timings, &spec("lighting_pbr")), None);
+        let untimed = [PassTiming {
+            name: "geometry".to_owned(),
+            gpu_ns: None,
+        }];
+        assert_eq!(pass_time(&untimed, &spec("geometry")), None);
+    }
+
+    #[test]
+    fn series_plots_have_a_point_per_value() {
+        let points: Vec<SeriesPoint> = [(1u64, 1.0), (8, 3.0), (64, 20.0)]
+            .into_iter()
+            .map(|(value, ms)| SeriesPoint {
+                series: "lights".to_owned(),
+                value,
+                pass: "lighting_pbr".to_owned(),
+                pass_ms: Some(ms),
+                frame_ms: Some(ms + 1.0),
+            })
+            .collect();
+        let svg = series_svg(&points);
+        assert_eq!(svg.matches("<circle").count(), 3);
+        assert!(svg.contains("lighting_pbr ms against lights"));
+        let table = series_table(&points);
+        assert!(table.contains("8.0") && table.contains("6.67"), "{table}");
+    }
+}
