@@ -604,7 +604,7 @@ fn escape(text: &str) -> String {
 
 /// A small SVG line chart of a series' pass time against its value (log2 x axis).
 pub fn series_svg(points: &[SeriesPoint]) -> String {
-    let (w, h, left, bottom, top, right) = (360.0, 200.0, 50.0, 30.0, 20.0, 15.0);
+    let (w, h, left, bottom, top, right) = (380.0, 200.0, 50.0, 30.0, 20.0, 35.0);
     let data: Vec<(f64, f64)> = points
         .iter()
         .filter_map(|p| p.pass_ms.map(|ms| ((p.value.max(1) as f64).log2(), ms)))
