@@ -377,14 +377,24 @@ pub fn canonical_scenes(scenes_dir: &Path) -> Vec<String> {
     names
 }
 
-/// Reads, parses and resolves a scene file, loading every asset it names.
+/// Reads, parses and resolves a scene file, loading every asset it names within the default
+/// [`assets::Limits`].
 pub fn load(path: &Path) -> Result<LoadedScene, SceneFileError> {
+    load_with_limits(path, assets::Limits::DEFAULT)
+}
+
+/// [`load`] with other limits ([`assets::Limits::NONE`] for none): an asset above them is
+/// refused, naming its file, before it is decoded.
+pub fn load_with_limits(
+    path: &Path,
+    limits: assets::Limits,
+) -> Result<LoadedScene, SceneFileError> {
     let text = std::fs::read_to_string(path).map_err(|source| SceneFileError::Io {
         path: path.to_owned(),
         source,
     })?;
     let file = parse(path, &text)?;
-    Resolver::new(path).resolve(file)
+    Resolver::new(path, limits).resolve(file)
 }
 
 struct Resolver {
@@ -404,11 +414,11 @@ fn finite(values: &[f64]) -> bool {
 }
 
 impl Resolver {
-    fn new(path: &Path) -> Self {
+    fn new(path: &Path, limits: assets::Limits) -> Self {
         Self {
             path: path.to_owned(),
             dir: path.parent().map(Path::to_owned).unwrap_or_default(),
-            cache: TextureCache::new(),
+            cache: TextureCache::with_limits(limits),
             texture_index: HashMap::new(),
             textures: Vec::new(),
             models: HashMap::new(),
@@ -420,6 +430,27 @@ impl Resolver {
             path: self.path.clone(),
             message,
         }
+    }
+
+    /// Checks an environment's size from its EXR header and reserves its RGBA32F texels.
+    fn reserve_environment(&mut self, path: &Path) -> Result<(), AssetError> {
+        let meta =
+            exr::meta::MetaData::read_from_file(path, false).map_err(|source| AssetError::Exr {
+                path: path.to_owned(),
+                source,
+            })?;
+        for header in &meta.headers {
+            let (w, h) = (header.layer_size.width(), header.layer_size.height());
+            let (w, h) = (
+                u32::try_from(w).unwrap_or(u32::MAX),
+                u32::try_from(h).unwrap_or(u32::MAX),
+            );
+            self.cache.budget().check_image(path, w, h)?;
+            self.cache
+                .budget()
+                .reserve(path, u64::from(w) * u64::from(h) * 16)?;
+        }
+        Ok(())
     }
 
     fn asset(&self, source: AssetError) -> SceneFileError {
@@ -511,6 +542,8 @@ impl Resolver {
         let environment = match &file.environment {
             Some(spec) => {
                 let env_path = self.dir.join(&spec.path);
+                self.reserve_environment(&env_path)
+                    .map_err(|e| self.asset(e))?;
                 let loaded = assets::load_environment(&env_path).map_err(|e| self.asset(e))?;
                 Some(Environment {
                     image: Arc::new(EnvironmentImage {

@@ -94,6 +94,21 @@ pub fn cross_compare(case: &Case, pass: &str, a: &Image, b: &Image) -> Option<(f
 pub fn run(
     cases: &[Case],
     store: &GoldenStore,
+    progress: impl FnMut(usize, usize, &str),
+) -> (CheckRun, crate::report::Outputs) {
+    run_with(cases, store, &|kind| backend::create(kind), progress)
+}
+
+/// Creates the backend for one render of [`run_with`].
+pub type BackendFactory<'a> =
+    dyn Fn(BackendKind) -> Result<Box<dyn backend::Backend>, backend::BackendError> + 'a;
+
+/// [`run`] with the backends made by `create` (one per scene and backend): a backend that fails
+/// to start or fails mid-run fails that scene on that backend, and the run goes on.
+pub fn run_with(
+    cases: &[Case],
+    store: &GoldenStore,
+    create: &BackendFactory<'_>,
     mut progress: impl FnMut(usize, usize, &str),
 ) -> (CheckRun, crate::report::Outputs) {
     let mut outputs = crate::report::Outputs::new();
@@ -126,7 +141,10 @@ pub fn run(
         let mut frames: BTreeMap<BackendKind, Frame> = BTreeMap::new();
         for &kind in &available {
             progress(done, total, &format!("{} on {kind}", case.name()));
-            match case.render(kind) {
+            let rendered = create(kind)
+                .map_err(|e| e.to_string())
+                .and_then(|mut backend| case.render_on(backend.as_mut()));
+            match rendered {
                 Ok(frame) => {
                     for t in &frame.timings {
                         timings.push(Timing {

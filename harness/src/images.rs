@@ -11,13 +11,14 @@ use engine::{Image, ImageData};
 /// Why an image could not be read or written.
 #[derive(Debug, thiserror::Error)]
 pub enum ImageFileError {
-    /// File system error.
-    #[error("{path}: {source}")]
+    /// File system error (the OS error is part of the message, not a separate source, so
+    /// `{:#}` chains print it once).
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: PathBuf,
         /// OS error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// PNG encode or decode error.
     #[error("{path}: PNG: {message}")]
@@ -45,11 +46,17 @@ pub enum ImageFileError {
     },
 }
 
-/// Writes `bytes` to `path` atomically (temporary file in the same folder, fsync, rename).
+/// Fault injection for tests: milliseconds to wait between writing the temporary file and
+/// renaming it over the target, so a test can kill the process mid-write.
+pub const WRITE_DELAY_ENV: &str = "HARNESS_FAULT_WRITE_DELAY_MS";
+
+/// Writes `bytes` to `path` atomically (temporary file in the same folder, fsync, rename): a
+/// reader, or a process killed at any moment, sees the old file or the new one, never a part.
+/// Temporary files of the same target left by killed processes are removed first.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ImageFileError> {
-    let io = |source| ImageFileError::Io {
+    let io = |error| ImageFileError::Io {
         path: path.to_owned(),
-        source,
+        error,
     };
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(io)?;
@@ -58,17 +65,51 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ImageFileError>
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
+    remove_stale_temporaries(path, &file_name);
     let temp = path.with_file_name(format!(".{file_name}.tmp{}", std::process::id()));
     let result = (|| {
         let mut file = std::fs::File::create(&temp)?;
         file.write_all(bytes)?;
         file.sync_all()?;
+        if let Some(ms) = std::env::var(WRITE_DELAY_ENV)
+            .ok()
+            .and_then(|v| v.parse::<u64>().ok())
+        {
+            std::thread::sleep(std::time::Duration::from_millis(ms));
+        }
         std::fs::rename(&temp, path)
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&temp);
     }
     result.map_err(io)
+}
+
+/// Removes `.<file_name>.tmp<pid>` siblings of `path` whose process is gone (Linux: no
+/// `/proc/<pid>`); best effort.
+fn remove_stale_temporaries(path: &Path, file_name: &str) {
+    let Some(dir) = path.parent() else { return };
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let prefix = format!(".{file_name}.tmp");
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Some(pid) = name
+            .strip_prefix(&prefix)
+            .and_then(|p| p.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
 }
 
 /// PNG bytes of an 8-bit RGBA image.

@@ -99,16 +99,17 @@ impl Case {
         &self.loaded.scene.name
     }
 
-    /// Renders the golden passes on a backend.
+    /// Renders the golden passes on a new backend of this kind.
     pub fn render(&self, kind: BackendKind) -> Result<Frame, String> {
         let mut backend = backend::create(kind).map_err(|e| e.to_string())?;
+        self.render_on(backend.as_mut())
+    }
+
+    /// Renders the golden passes on a given backend.
+    pub fn render_on(&self, backend: &mut dyn backend::Backend) -> Result<Frame, String> {
         let wanted: Vec<&str> = self.passes.iter().map(String::as_str).collect();
-        renderer::render(
-            backend.as_mut(),
-            &self.loaded.scene,
-            Readback::Only(&wanted),
-        )
-        .map_err(|e| e.to_string())
+        renderer::render(backend, &self.loaded.scene, Readback::Only(&wanted))
+            .map_err(|e| e.to_string())
     }
 }
 

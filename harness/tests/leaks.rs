@@ -1,5 +1,7 @@
 //! No GPU object leaks: creating and dropping a backend with resources 50 times keeps process
-//! memory flat. Its own test binary, so no other test's allocations disturb the measurement.
+//! memory flat, and (ignored by default: minutes) 500 renders of chess on one backend keep it
+//! within 10% of its value after the first 20. Its own test binary, so no other test's
+//! allocations disturb the measurement.
 
 mod common;
 
@@ -69,6 +71,45 @@ fn creating_and_dropping_backends_keeps_memory_flat() {
             growth <= BOUND,
             "{kind}: memory grew by {} KiB over {CYCLES} create/drop cycles",
             growth >> 10
+        );
+    }
+}
+
+/// The soak test: 500 consecutive renders of chess on each backend (one backend each, as a
+/// long-running check would use it); resident memory after them stays within 10% of its value
+/// after the first 20. `cargo test --release --test leaks -- --ignored` (several minutes).
+#[test]
+#[ignore = "soak: 500 renders per backend, several minutes"]
+fn five_hundred_chess_renders_keep_memory_within_ten_percent() {
+    const WARM_UP: usize = 20;
+    const RENDERS: usize = 500;
+    let scene = harness::load_scene("chess").unwrap().scene;
+    for kind in common::available_backends() {
+        let mut backend = create(kind).unwrap();
+        let mut after_warm_up = 0;
+        for i in 0..RENDERS {
+            engine::renderer::render(
+                backend.as_mut(),
+                &scene,
+                engine::renderer::Readback::Only(&["final"]),
+            )
+            .unwrap();
+            if i + 1 == WARM_UP {
+                after_warm_up = resident_bytes();
+            }
+        }
+        let after = resident_bytes();
+        let growth = after as f64 / after_warm_up as f64 - 1.0;
+        eprintln!(
+            "{kind}: RSS {} KiB after {WARM_UP} renders, {} KiB after {RENDERS} ({:+.2}%)",
+            after_warm_up >> 10,
+            after >> 10,
+            growth * 100.0
+        );
+        assert!(
+            growth <= 0.10,
+            "{kind}: memory grew {:.1}% over {RENDERS} renders",
+            growth * 100.0
         );
     }
 }

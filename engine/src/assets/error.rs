@@ -35,6 +35,19 @@ pub enum AssetError {
         message: String,
     },
 
+    /// The asset is above a loading limit ([`crate::assets::Limits`]); nothing was decoded.
+    #[error("{}: {what} {value} is above the limit of {limit}", .path.display())]
+    LimitExceeded {
+        /// The file.
+        path: PathBuf,
+        /// What was measured.
+        what: String,
+        /// Its value.
+        value: u64,
+        /// The limit.
+        limit: u64,
+    },
+
     /// The OBJ file contains no triangles or polygons.
     #[error("{}: no geometry: {detail}", .path.display())]
     NoGeometry {
@@ -126,6 +139,7 @@ impl AssetError {
             | Self::ImageDecode { path, .. }
             | Self::Exr { path, .. }
             | Self::InvalidImage { path, .. }
+            | Self::LimitExceeded { path, .. }
             | Self::Obj { path, .. } => path,
         }
     }

@@ -24,6 +24,7 @@
 
 mod environment;
 mod error;
+mod limits;
 mod mesh;
 mod mtl;
 mod obj;
@@ -32,6 +33,7 @@ mod texture;
 
 pub use environment::{load_environment, radiance, Environment, MAX_ENVIRONMENT_TEXELS};
 pub use error::AssetError;
+pub use limits::{Budget, Limits};
 pub use mesh::{Aabb, MeshData, Vertex};
 pub use obj::{load_mtl, load_obj, MaterialData, MaterialMaps, Model};
 pub use summary::{EnvironmentSummary, MaterialSummary, MeshSummary, ModelSummary, TextureSummary};

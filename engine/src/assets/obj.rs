@@ -101,6 +101,13 @@ impl MaterialMaps {
 pub fn load_obj(path: &Path, textures: &mut TextureCache) -> Result<Model, AssetError> {
     let bytes = std::fs::read(path).map_err(|e| AssetError::io(path, e))?;
     let scan = prescan(path, &bytes)?;
+    // Limits from the pre-scan's counts, before tobj parses anything: positions, and the
+    // vertices (48 bytes) and indices one triangle per face would take after single-indexing.
+    textures.budget().check_vertices(path, scan.positions)?;
+    let vertex_bytes = std::mem::size_of::<super::Vertex>() as u64 + 4;
+    textures
+        .budget()
+        .reserve(path, (scan.faces as u64).saturating_mul(3 * vertex_bytes))?;
     let mut warnings = scan.warnings.clone();
     if scan.faces == 0 {
         return Err(AssetError::NoGeometry {

@@ -16,6 +16,7 @@ use std::sync::OnceLock;
 use serde::Serialize;
 
 use super::error::AssetError;
+use super::limits::{Budget, Limits};
 
 /// How the colour channels of a texture are encoded.
 #[derive(Copy, Clone, PartialEq, Eq, Hash, Debug, Serialize)]
@@ -184,17 +185,33 @@ pub fn linear_to_srgb_u8(l: f64) -> u8 {
 ///
 /// A file referenced by several materials in the same colour space is decoded
 /// once and shares one [`TextureId`]. Failed loads are not cached.
+/// It also carries the load's [`Budget`]: the limits every asset of one load (textures here,
+/// meshes in `load_obj`, the environment in scene files) is checked against before decoding.
 #[derive(Debug, Default)]
 pub struct TextureCache {
     textures: Vec<TextureData>,
     by_key: HashMap<(PathBuf, ColorSpace), TextureId>,
     decodes: usize,
+    budget: Budget,
 }
 
 impl TextureCache {
-    /// An empty cache.
+    /// An empty cache with the default [`Limits`].
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// An empty cache whose load is held to `limits`.
+    pub fn with_limits(limits: Limits) -> Self {
+        Self {
+            budget: Budget::new(limits),
+            ..Self::default()
+        }
+    }
+
+    /// The load's limits and what is reserved against them.
+    pub fn budget(&mut self) -> &mut Budget {
+        &mut self.budget
     }
 
     /// Returns the id of `path` in `color_space`, decoding it on first use.
@@ -208,6 +225,20 @@ impl TextureCache {
         let id = u32::try_from(self.textures.len())
             .map(TextureId)
             .map_err(|_| AssetError::invalid_image(path, "texture cache is full"))?;
+        // Size from the header only, checked and reserved (RGBA8 with a full mip chain, 4/3 of
+        // level 0) before anything is decoded.
+        let (width, height) = image::ImageReader::open(path)
+            .map_err(|e| AssetError::io(path, e))?
+            .with_guessed_format()
+            .map_err(|e| AssetError::io(path, e))?
+            .into_dimensions()
+            .map_err(|source| AssetError::ImageDecode {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        self.budget.check_image(path, width, height)?;
+        self.budget
+            .reserve(path, u64::from(width) * u64::from(height) * 4 * 4 / 3)?;
         self.decodes += 1;
         let texture = load_texture(path, color_space)?;
         log::info!(

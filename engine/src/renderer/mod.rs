@@ -30,9 +30,27 @@ pub use uniforms::{ambient_radiance, environment_mean, light_uniforms};
 /// Why a frame could not be rendered.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
-    /// The backend refused or failed.
-    #[error(transparent)]
-    Backend(#[from] BackendError),
+    /// The backend refused or failed (its message names the backend, and the pass or resource
+    /// where it applies).
+    #[error("scene `{scene}`: {source}")]
+    Backend {
+        /// Scene name.
+        scene: String,
+        /// What the backend said.
+        #[source]
+        source: BackendError,
+    },
+    /// Reading a pass output back failed.
+    #[error("scene `{scene}`: reading back pass output `{output}` failed: {source}")]
+    Readback {
+        /// Scene name.
+        scene: String,
+        /// Target name.
+        output: String,
+        /// What the backend said.
+        #[source]
+        source: BackendError,
+    },
     /// The scene cannot be rendered as given (NaN, zero scale, empty mesh ...).
     #[error("scene `{scene}`: {problem}")]
     InvalidScene {
@@ -51,6 +69,16 @@ pub enum RenderError {
         /// Names that exist.
         available: String,
     },
+}
+
+impl From<BackendError> for RenderError {
+    /// A backend error inside a render; [`render_with_faults`] fills in the scene's name.
+    fn from(source: BackendError) -> Self {
+        RenderError::Backend {
+            scene: String::new(),
+            source,
+        }
+    }
 }
 
 /// Which outputs to read back after the frame.
@@ -128,7 +156,13 @@ pub fn render_with_faults(
     let mut scope = ResourceScope::default();
     let result = record_and_submit(backend, scene, &plan, &wanted, faults, &mut scope);
     scope.destroy(backend);
-    let (outputs, timings) = result?;
+    let (outputs, timings) = result.map_err(|e| match e {
+        RenderError::Backend { source, .. } => RenderError::Backend {
+            scene: scene.name.clone(),
+            source,
+        },
+        other => other,
+    })?;
     Ok(Frame {
         plan,
         outputs,
@@ -1107,7 +1141,13 @@ fn record_and_submit(
     for name in wanted {
         outputs.insert(
             name.clone(),
-            backend.read_texture(target(name), Subresource::default())?,
+            backend
+                .read_texture(target(name), Subresource::default())
+                .map_err(|source| RenderError::Readback {
+                    scene: scene.name.clone(),
+                    output: name.clone(),
+                    source,
+                })?,
         );
     }
     Ok((outputs, timings))
