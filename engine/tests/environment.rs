@@ -84,3 +84,62 @@ fn inverted_data_window_exr_is_rejected() {
     println!("{e}");
     assert!(e.contains("zero.exr"), "{e}");
 }
+
+/// Found by fuzzing (`scripts/fuzz.sh`, target `images`): a corrupt DWAB file on which the
+/// exr crate reserved ~2.3e14 bytes for one block's AC coefficients. Whether that aborted the
+/// process or failed cleanly depended on the order of exr's parallel block decoding; it is an
+/// error naming the file every time now.
+#[test]
+fn the_fuzzed_dwa_file_is_an_error_naming_it() {
+    let path = fixture("fuzz/dwa_huge_ac_count.exr");
+    let error = load_environment(&path).unwrap_err().to_string();
+    assert!(error.contains("dwa_huge_ac_count.exr"), "{error}");
+}
+
+/// interior.exr (DWAB) with its first block's AC coefficient count set to 2^46: refused by the
+/// DWA block check before the exr crate reserves memory for it.
+#[test]
+fn a_dwa_block_claiming_absurd_coefficient_counts_is_refused_before_decoding() {
+    let source =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/assets/interior.exr");
+    let mut bytes = std::fs::read(source).unwrap();
+    // Skip the magic number, version and header attributes (name\0 type\0 size value).
+    let mut at = 8;
+    let c_string = |at: &mut usize, bytes: &[u8]| {
+        let end = *at + bytes[*at..].iter().position(|&b| b == 0).unwrap();
+        let empty = end == *at;
+        *at = end + 1;
+        empty
+    };
+    while !c_string(&mut at, &bytes) {
+        c_string(&mut at, &bytes);
+        let size = i32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+        at += 4 + size;
+    }
+    // The offset table's first entry is the first block: y (i32), size (i32), then the DWA
+    // header's eleven u64 counters; the ninth is the AC coefficient count.
+    let first = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
+    let counter = first + 8 + 8 * 8;
+    bytes[counter..counter + 8].copy_from_slice(&(1u64 << 46).to_le_bytes());
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge_ac.exr");
+    std::fs::write(&path, bytes).unwrap();
+    let error = load_environment(&path).unwrap_err().to_string();
+    assert!(
+        error.contains("huge_ac.exr") && error.contains("corrupt DWA block at y 0: AC coefficient"),
+        "{error}"
+    );
+}
+
+/// The canonical environments (one of them DWA-compressed, like the fuzz seed above) still load
+/// through the DWA block check.
+#[test]
+fn canonical_environments_pass_the_dwa_block_check() {
+    for name in ["sunset.exr", "interior.exr"] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../scenes/assets")
+            .join(name);
+        let env = load_environment(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert!(env.width > 0, "{name}");
+    }
+}

@@ -52,6 +52,74 @@ pub fn radiance(texel: &[f32; 4]) -> f32 {
 
 type Pixels = (usize, Vec<[f32; 4]>);
 
+/// The exr crate (1.74.2) trusts the coefficient counts in a DWAA/DWAB block's header and
+/// reserves memory for them before decoding: a corrupt file claiming 10^14 coefficients aborts
+/// the process (found by fuzzing, input kept in tests/fixtures/fuzz/). So before decoding,
+/// every DWA block's counters are checked against the block's own size: no section of a block
+/// can hold more than the block's uncompressed bytes.
+fn check_dwa_blocks(path: &Path, bytes: &[u8]) -> Result<(), AssetError> {
+    use exr::compression::Compression;
+    let exr_err = |source| AssetError::Exr {
+        path: path.to_path_buf(),
+        source,
+    };
+    let reader = exr::block::read(Cursor::new(bytes), false).map_err(exr_err)?;
+    let headers = reader.headers().to_vec();
+    let is_dwa = |h: &exr::meta::header::Header| {
+        matches!(h.compression, Compression::DWAA(_) | Compression::DWAB(_))
+    };
+    if !headers.iter().any(is_dwa) {
+        return Ok(());
+    }
+    for chunk in reader.all_chunks(false).map_err(exr_err)? {
+        let chunk = chunk.map_err(exr_err)?;
+        let Some(header) = headers.get(chunk.layer_index).filter(|h| is_dwa(h)) else {
+            continue;
+        };
+        let data = match &chunk.compressed_block {
+            exr::block::chunk::CompressedBlock::ScanLine(b) => &b.compressed_pixels_le,
+            exr::block::chunk::CompressedBlock::Tile(b) => &b.compressed_pixels_le,
+            _ => continue,
+        };
+        let block = header
+            .get_block_data_indices(&chunk.compressed_block)
+            .and_then(|tile| header.get_absolute_block_pixel_coordinates(tile))
+            .map_err(exr_err)?;
+        let block_bytes = block
+            .size
+            .area()
+            .saturating_mul(header.channels.bytes_per_pixel);
+        if data.len() == block_bytes {
+            continue; // stored uncompressed
+        }
+        // The DWA block header: 11 little-endian u64 counters (version, unknown uncompressed
+        // and compressed sizes, AC, DC and RLE compressed sizes, RLE uncompressed and raw
+        // sizes, AC and DC coefficient counts, AC compression).
+        let counter = |i: usize| {
+            data.get(i * 8..i * 8 + 8)
+                .map(|b| u64::from_le_bytes(b.try_into().unwrap_or([0xff; 8])))
+                .unwrap_or(0)
+        };
+        let sizes = [
+            ("unknown section size", counter(1)),
+            ("RLE section size", counter(6)),
+            ("RLE raw size", counter(7)),
+            ("AC coefficient bytes", counter(8).saturating_mul(2)),
+            ("DC coefficient bytes", counter(9).saturating_mul(2)),
+        ];
+        if let Some((what, value)) = sizes.iter().find(|(_, value)| *value > block_bytes as u64) {
+            return Err(AssetError::invalid_image(
+                path,
+                format!(
+                    "corrupt DWA block at y {}: {what} {value} exceeds the block's {block_bytes} bytes",
+                    block.position.y()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Loads an EXR environment map; rejects missing/corrupt files, zero or
 /// oversized images and any non-finite texel (naming the first bad pixel).
 pub fn load_environment(path: &Path) -> Result<Environment, AssetError> {
@@ -91,6 +159,8 @@ pub fn load_environment(path: &Path) -> Result<Environment, AssetError> {
             ));
         }
     }
+
+    check_dwa_blocks(path, &bytes)?;
 
     let image = exr::prelude::read()
         .no_deep_data()
