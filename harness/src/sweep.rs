@@ -12,6 +12,7 @@ use engine::plan;
 use engine::renderer::{self, Frame, Readback};
 use engine::scene::{Light, Scene, ShadowFilter};
 
+use crate::bench::median;
 use crate::shadow_reference;
 
 /// One setting of the sweep.
@@ -61,14 +62,6 @@ fn with_shadow(scene: &Scene, filter: ShadowFilter, map_size: u32) -> Scene {
         }
     }
     scene
-}
-
-fn median(mut values: Vec<f64>) -> Option<f64> {
-    if values.is_empty() {
-        return None;
-    }
-    values.sort_by(f64::total_cmp);
-    Some(values[values.len() / 2])
 }
 
 fn pass_ms(frames: &[Frame], prefix: &str) -> Option<f64> {

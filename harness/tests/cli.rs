@@ -1,6 +1,8 @@
 //! The `harness` binary on bad and good input: `inspect` exits 1 with the loader's error (never
 //! 101, a panic) on every malformed fixture, and 0 on fixtures that load with warnings.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -151,19 +153,6 @@ fn render_writes_every_pass_of_a_scene_file() {
     assert!(stderr.contains("no pass output `shadow`"), "{stderr}");
 }
 
-fn copy_tree(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for entry in std::fs::read_dir(from).unwrap() {
-        let entry = entry.unwrap();
-        let target = to.join(entry.file_name());
-        if entry.file_type().unwrap().is_dir() {
-            copy_tree(&entry.path(), &target);
-        } else {
-            std::fs::copy(entry.path(), &target).unwrap();
-        }
-    }
-}
-
 fn snapshot(dir: &Path) -> std::collections::BTreeMap<PathBuf, (Vec<u8>, std::time::SystemTime)> {
     let mut out = std::collections::BTreeMap::new();
     for entry in std::fs::read_dir(dir).unwrap() {
@@ -192,10 +181,7 @@ fn bless_rewrites_only_the_named_golden() {
         eprintln!("gl unavailable here; skipped");
         return;
     }
-    let root = tempfile::tempdir().unwrap();
-    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    copy_tree(&workspace.join("scenes"), &root.path().join("scenes"));
-    copy_tree(&workspace.join("golden"), &root.path().join("golden"));
+    let root = common::temp_workspace();
     let golden = root.path().join("golden");
     let before = snapshot(&golden);
     std::thread::sleep(std::time::Duration::from_millis(20));
@@ -248,10 +234,7 @@ fn check_reports_failures_with_images_and_the_bless_command() {
         eprintln!("gl unavailable here; skipped");
         return;
     }
-    let root = tempfile::tempdir().unwrap();
-    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    copy_tree(&workspace.join("scenes"), &root.path().join("scenes"));
-    copy_tree(&workspace.join("golden"), &root.path().join("golden"));
+    let root = common::temp_workspace();
     // Darken the golden final image of `arrow` by 3/255: a change the tolerance must catch.
     let final_png = root.path().join("golden/arrow/final.png");
     let mut image = image::open(&final_png).unwrap().to_rgba8();

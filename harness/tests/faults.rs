@@ -213,28 +213,6 @@ fn harness_bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_harness"))
 }
 
-fn copy_tree(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for entry in std::fs::read_dir(from).unwrap() {
-        let entry = entry.unwrap();
-        let target = to.join(entry.file_name());
-        if entry.file_type().unwrap().is_dir() {
-            copy_tree(&entry.path(), &target);
-        } else {
-            std::fs::copy(entry.path(), &target).unwrap();
-        }
-    }
-}
-
-/// A temporary copy of scenes/ and golden/ for a HARNESS_ROOT.
-fn temp_workspace() -> tempfile::TempDir {
-    let root = tempfile::tempdir().unwrap();
-    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    copy_tree(&workspace.join("scenes"), &root.path().join("scenes"));
-    copy_tree(&workspace.join("golden"), &root.path().join("golden"));
-    root
-}
-
 fn temporaries(dir: &Path) -> Vec<PathBuf> {
     std::fs::read_dir(dir)
         .unwrap()
@@ -265,7 +243,7 @@ fn a_full_disk_while_blessing_keeps_the_old_golden_and_names_the_file() {
         eprintln!("gl unavailable here; skipped");
         return;
     }
-    let root = temp_workspace();
+    let root = common::temp_workspace();
     let golden = root.path().join("golden/chess");
     let before = std::fs::read(golden.join("final.png")).unwrap();
     let record = std::fs::read(golden.join("blessed.toml")).unwrap();
@@ -314,7 +292,7 @@ fn killing_a_bless_mid_write_leaves_the_old_golden_intact() {
         eprintln!("gl unavailable here; skipped");
         return;
     }
-    let root = temp_workspace();
+    let root = common::temp_workspace();
     let golden = root.path().join("golden/chess");
     let before = std::fs::read(golden.join("final.png")).unwrap();
     let record = std::fs::read(golden.join("blessed.toml")).unwrap();

@@ -1,4 +1,8 @@
-//! Shared helpers for GPU tests: which backends to run, and when a missing one is a failure.
+//! Shared helpers for the harness tests: which backends to run (and when a missing one is a
+//! failure), and temporary copies of the workspace.
+
+// Each test binary uses some of these helpers.
+#![allow(dead_code)]
 
 use engine::backend::{self, BackendKind};
 
@@ -27,4 +31,27 @@ pub fn available_backends() -> Vec<BackendKind> {
         }
     }
     kinds
+}
+
+/// Copies a folder tree (for tests that write into a temporary copy of the workspace).
+pub fn copy_tree(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).unwrap();
+        }
+    }
+}
+
+/// A temporary copy of the workspace's scenes/ and golden/, to point HARNESS_ROOT at.
+pub fn temp_workspace() -> tempfile::TempDir {
+    let root = tempfile::tempdir().unwrap();
+    let workspace = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    copy_tree(&workspace.join("scenes"), &root.path().join("scenes"));
+    copy_tree(&workspace.join("golden"), &root.path().join("golden"));
+    root
 }
