@@ -16,31 +16,25 @@ use std::time::{Duration, Instant};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode};
 use engine::backend::{self, Backend, BackendKind};
 use engine::plan::RenderPlan;
-use engine::renderer::{self, Readback};
 use engine::scene::Scene;
 use harness::bench::{pass_time, Floors};
 
-/// Renders `scene` once and returns the GPU time of plan pass `pass` (every pass when `None`)
-/// (wall time of the render when the backend has no timestamps).
+/// GPU time of plan pass `pass` (every pass when `None`) in one render of `scene` (wall time
+/// of the render when the backend has no timestamps).
 fn timed_render(
     backend: &mut dyn Backend,
     scene: &Scene,
     plan: &RenderPlan,
     pass: Option<&str>,
 ) -> Duration {
-    let start = Instant::now();
-    let frame = renderer::render(backend, scene, Readback::Only(&[]))
-        .unwrap_or_else(|e| panic!("{}: {e}", scene.name));
-    let wall = start.elapsed();
-    let ns: Option<f64> = match pass {
+    harness::bench::timed_render(backend, scene, |timings| match pass {
         Some(name) => plan
             .passes
             .iter()
             .find(|p| p.name == name)
-            .and_then(|spec| pass_time(&frame.timings, spec)),
-        None => frame.timings.iter().map(|t| t.gpu_ns).sum(),
-    };
-    ns.map_or(wall, |ns| Duration::from_nanos(ns as u64))
+            .and_then(|spec| pass_time(timings, spec)),
+        None => timings.iter().map(|t| t.gpu_ns).sum(),
+    })
 }
 
 fn passes(c: &mut Criterion) {

@@ -15,27 +15,22 @@
 //! Flat sampling with ten samples keeps the run short on a 2-core machine: every figure is the
 //! mean of ten frames, each a full render.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode};
 use engine::backend::{self, Backend, BackendKind};
-use engine::renderer::{self, Readback};
 use engine::scene::{Light, PointShadowPass, Scene, ShadowFilter};
 
 /// GPU time of the passes whose names start with one of `prefixes` in one render of `scene`
 /// (wall time of the render where the backend has no timestamps).
 fn timed_render(backend: &mut dyn Backend, scene: &Scene, prefixes: &[&str]) -> Duration {
-    let start = Instant::now();
-    let frame = renderer::render(backend, scene, Readback::Only(&[]))
-        .unwrap_or_else(|e| panic!("{}: {e}", scene.name));
-    let wall = start.elapsed();
-    let gpu_ns: Option<f64> = frame
-        .timings
-        .iter()
-        .filter(|t| prefixes.iter().any(|p| t.name.starts_with(p)))
-        .map(|t| t.gpu_ns)
-        .sum();
-    gpu_ns.map_or(wall, |ns| Duration::from_nanos(ns as u64))
+    harness::bench::timed_render(backend, scene, |timings| {
+        timings
+            .iter()
+            .filter(|t| prefixes.iter().any(|p| t.name.starts_with(p)))
+            .map(|t| t.gpu_ns)
+            .sum()
+    })
 }
 
 fn with_filter(scene: &Scene, filter: ShadowFilter) -> Scene {

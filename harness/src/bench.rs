@@ -134,6 +134,21 @@ pub fn pass_time(timings: &[backend::PassTiming], spec: &PassSpec) -> Option<f64
     matched.try_fold(first, |sum, t| t.gpu_ns.map(|ns| sum + ns))
 }
 
+/// Renders `scene` once (nothing read back) for the criterion benchmarks: the GPU ns `pick`
+/// takes from the frame's pass timings, or the render's wall time when it gives none (no
+/// timestamps). Panics on a failed render, as a benchmark should.
+pub fn timed_render(
+    backend: &mut dyn Backend,
+    scene: &Scene,
+    pick: impl FnOnce(&[backend::PassTiming]) -> Option<f64>,
+) -> std::time::Duration {
+    let start = Instant::now();
+    let frame = renderer::render(backend, scene, Readback::Only(&[]))
+        .unwrap_or_else(|e| panic!("{}: {e}", scene.name));
+    let wall = start.elapsed();
+    pick(&frame.timings).map_or(wall, |ns| std::time::Duration::from_nanos(ns as u64))
+}
+
 /// Floor passes for every pass of a plan, created once on a backend and submitted on demand.
 pub struct Floors {
     scope: ResourceScope,
