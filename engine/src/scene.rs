@@ -460,6 +460,8 @@ pub struct Quality {
     pub debug_shadow_terms: bool,
     /// How point-light shadow faces are drawn (default: six passes, the faster on llvmpipe).
     pub point_shadows: PointShadowPass,
+    /// Image-based lighting precompute settings (used only with an environment).
+    pub ibl: crate::ibl::IblSettings,
 }
 
 impl Default for Quality {
@@ -472,6 +474,7 @@ impl Default for Quality {
             gizmos: false,
             debug_shadow_terms: false,
             point_shadows: PointShadowPass::SixPasses,
+            ibl: crate::ibl::IblSettings::default(),
         }
     }
 }

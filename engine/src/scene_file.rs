@@ -15,6 +15,7 @@ use glam::{DQuat, DVec3, EulerRot};
 use serde::Deserialize;
 
 use crate::assets::{self, AssetError, ColorSpace, TextureCache, TextureId};
+use crate::ibl::IblSettings;
 use crate::mesh::{self, MeshData};
 use crate::scene::*;
 
@@ -128,6 +129,8 @@ pub struct QualitySpec {
     pub debug_shadow_terms: Option<bool>,
     /// `six-passes` (default) or `geometry-shader` (gl only).
     pub point_shadows: Option<PointShadowPass>,
+    /// `[quality.ibl]`: image-based lighting precompute (defaults in [`IblSettings`]).
+    pub ibl: Option<IblSettings>,
 }
 
 /// `[environment]`.
@@ -302,6 +305,7 @@ impl QualitySpec {
             gizmos: None,
             debug_shadow_terms: None,
             point_shadows: None,
+            ibl: None,
         }
     }
 }
@@ -538,6 +542,7 @@ impl Resolver {
             gizmos: q.gizmos.unwrap_or(defaults.gizmos),
             debug_shadow_terms: q.debug_shadow_terms.unwrap_or(defaults.debug_shadow_terms),
             point_shadows: q.point_shadows.unwrap_or(defaults.point_shadows),
+            ibl: q.ibl.clone().unwrap_or(defaults.ibl),
         };
         let environment = match &file.environment {
             Some(spec) => {

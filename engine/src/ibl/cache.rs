@@ -1,0 +1,278 @@
+//! Caches of precomputed IBL maps: one in memory per process, and optionally one on disk.
+//!
+//! Disk entries are named by the SHA-256 of the environment's texels, its size, the
+//! [`IblSettings`] and [`FORMAT_VERSION`], so a changed image, setting or algorithm misses. An
+//! entry is written to a temporary file in the same directory and renamed into place, so a
+//! reader never sees half of one. Each entry ends with the SHA-256 of its payload: an entry
+//! that is truncated, corrupt or from another version is rebuilt (with a warning), never
+//! trusted.
+
+use std::collections::VecDeque;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, RwLock};
+
+use sha2::{Digest, Sha256};
+
+use super::{CubeLevel, CubeMap, IblMaps, IblSettings};
+use crate::scene::EnvironmentImage;
+
+/// Bump when the maps an entry holds would change for the same key (algorithm or layout).
+pub const FORMAT_VERSION: u32 = 1;
+
+const MAGIC: &[u8; 8] = b"IBLMAPS\0";
+
+/// Maps kept in memory per process (most recent first out last).
+const MEMORY_ENTRIES: usize = 8;
+
+/// A cache entry's name: SHA-256 of everything the maps depend on.
+pub type Key = [u8; 32];
+
+/// Why the disk cache could not be written.
+#[derive(Debug, thiserror::Error)]
+#[error("IBL cache `{}`: {source}", path.display())]
+pub struct CacheError {
+    /// The file or directory.
+    pub path: PathBuf,
+    /// What failed.
+    #[source]
+    pub source: std::io::Error,
+}
+
+static DIRECTORY: RwLock<Option<PathBuf>> = RwLock::new(None);
+static MEMORY: Mutex<VecDeque<(Key, Arc<IblMaps>)>> = Mutex::new(VecDeque::new());
+
+/// Sets (or with `None` clears) the directory [`super::prepare`] caches maps in. Without one,
+/// maps are only kept in memory.
+pub fn set_directory(directory: Option<PathBuf>) {
+    *DIRECTORY.write().unwrap_or_else(|e| e.into_inner()) = directory;
+}
+
+/// The directory set with [`set_directory`].
+pub fn directory() -> Option<PathBuf> {
+    DIRECTORY.read().unwrap_or_else(|e| e.into_inner()).clone()
+}
+
+/// The key of an environment and settings.
+pub fn key(image: &EnvironmentImage, settings: &IblSettings) -> Key {
+    let mut hash = Sha256::new();
+    hash.update(MAGIC);
+    hash.update(FORMAT_VERSION.to_le_bytes());
+    hash.update(image.width.to_le_bytes());
+    hash.update(image.height.to_le_bytes());
+    for texel in &image.texels {
+        for c in texel {
+            hash.update(c.to_bits().to_le_bytes());
+        }
+    }
+    hash.update(
+        serde_json::to_vec(settings).expect("IBL settings serialise"), // plain struct
+    );
+    hash.finalize().into()
+}
+
+/// Entry file name of a key.
+pub fn file_name(key: &Key) -> String {
+    let hex: String = key.iter().map(|b| format!("{b:02x}")).collect();
+    format!("ibl-{hex}.bin")
+}
+
+pub(super) fn memory_get(key: &Key) -> Option<Arc<IblMaps>> {
+    let memory = MEMORY.lock().unwrap_or_else(|e| e.into_inner());
+    memory
+        .iter()
+        .find(|(k, _)| k == key)
+        .map(|(_, m)| m.clone())
+}
+
+pub(super) fn memory_put(key: Key, maps: Arc<IblMaps>) {
+    let mut memory = MEMORY.lock().unwrap_or_else(|e| e.into_inner());
+    memory.retain(|(k, _)| *k != key);
+    memory.push_back((key, maps));
+    while memory.len() > MEMORY_ENTRIES {
+        memory.pop_front();
+    }
+}
+
+/// Forgets the maps kept in memory (for tests and timing the disk cache).
+pub fn clear_memory() {
+    MEMORY.lock().unwrap_or_else(|e| e.into_inner()).clear();
+}
+
+fn push_level(out: &mut Vec<u8>, level: &CubeLevel) {
+    out.extend_from_slice(&level.size.to_le_bytes());
+    for t in &level.texels {
+        for c in t {
+            out.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+}
+
+/// The bytes of an entry: header, payload, SHA-256 of the payload.
+pub fn encode(key: &Key, maps: &IblMaps) -> Vec<u8> {
+    let mut payload = Vec::new();
+    payload.extend_from_slice(&(maps.specular.levels.len() as u32).to_le_bytes());
+    for level in &maps.specular.levels {
+        push_level(&mut payload, level);
+    }
+    push_level(&mut payload, &maps.irradiance);
+    payload.extend_from_slice(&(maps.dfg.len() as u32).to_le_bytes());
+    for t in &maps.dfg {
+        payload.extend_from_slice(&t[0].to_le_bytes());
+        payload.extend_from_slice(&t[1].to_le_bytes());
+    }
+    let mut out = Vec::with_capacity(payload.len() + 84);
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    out.extend_from_slice(key);
+    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    out.extend_from_slice(&payload);
+    out.extend_from_slice(&Sha256::digest(&payload));
+    out
+}
+
+struct Reader<'a>(&'a [u8]);
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
+        if self.0.len() < n {
+            return Err("truncated".into());
+        }
+        let (head, rest) = self.0.split_at(n);
+        self.0 = rest;
+        Ok(head)
+    }
+
+    fn u32(&mut self) -> Result<u32, String> {
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().expect("4 bytes"),
+        ))
+    }
+
+    fn f32(&mut self) -> Result<f32, String> {
+        let v = f32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes"));
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err("non-finite value".into())
+        }
+    }
+
+    fn level(&mut self) -> Result<CubeLevel, String> {
+        let size = self.u32()?;
+        if size == 0 || size > 4096 {
+            return Err(format!("bad level size {size}"));
+        }
+        let count = 6 * (size as usize).pow(2);
+        if self.0.len() < count * 12 {
+            return Err("truncated".into());
+        }
+        let texels = (0..count)
+            .map(|_| Ok([self.f32()?, self.f32()?, self.f32()?]))
+            .collect::<Result<_, String>>()?;
+        Ok(CubeLevel { size, texels })
+    }
+}
+
+/// Parses an entry, checking its header, key and checksum.
+pub fn decode(key: &Key, bytes: &[u8]) -> Result<IblMaps, String> {
+    let mut r = Reader(bytes);
+    if r.take(8)? != MAGIC {
+        return Err("not an IBL cache entry".into());
+    }
+    let version = r.u32()?;
+    if version != FORMAT_VERSION {
+        return Err(format!(
+            "format version {version}, expected {FORMAT_VERSION}"
+        ));
+    }
+    if r.take(32)? != key {
+        return Err("key mismatch".into());
+    }
+    let length = u64::from_le_bytes(r.take(8)?.try_into().expect("8 bytes")) as usize;
+    let payload = r.take(length)?;
+    let checksum = r.take(32)?;
+    if !r.0.is_empty() {
+        return Err("trailing bytes".into());
+    }
+    if Sha256::digest(payload).as_slice() != checksum {
+        return Err("checksum mismatch".into());
+    }
+    let mut p = Reader(payload);
+    let levels = p.u32()?;
+    if levels == 0 || levels > 16 {
+        return Err(format!("bad level count {levels}"));
+    }
+    let specular = CubeMap {
+        levels: (0..levels).map(|_| p.level()).collect::<Result<_, _>>()?,
+    };
+    let irradiance = p.level()?;
+    let dfg_len = p.u32()? as usize;
+    if p.0.len() != dfg_len * 8 {
+        return Err("bad DFG table length".into());
+    }
+    let dfg = (0..dfg_len)
+        .map(|_| Ok([p.f32()?, p.f32()?]))
+        .collect::<Result<_, String>>()?;
+    Ok(IblMaps {
+        specular,
+        irradiance,
+        dfg,
+    })
+}
+
+/// The entry for `key` in `directory`, if there is a valid one. A missing entry is a quiet
+/// miss; an unreadable or invalid one is logged as a warning and treated as a miss (it will be
+/// rebuilt and replaced).
+pub fn read(directory: &Path, key: &Key) -> Option<IblMaps> {
+    let path = directory.join(file_name(key));
+    let bytes = match std::fs::read(&path) {
+        Ok(bytes) => bytes,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return None,
+        Err(e) => {
+            log::warn!(
+                "IBL cache `{}` unreadable ({e}); rebuilding",
+                path.display()
+            );
+            return None;
+        }
+    };
+    match decode(key, &bytes) {
+        Ok(maps) => Some(maps),
+        Err(problem) => {
+            log::warn!(
+                "IBL cache `{}` is invalid ({problem}); rebuilding",
+                path.display()
+            );
+            None
+        }
+    }
+}
+
+/// Writes the entry for `key` atomically (temporary file in the same directory, then rename).
+pub fn write(directory: &Path, key: &Key, maps: &IblMaps) -> Result<PathBuf, CacheError> {
+    let err = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| CacheError { path, source }
+    };
+    std::fs::create_dir_all(directory).map_err(err(directory))?;
+    let path = directory.join(file_name(key));
+    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let temporary = directory.join(format!(
+        ".{}.{}.{}.tmp",
+        file_name(key),
+        std::process::id(),
+        COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+    ));
+    let result = (|| {
+        let mut file = std::fs::File::create(&temporary)?;
+        file.write_all(&encode(key, maps))?;
+        file.sync_all()?;
+        std::fs::rename(&temporary, &path)
+    })();
+    if let Err(source) = result {
+        let _ = std::fs::remove_file(&temporary);
+        return Err(CacheError { path, source });
+    }
+    Ok(path)
+}

@@ -1,0 +1,301 @@
+//! Image-based lighting, precomputed on the CPU: the split-sum model's three maps, built from
+//! an equirectangular environment.
+//!
+//! - [`CubeMap`] `specular`: the environment prefiltered with the GGX lobe, one roughness per
+//!   mip ([`specular`] documents the roughness-to-mip mapping and the filtered importance
+//!   sampling that keeps a bright sun from leaving fireflies).
+//! - `irradiance`: diffuse irradiance / pi as a small cube, by exact convolution (default) or
+//!   SH9 ([`irradiance`] says why).
+//! - `dfg`: the DFG lookup table of the split sum ([`dfg`]).
+//!
+//! Why the CPU: the maps are a pure function of the image and [`IblSettings`], so computing
+//! them once, identically for every backend, keeps driver differences out of them (one golden
+//! serves all backends), and the result can be cached on disk ([`cache`]) keyed by a hash of the
+//! image and settings. The work is split over threads by texel, and every texel is computed
+//! alone, so the maps are bit-identical whatever the thread count. Rotation and intensity are
+//! applied when the lighting pass samples the maps, so changing them needs no precompute.
+
+pub mod cache;
+pub mod cube;
+pub mod dfg;
+pub mod irradiance;
+pub mod specular;
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+pub use cube::{CubeLevel, CubeMap};
+
+use crate::scene::EnvironmentImage;
+
+/// How the diffuse irradiance map is built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum IrradianceMethod {
+    /// Exact cosine convolution of a 32 x 32 source mip.
+    Convolution,
+    /// Nine spherical-harmonic coefficients (order 2).
+    Sh9,
+}
+
+impl IrradianceMethod {
+    /// Name in scene files and plans.
+    pub fn name(self) -> &'static str {
+        match self {
+            IrradianceMethod::Convolution => "convolution",
+            IrradianceMethod::Sh9 => "sh9",
+        }
+    }
+}
+
+/// The IBL quality knobs (`[quality.ibl]` in scene files).
+#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct IblSettings {
+    /// Face size of the environment cube the prefilter reads (power of two).
+    pub source_size: u32,
+    /// Face size of the prefiltered specular cube's level 0 (power of two, at most
+    /// `source_size`); levels go down to 4 x 4.
+    pub specular_size: u32,
+    /// GGX samples per texel of level 1; each level after it takes four times more (see
+    /// [`specular::samples_at`]).
+    pub specular_samples: u32,
+    /// Face size of the irradiance cube.
+    pub irradiance_size: u32,
+    /// How irradiance is computed.
+    pub irradiance: IrradianceMethod,
+    /// Seed of the sample pattern (0: plain Hammersley; others add a seeded Cranley-Patterson
+    /// rotation), to check that the result does not depend on the pattern.
+    pub seed: u32,
+}
+
+impl Default for IblSettings {
+    fn default() -> Self {
+        Self {
+            source_size: 256,
+            specular_size: 128,
+            specular_samples: 128,
+            irradiance_size: 32,
+            irradiance: IrradianceMethod::Convolution,
+            seed: 0,
+        }
+    }
+}
+
+impl IblSettings {
+    /// Why these settings cannot be used, if they cannot.
+    pub fn problem(&self) -> Option<String> {
+        let pow2 = |v: u32| v.is_power_of_two();
+        if !pow2(self.source_size) || !(16..=2048).contains(&self.source_size) {
+            return Some(format!(
+                "ibl source_size {} must be a power of two in 16..2048",
+                self.source_size
+            ));
+        }
+        if !pow2(self.specular_size)
+            || self.specular_size < 8
+            || self.specular_size > self.source_size
+        {
+            return Some(format!(
+                "ibl specular_size {} must be a power of two from 8 to source_size {}",
+                self.specular_size, self.source_size
+            ));
+        }
+        if !(1..=65536).contains(&self.specular_samples) {
+            return Some(format!(
+                "ibl specular_samples {} must be in 1..65536",
+                self.specular_samples
+            ));
+        }
+        if !(1..=256).contains(&self.irradiance_size) {
+            return Some(format!(
+                "ibl irradiance_size {} must be in 1..256",
+                self.irradiance_size
+            ));
+        }
+        None
+    }
+
+    /// One line for plans and reports.
+    pub fn describe(&self) -> String {
+        format!(
+            "specular {} x {} mips, {} GGX samples from a {} cube; irradiance {} {}; DFG {}x{}",
+            self.specular_size,
+            specular::level_count(self.specular_size),
+            self.specular_samples,
+            self.source_size,
+            self.irradiance.name(),
+            self.irradiance_size,
+            dfg::SIZE,
+            dfg::SIZE,
+        ) + &if self.seed != 0 {
+            format!(", seed {}", self.seed)
+        } else {
+            String::new()
+        }
+    }
+}
+
+/// The precomputed maps of one environment.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IblMaps {
+    /// Prefiltered specular radiance; level `m` holds roughness `m / (levels - 1)`.
+    pub specular: CubeMap,
+    /// Irradiance / pi.
+    pub irradiance: CubeLevel,
+    /// DFG table (`scale`, `bias`), [`dfg::SIZE`] square, `NoV` across, roughness down.
+    pub dfg: Vec<[f32; 2]>,
+}
+
+/// Builds the maps (the whole precompute, no caches).
+pub fn build(image: &EnvironmentImage, settings: &IblSettings) -> IblMaps {
+    let base = cube::cube_from_equirect(image, settings.source_size);
+    let source = CubeMap::with_mips(base, 1);
+    IblMaps {
+        specular: specular::prefilter(&source, settings),
+        irradiance: irradiance::irradiance(&source, settings.irradiance_size, settings.irradiance),
+        dfg: dfg_table().as_ref().clone(),
+    }
+}
+
+/// The DFG table, computed once per process (it depends on nothing).
+pub fn dfg_table() -> Arc<Vec<[f32; 2]>> {
+    static TABLE: std::sync::OnceLock<Arc<Vec<[f32; 2]>>> = std::sync::OnceLock::new();
+    TABLE
+        .get_or_init(|| Arc::new(dfg::table(dfg::SIZE, dfg::SAMPLES)))
+        .clone()
+}
+
+/// Where a frame's maps came from.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "kebab-case", tag = "from")]
+pub enum MapsSource {
+    /// Computed now, taking this long.
+    Built {
+        /// Seconds of CPU precompute.
+        seconds: f64,
+    },
+    /// Read from the disk cache.
+    Disk {
+        /// Seconds to read and verify.
+        seconds: f64,
+    },
+    /// Already in this process.
+    Memory,
+}
+
+impl MapsSource {
+    /// Seconds this frame spent on the precompute.
+    pub fn seconds(self) -> f64 {
+        match self {
+            MapsSource::Built { seconds } | MapsSource::Disk { seconds } => seconds,
+            MapsSource::Memory => 0.0,
+        }
+    }
+}
+
+/// The maps for an environment and settings: from this process's memory, else from the disk
+/// cache set with [`cache::set_directory`], else built (and then stored in both).
+pub fn prepare(
+    image: &EnvironmentImage,
+    settings: &IblSettings,
+) -> Result<(Arc<IblMaps>, MapsSource), cache::CacheError> {
+    let key = cache::key(image, settings);
+    if let Some(maps) = cache::memory_get(&key) {
+        return Ok((maps, MapsSource::Memory));
+    }
+    let start = Instant::now();
+    let directory = cache::directory();
+    if let Some(dir) = &directory {
+        if let Some(maps) = cache::read(dir, &key) {
+            let maps = Arc::new(maps);
+            cache::memory_put(key, maps.clone());
+            return Ok((
+                maps,
+                MapsSource::Disk {
+                    seconds: start.elapsed().as_secs_f64(),
+                },
+            ));
+        }
+    }
+    let maps = Arc::new(build(image, settings));
+    let seconds = start.elapsed().as_secs_f64();
+    if let Some(dir) = &directory {
+        cache::write(dir, &key, &maps)?;
+    }
+    cache::memory_put(key, maps.clone());
+    Ok((maps, MapsSource::Built { seconds }))
+}
+
+/// `f(i)` for `i` in `0..count`, split over the available cores. Each element is computed on
+/// its own, so the result does not depend on the thread count.
+pub(crate) fn parallel_map<T: Send>(count: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(16);
+    if threads <= 1 || count < 256 {
+        return (0..count).map(f).collect();
+    }
+    let chunk = count.div_ceil(threads);
+    let f = &f;
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads)
+            .map(|t| {
+                let range = (t * chunk).min(count)..((t + 1) * chunk).min(count);
+                scope.spawn(move || range.map(f).collect::<Vec<T>>())
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().expect("IBL worker thread panicked"))
+            .collect()
+    })
+}
+
+/// Point `i` of `n` of the Hammersley set, optionally rotated (Cranley-Patterson) by offsets
+/// derived from `seed`.
+pub fn hammersley(i: u32, n: u32, seed: u32) -> (f32, f32) {
+    let u1 = i as f32 / n as f32;
+    let u2 = i.reverse_bits() as f32 * (1.0 / 4_294_967_296.0);
+    if seed == 0 {
+        return (u1, u2);
+    }
+    let offset = |salt: u64| {
+        // SplitMix64 of (seed, salt): a fixed function, no global state.
+        let mut z = (u64::from(seed) << 32 | salt).wrapping_add(0x9e37_79b9_7f4a_7c15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+    };
+    ((u1 + offset(1)).fract(), (u2 + offset(2)).fract())
+}
+
+/// A GGX-distributed half vector around +Z for uniform `(u1, u2)`.
+pub fn ggx_half_vector(u1: f32, u2: f32, alpha: f32) -> Vec3 {
+    let a2 = alpha * alpha;
+    let cos_theta = ((1.0 - u1) / (1.0 + (a2 - 1.0) * u1)).max(0.0).sqrt();
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = std::f32::consts::TAU * u2;
+    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
+/// GGX normal distribution (Filament's form).
+pub fn d_ggx(n_dot_h: f32, alpha: f32) -> f32 {
+    let a = n_dot_h * alpha;
+    let k = alpha / (1.0 - n_dot_h * n_dot_h + a * a);
+    k * k / std::f32::consts::PI
+}
+
+/// Two unit vectors completing `n` to an orthonormal basis (Duff et al. 2017).
+pub fn tangent_frame(n: Vec3) -> (Vec3, Vec3) {
+    let sign = 1.0f32.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (
+        Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        Vec3::new(b, sign + n.y * n.y * a, -n.y),
+    )
+}
