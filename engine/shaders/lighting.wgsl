@@ -7,6 +7,14 @@
 // k_d = (1 - F)(1 - metallic), f_s = D_GGX F_Schlick V_SmithGGXCorrelated (anisotropic D and V
 // when anisotropy != 0), clearcoat f_c = D_GGX V_Kelemen F_c with F0 = 0.04, F_c = F_Schlick *
 // clearcoat, alpha = roughness^2 + 0.001, F0 = 0.16 specular^2 (1 - metallic) + base metallic.
+//
+// Image-based lighting (first batch of a draw only) is the split sum, as in Filament's
+// light_indirect.fs: specular = prefiltered(R, roughness) * (F0 * DFG.x + DFG.y) and diffuse =
+// base (1 - metallic) (1 - E) irradiance / pi (E the specular's directional albedo, so white
+// furnace energy is conserved); clearcoat attenuates both by (1 - Fc) and adds its own lobe;
+// anisotropy bends the reflection vector, and rough lobes lean towards N (the dominant
+// direction). Specular occlusion is left out. Other models get the
+// irradiance as diffuse ambient.
 
 const PI: f32 = 3.14159265358979;
 const MAX_LIGHTS: u32 = 16u;
@@ -31,6 +39,9 @@ struct LightingUniforms {
     ambient: vec4<f32>,
     // x = number of lights in this batch; y = 1 to emit unlit albedo (first batch only).
     counts: vec4<u32>,
+    // IBL: x = environment intensity * exposure (0: none, or not the first batch), y = highest
+    // specular lod (roughness 1), z, w = cos and sin of the environment's rotation about +Y.
+    ibl: vec4<f32>,
     lights: array<LightData, 16>,
 }
 
@@ -72,6 +83,13 @@ struct ShadowUniforms {
 // sampled bilinearly.
 @group(0) @binding(11) var shadow_moments: texture_2d<f32>;
 @group(0) @binding(12) var moments_sampler: sampler;
+
+// Image-based lighting maps (crate::ibl): irradiance / pi, prefiltered specular with roughness
+// r at lod r * u.ibl.y, and the DFG table (x = scale, y = bias; NoV across, roughness down).
+@group(0) @binding(13) var ibl_irradiance: texture_cube<f32>;
+@group(0) @binding(14) var ibl_specular: texture_cube<f32>;
+@group(0) @binding(15) var ibl_dfg: texture_2d<f32>;
+@group(0) @binding(16) var ibl_sampler: sampler;
 
 fn shadow_tap(uv: vec2<f32>, reference: f32, bounds: vec4<f32>) -> f32 {
     return textureSampleCompareLevel(shadow_map, shadow_sampler, clamp(uv, bounds.xy, bounds.zw), reference);
@@ -461,6 +479,55 @@ fn brdf_times_cosine(model: u32, s: Surface, v: vec3<f32>, l: vec3<f32>) -> vec3
     }
 }
 
+// World direction to environment-map direction (the rotation about +Y, as skybox.wgsl).
+fn environment_direction(d: vec3<f32>) -> vec3<f32> {
+    let c = u.ibl.z;
+    let s = u.ibl.w;
+    return vec3<f32>(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
+}
+
+fn ibl_irradiance_at(n: vec3<f32>) -> vec3<f32> {
+    return textureSampleLevel(ibl_irradiance, ibl_sampler, environment_direction(n), 0.0).rgb;
+}
+
+fn ibl_prefiltered(r: vec3<f32>, roughness: f32) -> vec3<f32> {
+    let lod = clamp(roughness, 0.0, 1.0) * u.ibl.y;
+    return textureSampleLevel(ibl_specular, ibl_sampler, environment_direction(r), lod).rgb;
+}
+
+// Split-sum IBL of the PBR model (unexposed; the caller scales by u.ibl.x).
+fn pbr_ibl(s: Surface, v: vec3<f32>) -> vec3<f32> {
+    let n = s.normal;
+    let n_dot_v = max(dot(n, v), MIN_N_DOT_V);
+    let f0 = vec3<f32>(0.16 * s.specular * s.specular * (1.0 - s.metallic)) + s.base_color * s.metallic;
+    // Texel i of the table holds parameter i / (size - 1) (crate::ibl::dfg): remap so that 0 and 1
+    // land on the first and last texel centers.
+    let dfg_size = vec2<f32>(textureDimensions(ibl_dfg));
+    let dfg_uv = (vec2<f32>(n_dot_v, clamp(s.roughness, 0.0, 1.0)) * (dfg_size - 1.0) + 0.5) / dfg_size;
+    let dfg = textureSampleLevel(ibl_dfg, ibl_sampler, dfg_uv, 0.0).xy;
+    let e = f0 * dfg.x + vec3<f32>(dfg.y);
+    // Anisotropy: reflect about a normal bent towards the anisotropic direction (Filament's
+    // getReflectedVector), scaled down for smooth surfaces.
+    var bent = n;
+    if s.anisotropy != 0.0 {
+        let b = cross(n, s.tangent);
+        let direction = select(s.tangent, b, s.anisotropy >= 0.0);
+        let anisotropic_tangent = cross(direction, v);
+        let anisotropic_normal = cross(anisotropic_tangent, direction);
+        let amount = abs(s.anisotropy) * clamp(5.0 * s.roughness, 0.0, 1.0);
+        bent = safe_normalize(mix(n, anisotropic_normal, amount), n);
+    }
+    // The lobe's dominant direction leans from R towards N as roughness grows (Filament's
+    // getSpecularDominantDirection): the split sum's N = V = R assumption misses that.
+    let r = reflect(-v, bent);
+    let dominant = safe_normalize(mix(r, bent, s.roughness * s.roughness * s.roughness * s.roughness), r);
+    let specular = ibl_prefiltered(dominant, s.roughness) * e;
+    let diffuse = s.base_color * (1.0 - s.metallic) * (vec3<f32>(1.0) - e) * ibl_irradiance_at(n);
+    let clearcoat_fresnel = (0.04 + 0.96 * pow5(1.0 - n_dot_v)) * s.clearcoat;
+    let clearcoat = ibl_prefiltered(reflect(-v, n), s.clearcoat_roughness) * clearcoat_fresnel;
+    return (diffuse + specular) * (1.0 - clearcoat_fresnel) + clearcoat;
+}
+
 // Exposed radiance of a masked pixel under the draw's ambient and lights. Ambient is diffuse:
 // PBR scales it by (1 - metallic), the other models by the base color alone.
 fn shade(model: u32, pixel: vec2<i32>) -> vec4<f32> {
@@ -469,6 +536,13 @@ fn shade(model: u32, pixel: vec2<i32>) -> vec4<f32> {
     var radiance = s.base_color * u.ambient.rgb;
     if model == MODEL_PBR {
         radiance *= 1.0 - s.metallic;
+    }
+    if u.ibl.x > 0.0 {
+        if model == MODEL_PBR {
+            radiance += pbr_ibl(s, v) * u.ibl.x;
+        } else {
+            radiance += s.base_color * ibl_irradiance_at(s.normal) * u.ibl.x;
+        }
     }
     for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
         let light = incoming(u.lights[i], s);

@@ -4,7 +4,7 @@
 //!
 //! What is left out, and when: no shader-mask channel for a lighting model no object uses (and a
 //! second mask target only past four models), no lighting pass for an unused model, no skybox
-//! without an environment, no gizmos unless the quality settings ask for them.
+//! or IBL precompute without an environment, no gizmos unless the quality settings ask for them.
 
 use std::fmt;
 
@@ -47,6 +47,9 @@ pub enum PassKind {
     Geometry,
     /// Draws every object's one-hot lighting-model channel into the mask targets.
     ShaderMask,
+    /// On the CPU, before any GPU pass: the environment's IBL maps (prefiltered specular,
+    /// irradiance, DFG), read by the lighting passes; cached in memory and on disk.
+    IblPrecompute,
     /// Fills uncovered pixels of the light buffer from the environment.
     Skybox,
     /// Shades one lighting model's pixels into the light buffer.
@@ -331,6 +334,13 @@ impl RenderPlan {
         });
         if let Some(environment) = &scene.environment {
             passes.push(PassSpec {
+                name: "ibl_precompute".to_owned(),
+                kind: PassKind::IblPrecompute,
+                reads: vec![],
+                writes: vec![],
+                detail: format!("CPU, cached: {}", scene.quality.ibl.describe()),
+            });
+            passes.push(PassSpec {
                 name: "skybox".to_owned(),
                 kind: PassKind::Skybox,
                 reads: masks.clone(),
@@ -471,7 +481,9 @@ impl fmt::Display for RenderPlan {
             if !p.reads.is_empty() {
                 writeln!(f, "       reads  {}", p.reads.join(", "))?;
             }
-            writeln!(f, "       writes {}", p.writes.join(", "))?;
+            if !p.writes.is_empty() {
+                writeln!(f, "       writes {}", p.writes.join(", "))?;
+            }
         }
         Ok(())
     }

@@ -248,13 +248,13 @@ fn prepare_uses_memory_then_disk() {
         seed: 3,
         ..IblSettings::default()
     };
-    let (first, source) = ibl::prepare(&image, &settings).unwrap();
+    let (first, source) = ibl::prepare(&image, &settings);
     assert!(matches!(source, MapsSource::Built { .. }), "{source:?}");
-    let (second, source) = ibl::prepare(&image, &settings).unwrap();
+    let (second, source) = ibl::prepare(&image, &settings);
     assert_eq!(source, MapsSource::Memory);
     assert!(Arc::ptr_eq(&first, &second));
     ibl::cache::clear_memory();
-    let (third, source) = ibl::prepare(&image, &settings).unwrap();
+    let (third, source) = ibl::prepare(&image, &settings);
     assert!(matches!(source, MapsSource::Disk { .. }), "{source:?}");
     assert_eq!(*third, *first);
     let path = dir
@@ -262,9 +262,17 @@ fn prepare_uses_memory_then_disk() {
         .join(ibl::cache::file_name(&ibl::cache::key(&image, &settings)));
     std::fs::write(&path, b"IBLMAPS\0garbage").unwrap();
     ibl::cache::clear_memory();
-    let (fourth, source) = ibl::prepare(&image, &settings).unwrap();
+    let (fourth, source) = ibl::prepare(&image, &settings);
     assert!(matches!(source, MapsSource::Built { .. }), "{source:?}");
     assert_eq!(*fourth, *first);
     assert!(ibl::cache::read(dir.path(), &ibl::cache::key(&image, &settings)).is_some());
+    // A cache that cannot be written is a warning: the maps still come back, built.
+    let blocked = dir.path().join("a file, not a folder");
+    std::fs::write(&blocked, b"").unwrap();
+    ibl::cache::set_directory(Some(blocked));
+    ibl::cache::clear_memory();
+    let (fifth, source) = ibl::prepare(&image, &settings);
+    assert!(matches!(source, MapsSource::Built { .. }), "{source:?}");
+    assert_eq!(*fifth, *first);
     ibl::cache::set_directory(None);
 }

@@ -35,7 +35,6 @@ pub struct CacheError {
     /// The file or directory.
     pub path: PathBuf,
     /// What failed.
-    #[source]
     pub source: std::io::Error,
 }
 

@@ -77,7 +77,7 @@ impl Default for IblSettings {
         Self {
             source_size: 256,
             specular_size: 128,
-            specular_samples: 128,
+            specular_samples: 256,
             irradiance_size: 32,
             irradiance: IrradianceMethod::Convolution,
             seed: 0,
@@ -198,14 +198,13 @@ impl MapsSource {
 }
 
 /// The maps for an environment and settings: from this process's memory, else from the disk
-/// cache set with [`cache::set_directory`], else built (and then stored in both).
-pub fn prepare(
-    image: &EnvironmentImage,
-    settings: &IblSettings,
-) -> Result<(Arc<IblMaps>, MapsSource), cache::CacheError> {
+/// cache set with [`cache::set_directory`], else built (and then stored in both). A disk cache
+/// that cannot be written (full disk, read-only folder) is a warning naming the file, not an
+/// error: the frame renders with the maps just built, and no partial entry is left.
+pub fn prepare(image: &EnvironmentImage, settings: &IblSettings) -> (Arc<IblMaps>, MapsSource) {
     let key = cache::key(image, settings);
     if let Some(maps) = cache::memory_get(&key) {
-        return Ok((maps, MapsSource::Memory));
+        return (maps, MapsSource::Memory);
     }
     let start = Instant::now();
     let directory = cache::directory();
@@ -213,21 +212,23 @@ pub fn prepare(
         if let Some(maps) = cache::read(dir, &key) {
             let maps = Arc::new(maps);
             cache::memory_put(key, maps.clone());
-            return Ok((
+            return (
                 maps,
                 MapsSource::Disk {
                     seconds: start.elapsed().as_secs_f64(),
                 },
-            ));
+            );
         }
     }
     let maps = Arc::new(build(image, settings));
     let seconds = start.elapsed().as_secs_f64();
     if let Some(dir) = &directory {
-        cache::write(dir, &key, &maps)?;
+        if let Err(e) = cache::write(dir, &key, &maps) {
+            log::warn!("{e}; continuing without caching these IBL maps");
+        }
     }
     cache::memory_put(key, maps.clone());
-    Ok((maps, MapsSource::Built { seconds }))
+    (maps, MapsSource::Built { seconds })
 }
 
 /// `f(i)` for `i` in `0..count`, split over the available cores. Each element is computed on

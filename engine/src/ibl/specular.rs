@@ -24,8 +24,7 @@ const LOD_BIAS: f32 = 1.0;
 /// 16384.
 pub fn samples_at(base: u32, level: u32) -> u32 {
     base.saturating_mul(1 << (2 * level.saturating_sub(1)).min(16))
-        .min(16384)
-        .max(1)
+        .clamp(1, 16384)
 }
 
 /// Number of levels of the prefiltered cube for a base size (down to 4 x 4 faces).

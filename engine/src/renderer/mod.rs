@@ -10,6 +10,7 @@
 //! camera-relative positions, so a scene 10 km from the origin renders like one at the origin.
 
 mod gizmos;
+mod ibl;
 pub mod shadows;
 mod uniforms;
 
@@ -98,6 +99,8 @@ pub struct Frame {
     pub outputs: BTreeMap<String, Image>,
     /// GPU time per pass, in plan order.
     pub timings: Vec<PassTiming>,
+    /// Where the IBL maps came from (with an environment only).
+    pub ibl: Option<crate::ibl::MapsSource>,
 }
 
 impl Frame {
@@ -153,8 +156,20 @@ pub fn render_with_faults(
             names.iter().map(|s| (*s).to_owned()).collect()
         }
     };
+    let ibl_maps = scene
+        .environment
+        .as_ref()
+        .map(|environment| crate::ibl::prepare(&environment.image, &scene.quality.ibl));
     let mut scope = ResourceScope::default();
-    let result = record_and_submit(backend, scene, &plan, &wanted, faults, &mut scope);
+    let result = record_and_submit(
+        backend,
+        scene,
+        &plan,
+        &wanted,
+        faults,
+        ibl_maps.as_ref().map(|(maps, _)| maps.as_ref()),
+        &mut scope,
+    );
     scope.destroy(backend);
     let (outputs, timings) = result.map_err(|e| match e {
         RenderError::Backend { source, .. } => RenderError::Backend {
@@ -167,6 +182,7 @@ pub fn render_with_faults(
         plan,
         outputs,
         timings,
+        ibl: ibl_maps.map(|(_, source)| source),
     })
 }
 
@@ -325,6 +341,11 @@ pub fn validate(scene: &Scene) -> Result<(), RenderError> {
             return Err(invalid(format!("light {i}: {problem}")));
         }
     }
+    if scene.environment.is_some() {
+        if let Some(problem) = scene.quality.ibl.problem() {
+            return Err(invalid(problem));
+        }
+    }
     if let Some(env) = &scene.environment {
         if !(env.intensity.is_finite() && env.intensity >= 0.0 && env.rotation_degrees.is_finite())
         {
@@ -411,6 +432,16 @@ fn filterable_texture_layout(binding: u32) -> BindingLayout {
     }
 }
 
+fn cube_layout(binding: u32) -> BindingLayout {
+    BindingLayout {
+        binding,
+        kind: BindingKind::Texture {
+            sample_type: TextureSampleType::Float,
+            view: TextureViewKind::Cube,
+        },
+    }
+}
+
 fn uniform_layout() -> BindingLayout {
     BindingLayout {
         binding: 0,
@@ -465,6 +496,7 @@ fn record_and_submit(
     plan: &RenderPlan,
     wanted: &[String],
     faults: &Faults,
+    ibl_maps: Option<&crate::ibl::IblMaps>,
     scope: &mut ResourceScope,
 ) -> Result<Outputs, RenderError> {
     let mut targets: HashMap<String, Handle<Texture>> = HashMap::new();
@@ -872,7 +904,15 @@ fn record_and_submit(
             binding: 12,
             kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
         },
+        cube_layout(13),
+        cube_layout(14),
+        filterable_texture_layout(15),
+        BindingLayout {
+            binding: 16,
+            kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
+        },
     ]);
+    let ibl_textures = ibl::upload(backend, scope, ibl_maps)?;
     let jitter_layers = (shadows::SOFT_RINGS * shadows::SOFT_SECTORS / 2) as u32;
     let jitter = scope.texture(
         backend,
@@ -915,7 +955,7 @@ fn record_and_submit(
             ..SamplerDesc::linear("shadow moments", AddressMode::ClampToEdge)
         },
     )?;
-    // Bind group of a lighting-shader draw (`lighting.wgsl` bindings 0..12).
+    // Bind group of a lighting-shader draw (`lighting.wgsl` bindings 0..16).
     let lighting_bind_group = |uniform, mask, draw: &LightDraw| {
         let mut bindings = vec![binding(0, BindingResource::Buffer(uniform))];
         bindings.extend(
@@ -932,6 +972,10 @@ fn record_and_submit(
             binding(10, BindingResource::Texture(jitter)),
             binding(11, BindingResource::Texture(draw.moments)),
             binding(12, BindingResource::Sampler(moments_sampler)),
+            binding(13, BindingResource::Texture(ibl_textures.irradiance)),
+            binding(14, BindingResource::Texture(ibl_textures.specular)),
+            binding(15, BindingResource::Texture(ibl_textures.dfg)),
+            binding(16, BindingResource::Sampler(ibl_textures.sampler)),
         ]);
         bindings
     };
@@ -1009,7 +1053,13 @@ fn record_and_submit(
         };
         let mut draws = Vec::new();
         for (index, draw) in batches.iter().enumerate() {
-            let data = uniforms::lighting_uniforms(scene, *channel, &draw.lights, index == 0);
+            let data = uniforms::lighting_uniforms(
+                scene,
+                *channel,
+                &draw.lights,
+                index == 0,
+                ibl_textures.max_lod,
+            );
             let uniform = scope.buffer(
                 backend,
                 &format!("lighting {model} batch {index}"),
@@ -1070,7 +1120,7 @@ fn record_and_submit(
                 continue;
             };
             let channel = plan.mask_channels[0];
-            let data = uniforms::lighting_uniforms(scene, channel, &draw.lights, false);
+            let data = uniforms::lighting_uniforms(scene, channel, &draw.lights, false, 0.0);
             let uniform = scope.buffer(
                 backend,
                 &format!("{name} uniforms"),

@@ -114,6 +114,7 @@ pub(super) fn lighting_uniforms(
     channel: MaskChannel,
     batch: &[LightData],
     first_batch: bool,
+    ibl_max_lod: f32,
 ) -> Vec<u8> {
     let mut select = [0.0f32; 4];
     select[channel.channel] = 1.0;
@@ -125,12 +126,22 @@ pub(super) fn lighting_uniforms(
         [0.0; 4]
     };
     let counts = [batch.len() as u32, u32::from(first_batch), 0, 0];
+    // IBL: x = intensity * exposure (first batch only), y = highest specular lod,
+    // z, w = cos and sin of the rotation about +Y.
+    let ibl = match (&scene.environment, first_batch) {
+        (Some(env), true) => {
+            let r = env.rotation_degrees.to_radians();
+            [env.intensity * exposure, ibl_max_lod, r.cos(), r.sin()]
+        }
+        _ => [0.0, 0.0, 1.0, 0.0],
+    };
     let mut lights = [LightData::default(); MAX_LIGHTS_PER_DRAW];
     lights[..batch.len()].copy_from_slice(batch);
     let mut bytes = Vec::new();
     bytes.extend_from_slice(bytemuck::cast_slice(&select));
     bytes.extend_from_slice(bytemuck::cast_slice(&ambient));
     bytes.extend_from_slice(bytemuck::cast_slice(&counts));
+    bytes.extend_from_slice(bytemuck::cast_slice(&ibl));
     bytes.extend_from_slice(bytemuck::cast_slice(&lights));
     bytes
 }
@@ -151,18 +162,10 @@ pub(super) fn skybox_uniforms(scene: &Scene, camera: &CameraMatrices) -> Vec<f32
     data
 }
 
-/// Uniform ambient radiance the lighting passes apply (diffuse only): the scene's `ambient` plus,
-/// with an environment, its solid-angle-weighted mean radiance times its intensity (the
-/// environment's constant spherical-harmonic band; the IBL passes replace it).
+/// Uniform ambient radiance the lighting passes apply (diffuse only): the scene's `ambient`.
+/// An environment lights the scene through the IBL maps instead.
 pub fn ambient_radiance(scene: &Scene) -> [f32; 3] {
-    let mut ambient = scene.ambient;
-    if let Some(env) = &scene.environment {
-        let mean = environment_mean(&env.image);
-        for c in 0..3 {
-            ambient[c] += (mean[c] * f64::from(env.intensity)) as f32;
-        }
-    }
-    ambient
+    scene.ambient
 }
 
 /// Solid-angle-weighted mean of an equirectangular image (rows weighted by sin(latitude angle)).

@@ -12,6 +12,7 @@
 
 mod context;
 mod conv;
+pub(crate) mod wgpu_interop;
 
 use std::marker::PhantomData;
 use std::sync::{Arc, Mutex};
@@ -115,6 +116,8 @@ impl GlBackend {
             clip_control(glow::UPPER_LEFT, glow::ZERO_TO_ONE);
             // Writes to sRGB targets are encoded, as in wgpu.
             gl.enable(glow::FRAMEBUFFER_SRGB);
+            // Cube maps filter across face edges, as Vulkan's always do.
+            gl.enable(glow::TEXTURE_CUBE_MAP_SEAMLESS);
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
             gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
             DriverInfo {

@@ -131,6 +131,11 @@ impl WgpuBackend {
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
             log::error!("{backend_name}: uncaptured wgpu error: {e}");
         }));
+        if kind == BackendKind::WgpuGl
+            && !super::gl::wgpu_interop::enable_seamless_cube_maps(&device)
+        {
+            log::debug!("wgpu-gl: seamless cube maps not enabled (GLES contexts always are)");
+        }
         let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
         let info = DriverInfo {
             backend: kind.name().to_owned(),
