@@ -106,11 +106,82 @@ pub fn precompute() -> Vec<Precompute> {
             start.elapsed().as_secs_f64() * 1e3
         })
         .collect();
-    vec![Precompute {
+    let mut out = vec![Precompute {
         what: "shadow jitter texture (32x32x8 RGBA16F)".to_owned(),
         on: "CPU, once per process".to_owned(),
         ms: median(runs).unwrap_or(0.0),
-    }]
+    }];
+    out.extend(ibl_precompute());
+    out
+}
+
+/// The IBL maps of the canonical environments at default settings: built from scratch (the DFG
+/// table apart, as it is computed once per process), read back from a disk cache, and found in
+/// memory (a second render in the same process). Median of 3 (1 for the DFG table).
+fn ibl_precompute() -> Vec<Precompute> {
+    use engine::ibl;
+    let mut out = Vec::new();
+    let start = Instant::now();
+    std::hint::black_box(ibl::dfg::table(ibl::dfg::SIZE, ibl::dfg::SAMPLES));
+    out.push(Precompute {
+        what: format!(
+            "IBL DFG table ({}x{}, {} samples)",
+            ibl::dfg::SIZE,
+            ibl::dfg::SIZE,
+            ibl::dfg::SAMPLES
+        ),
+        on: "CPU, once per process".to_owned(),
+        ms: start.elapsed().as_secs_f64() * 1e3,
+    });
+    ibl::dfg_table();
+    let settings = ibl::IblSettings::default();
+    let Ok(cache) = tempfile::tempdir() else {
+        return out;
+    };
+    for name in ["sunset.exr", "interior.exr"] {
+        let path = crate::scenes_dir().join("assets").join(name);
+        let Ok(env) = engine::assets::load_environment(&path) else {
+            continue;
+        };
+        let image = engine::scene::EnvironmentImage {
+            label: name.to_owned(),
+            width: env.width,
+            height: env.height,
+            texels: env.texels,
+        };
+        let timed = |f: &mut dyn FnMut()| {
+            median(
+                (0..3)
+                    .map(|_| {
+                        let start = Instant::now();
+                        f();
+                        start.elapsed().as_secs_f64() * 1e3
+                    })
+                    .collect(),
+            )
+            .unwrap_or(0.0)
+        };
+        let built = timed(&mut || {
+            std::hint::black_box(ibl::build(&image, &settings));
+        });
+        out.push(Precompute {
+            what: format!("IBL maps of {name}: {}", settings.describe()),
+            on: "CPU, built".to_owned(),
+            ms: built,
+        });
+        let key = ibl::cache::key(&image, &settings);
+        if ibl::cache::write(cache.path(), &key, &ibl::build(&image, &settings)).is_ok() {
+            let read = timed(&mut || {
+                std::hint::black_box(ibl::cache::read(cache.path(), &key));
+            });
+            out.push(Precompute {
+                what: format!("IBL maps of {name}, from the disk cache (hash + read + verify)"),
+                on: "CPU, cached".to_owned(),
+                ms: read,
+            });
+        }
+    }
+    out
 }
 
 /// The median of some values (None when empty).

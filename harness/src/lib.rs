@@ -6,6 +6,7 @@ pub mod check;
 pub mod compare;
 pub mod first_scene;
 pub mod golden;
+pub mod ibl_reference;
 pub mod images;
 pub mod inspect;
 pub mod metrics;
@@ -27,6 +28,22 @@ pub fn workspace_root() -> std::path::PathBuf {
             let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
             root.canonicalize().unwrap_or(root)
         })
+}
+
+/// Where the harness caches precomputed IBL maps: `<workspace>/target/harness/ibl-cache`
+/// (`HARNESS_IBL_CACHE` overrides it; an empty value turns the disk cache off).
+pub fn ibl_cache_dir() -> Option<std::path::PathBuf> {
+    match std::env::var_os("HARNESS_IBL_CACHE") {
+        Some(dir) if dir.is_empty() => None,
+        Some(dir) => Some(dir.into()),
+        None => Some(workspace_root().join("target/harness/ibl-cache")),
+    }
+}
+
+/// Points the engine's IBL disk cache at [`ibl_cache_dir`] (the CLI and the golden suite do
+/// this at start-up, so a second run skips the precompute).
+pub fn use_ibl_cache() {
+    engine::ibl::cache::set_directory(ibl_cache_dir());
 }
 
 /// The canonical scenes' folder, `<workspace>/scenes`.

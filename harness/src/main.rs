@@ -95,13 +95,14 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Speed against error for a quality knob (`shadow`: filter x map size), timed with GPU
-    /// timestamps and measured against ray casting and the converged soft filter.
+    /// Speed against error for a quality knob, timed with GPU timestamps: `shadow` (filter x map
+    /// size, against ray casting and the converged soft filter) or `ibl` (samples, specular size,
+    /// SH9 irradiance, against a Monte Carlo reference, with the precompute time).
     Sweep {
         /// Canonical scene name or scene file.
         #[arg(long, default_value = "chess")]
         scene: String,
-        /// The knob: shadow.
+        /// The knob: shadow or ibl.
         #[arg(long, default_value = "shadow")]
         knob: String,
         /// Backend.
@@ -157,6 +158,7 @@ fn default_out_dir() -> PathBuf {
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
+    harness::use_ibl_cache();
     let command = cli.command.unwrap_or(Command::Check {
         out: default_out_dir(),
         scenes: vec![],
@@ -564,10 +566,27 @@ fn sweep(
     repeats: usize,
     json: bool,
 ) -> anyhow::Result<ExitCode> {
+    let loaded = harness::load_scene(scene)?;
+    if knob == "ibl" {
+        let rows = harness::sweep::ibl_sweep(&loaded.scene, kind, repeats, |what| {
+            eprintln!("  {what} ...");
+        })?;
+        if json {
+            println!("{}", serde_json::to_string_pretty(&rows)?);
+        } else {
+            println!(
+                "ibl sweep of {} on {kind} ({repeats} renders per setting, median GPU time; error = mean relative error of r+g+b against the Monte Carlo reference, {} pixels, {} directions per strategy)",
+                loaded.scene.name,
+                harness::sweep::IBL_REFERENCE_PIXELS,
+                harness::sweep::IBL_REFERENCE_SAMPLES
+            );
+            print!("{}", harness::sweep::ibl_table(&rows));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
     if knob != "shadow" {
         return Err(harness::sweep::SweepError::UnknownKnob(knob.to_owned()).into());
     }
-    let loaded = harness::load_scene(scene)?;
     let rows = harness::sweep::shadow_sweep(&loaded.scene, kind, repeats, |what| {
         eprintln!("  {what} ...");
     })?;

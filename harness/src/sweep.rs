@@ -1,4 +1,10 @@
-//! Speed against error for one quality knob: `harness sweep --scene chess --knob shadow` renders
+//! Speed against error for one quality knob.
+//!
+//! `harness sweep --scene ibl --knob ibl` varies the IBL precompute (sample count, specular
+//! size, SH9 irradiance) and measures each setting's precompute time, lighting-pass time and
+//! error against the Monte Carlo reference ([`crate::ibl_reference`]) per roughness.
+//!
+//! `harness sweep --scene chess --knob shadow` renders
 //! the scene once per setting (shadow filter x map size), times the passes from GPU timestamps
 //! (median of several renders), and measures the error of the shadow term against
 //!
@@ -36,8 +42,11 @@ pub struct SweepRow {
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
     /// The knob is not one the sweep knows.
-    #[error("unknown knob `{0}` (known: shadow)")]
+    #[error("unknown knob `{0}` (known: shadow, ibl)")]
     UnknownKnob(String),
+    /// The scene has no environment (for the `ibl` knob).
+    #[error("scene `{0}` has no environment")]
+    NoEnvironment(String),
     /// The scene has no shadowed light.
     #[error("scene `{0}` has no light with shadows")]
     NoShadows(String),
@@ -200,5 +209,175 @@ pub fn table(rows: &[SweepRow]) -> String {
                 .map_or("-".to_owned(), |e| format!("{e:.4}"))
         ));
     }
+    out
+}
+
+/// One setting of the IBL sweep.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct IblSweepRow {
+    /// What differs from the default settings.
+    pub setting: String,
+    /// The settings.
+    pub settings: engine::ibl::IblSettings,
+    /// CPU precompute of the maps without caches, seconds (the DFG table, shared by every
+    /// setting, is computed once per process and not included).
+    pub precompute_s: f64,
+    /// Median GPU time of the lighting pass, ms.
+    pub lighting_ms: Option<f64>,
+    /// Error of the light buffer against the Monte Carlo reference, per roughness.
+    pub by_roughness: Vec<crate::ibl_reference::RoughnessError>,
+    /// Mean relative error over every reference pixel.
+    pub mean_relative: f64,
+}
+
+/// The settings the IBL sweep visits: the default, then one knob changed at a time.
+pub fn ibl_settings() -> Vec<(String, engine::ibl::IblSettings)> {
+    use engine::ibl::{IblSettings, IrradianceMethod};
+    let d = IblSettings::default();
+    vec![
+        ("default".to_owned(), d.clone()),
+        (
+            "64 samples".to_owned(),
+            IblSettings {
+                specular_samples: 64,
+                ..d.clone()
+            },
+        ),
+        (
+            "1024 samples".to_owned(),
+            IblSettings {
+                specular_samples: 1024,
+                ..d.clone()
+            },
+        ),
+        (
+            "specular 64".to_owned(),
+            IblSettings {
+                specular_size: 64,
+                ..d.clone()
+            },
+        ),
+        (
+            "specular 256".to_owned(),
+            IblSettings {
+                specular_size: 256,
+                ..d.clone()
+            },
+        ),
+        (
+            "sh9 irradiance".to_owned(),
+            IblSettings {
+                irradiance: IrradianceMethod::Sh9,
+                ..d
+            },
+        ),
+    ]
+}
+
+/// Reference pixels and directions per strategy of the IBL sweep's Monte Carlo reference.
+pub const IBL_REFERENCE_PIXELS: usize = 144;
+/// Directions per strategy and pixel (three or four strategies).
+pub const IBL_REFERENCE_SAMPLES: usize = 8192;
+
+/// Runs the IBL sweep on one backend: per setting, the precompute time, the lighting pass's GPU
+/// time (median of `repeats` renders) and the error against the Monte Carlo reference per
+/// roughness. The reference is computed once, from the default render's G-buffer (the
+/// G-buffer does not depend on IBL settings).
+pub fn ibl_sweep(
+    scene: &Scene,
+    kind: BackendKind,
+    repeats: usize,
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<IblSweepRow>, SweepError> {
+    let environment = scene
+        .environment
+        .as_ref()
+        .ok_or_else(|| SweepError::NoEnvironment(scene.name.clone()))?;
+    let mut backend = backend::create(kind).map_err(|e| SweepError::Render(e.to_string()))?;
+    let mut rows = Vec::new();
+    let mut references = None;
+    for (name, settings) in ibl_settings() {
+        progress(&format!("precompute {name}"));
+        engine::ibl::dfg_table();
+        let start = std::time::Instant::now();
+        std::hint::black_box(engine::ibl::build(&environment.image, &settings));
+        let precompute_s = start.elapsed().as_secs_f64();
+        let mut variant = scene.clone();
+        variant.quality.ibl = settings.clone();
+        let mut frames = Vec::new();
+        for _ in 0..repeats.max(1) {
+            frames.push(
+                renderer::render(backend.as_mut(), &variant, Readback::All)
+                    .map_err(|e| SweepError::Render(e.to_string()))?,
+            );
+        }
+        if references.is_none() {
+            progress("Monte Carlo reference");
+            references = Some(
+                crate::ibl_reference::reference_pixels(
+                    scene,
+                    &frames[0],
+                    IBL_REFERENCE_PIXELS,
+                    IBL_REFERENCE_SAMPLES,
+                )
+                .map_err(SweepError::Render)?,
+            );
+        }
+        let references = references.as_deref().unwrap_or_default();
+        let by_roughness = crate::ibl_reference::error_by_roughness(&frames[0], references);
+        let total: usize = by_roughness.iter().map(|r| r.pixels).sum();
+        let mean_relative = by_roughness
+            .iter()
+            .map(|r| r.mean_relative * r.pixels as f64)
+            .sum::<f64>()
+            / total.max(1) as f64;
+        rows.push(IblSweepRow {
+            setting: name,
+            settings,
+            precompute_s,
+            lighting_ms: pass_ms(&frames, "lighting"),
+            by_roughness,
+            mean_relative,
+        });
+    }
+    Ok(rows)
+}
+
+/// The IBL sweep as a table: one line per setting, the mean relative error per roughness in
+/// columns, then the reference's own noise.
+pub fn ibl_table(rows: &[IblSweepRow]) -> String {
+    let Some(first) = rows.first() else {
+        return String::new();
+    };
+    let mut out = format!(
+        "{:<15} {:>13} {:>12}",
+        "setting", "precompute s", "lighting ms"
+    );
+    for g in &first.by_roughness {
+        out.push_str(&format!(" {:>7}", format!("r {:.1}", g.roughness)));
+    }
+    out.push_str(&format!(" {:>7}\n", "mean"));
+    for r in rows {
+        out.push_str(&format!(
+            "{:<15} {:>13.3} {:>12}",
+            r.setting,
+            r.precompute_s,
+            r.lighting_ms.map_or("-".to_owned(), |v| format!("{v:.1}"))
+        ));
+        for g in &r.by_roughness {
+            out.push_str(&format!(" {:>6.2}%", g.mean_relative * 100.0));
+        }
+        out.push_str(&format!(" {:>6.2}%\n", r.mean_relative * 100.0));
+        out.push_str(&format!("{:<15} {:>13} {:>12}", "  (median)", "", ""));
+        for g in &r.by_roughness {
+            out.push_str(&format!(" {:>6.2}%", g.median_relative * 100.0));
+        }
+        out.push('\n');
+    }
+    out.push_str(&format!("{:<15} {:>13} {:>12}", "(ref. noise)", "", ""));
+    for g in &first.by_roughness {
+        out.push_str(&format!(" {:>6.2}%", g.reference_noise * 100.0));
+    }
+    out.push('\n');
     out
 }

@@ -255,3 +255,34 @@ pub fn many_point_lights(size: u32, count: usize) -> Scene {
     }
     scene
 }
+
+/// A sphere under a uniform environment of radiance 1 and nothing else (the IBL white
+/// furnace), with the given material and lighting model.
+pub fn ibl_furnace(size: u32, material: Material, lighting: LightingModel) -> Scene {
+    let mesh = Arc::new(mesh::uv_sphere(64, 32));
+    let mut scene = empty_scene(
+        "ibl_furnace",
+        size,
+        camera(DVec3::new(0.0, 0.0, 3.0), DVec3::ZERO),
+    );
+    scene.objects.push(sphere_at(
+        "sphere".to_owned(),
+        &mesh,
+        DVec3::ZERO,
+        1.0,
+        material,
+        lighting,
+    ));
+    scene.environment = Some(Environment {
+        image: Arc::new(EnvironmentImage {
+            label: "uniform radiance 1".to_owned(),
+            width: 64,
+            height: 32,
+            texels: vec![[1.0, 1.0, 1.0, 1.0]; 64 * 32],
+        }),
+        rotation_degrees: 0.0,
+        intensity: 1.0,
+    });
+    scene.quality.tone_map = ToneMap::Clamp;
+    scene
+}

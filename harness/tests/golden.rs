@@ -109,6 +109,7 @@ impl Suite {
 
 fn main() {
     let arguments = Arguments::from_args();
+    harness::use_ibl_cache();
     let cases = match suite::canonical_cases() {
         Ok(cases) => cases,
         Err(e) => {
