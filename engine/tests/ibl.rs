@@ -239,7 +239,7 @@ fn disk_cache_round_trips_and_rebuilds_corrupt_entries() {
 fn prepare_uses_memory_then_disk() {
     let dir = tempfile::tempdir().unwrap();
     ibl::cache::set_directory(Some(dir.path().to_path_buf()));
-    let image = uniform(0.75);
+    let image = Arc::new(uniform(0.75));
     let settings = IblSettings {
         source_size: 32,
         specular_size: 16,

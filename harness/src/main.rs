@@ -655,7 +655,6 @@ fn bench(
         for p in &precompute {
             println!("  {:<44} {:>8.3} ms  ({})", p.what, p.ms, p.on);
         }
-        println!("  {:<44} {:>8}     (not built yet)", "IBL maps", "-");
     }
     let text = serde_json::to_string_pretty(
         &serde_json::json!({ "precompute": precompute, "scenes": results }),

@@ -228,6 +228,9 @@ pub struct IblSweepRow {
     pub by_roughness: Vec<crate::ibl_reference::RoughnessError>,
     /// Mean relative error over every reference pixel.
     pub mean_relative: f64,
+    /// Mean relative error per material family (rows) and roughness (columns: roughness, error,
+    /// pixels).
+    pub by_family: Vec<crate::ibl_reference::FamilyRow>,
 }
 
 /// The settings the IBL sweep visits: the default, then one knob changed at a time.
@@ -325,6 +328,7 @@ pub fn ibl_sweep(
         }
         let references = references.as_deref().unwrap_or_default();
         let by_roughness = crate::ibl_reference::error_by_roughness(&frames[0], references);
+        let by_family = crate::ibl_reference::error_by_family(&frames[0], references);
         let total: usize = by_roughness.iter().map(|r| r.pixels).sum();
         let mean_relative = by_roughness
             .iter()
@@ -338,6 +342,7 @@ pub fn ibl_sweep(
             lighting_ms: pass_ms(&frames, "lighting"),
             by_roughness,
             mean_relative,
+            by_family,
         });
     }
     Ok(rows)
@@ -379,5 +384,16 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
         out.push_str(&format!(" {:>6.2}%", g.reference_noise * 100.0));
     }
     out.push('\n');
+    out.push_str(&format!(
+        "\n{} settings, mean relative error per material row:\n",
+        first.setting
+    ));
+    for (family, cells) in &first.by_family {
+        out.push_str(&format!("{family:<15} {:>13} {:>12}", "", ""));
+        for (_, error, _) in cells {
+            out.push_str(&format!(" {:>6.2}%", error * 100.0));
+        }
+        out.push('\n');
+    }
     out
 }

@@ -10,7 +10,7 @@
 use std::collections::VecDeque;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex, RwLock};
+use std::sync::{Arc, Mutex, RwLock, Weak};
 
 use sha2::{Digest, Sha256};
 
@@ -40,6 +40,9 @@ pub struct CacheError {
 
 static DIRECTORY: RwLock<Option<PathBuf>> = RwLock::new(None);
 static MEMORY: Mutex<VecDeque<(Key, Arc<IblMaps>)>> = Mutex::new(VecDeque::new());
+/// Keys already computed for images still alive: hashing megabytes of texels again for every
+/// frame would make a memory hit cost tens of milliseconds.
+static KNOWN_KEYS: Mutex<Vec<(Weak<EnvironmentImage>, IblSettings, Key)>> = Mutex::new(Vec::new());
 
 /// Sets (or with `None` clears) the directory [`super::prepare`] caches maps in. Without one,
 /// maps are only kept in memory.
@@ -68,6 +71,26 @@ pub fn key(image: &EnvironmentImage, settings: &IblSettings) -> Key {
         serde_json::to_vec(settings).expect("IBL settings serialise"), // plain struct
     );
     hash.finalize().into()
+}
+
+/// [`key`], remembered per image object while it lives (so a second frame of the same scene
+/// does not hash its texels again).
+pub fn key_of_shared(image: &Arc<EnvironmentImage>, settings: &IblSettings) -> Key {
+    let mut known = KNOWN_KEYS.lock().unwrap_or_else(|e| e.into_inner());
+    known.retain(|(weak, _, _)| weak.strong_count() > 0);
+    if let Some((_, _, key)) = known.iter().find(|(weak, s, _)| {
+        s == settings && weak.upgrade().is_some_and(|live| Arc::ptr_eq(&live, image))
+    }) {
+        return *key;
+    }
+    drop(known);
+    let computed = key(image, settings);
+    KNOWN_KEYS.lock().unwrap_or_else(|e| e.into_inner()).push((
+        Arc::downgrade(image),
+        settings.clone(),
+        computed,
+    ));
+    computed
 }
 
 /// Entry file name of a key.

@@ -201,8 +201,11 @@ impl MapsSource {
 /// cache set with [`cache::set_directory`], else built (and then stored in both). A disk cache
 /// that cannot be written (full disk, read-only folder) is a warning naming the file, not an
 /// error: the frame renders with the maps just built, and no partial entry is left.
-pub fn prepare(image: &EnvironmentImage, settings: &IblSettings) -> (Arc<IblMaps>, MapsSource) {
-    let key = cache::key(image, settings);
+pub fn prepare(
+    image: &Arc<EnvironmentImage>,
+    settings: &IblSettings,
+) -> (Arc<IblMaps>, MapsSource) {
+    let key = cache::key_of_shared(image, settings);
     if let Some(maps) = cache::memory_get(&key) {
         return (maps, MapsSource::Memory);
     }
