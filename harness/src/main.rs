@@ -571,8 +571,10 @@ fn sweep(
         let rows = harness::sweep::ibl_sweep(&loaded.scene, kind, repeats, |what| {
             eprintln!("  {what} ...");
         })?;
+        let text = serde_json::to_string_pretty(&rows)?;
+        save_sweep(&loaded.scene.name, "ibl", &text);
         if json {
-            println!("{}", serde_json::to_string_pretty(&rows)?);
+            println!("{text}");
         } else {
             println!(
                 "ibl sweep of {} on {kind} ({repeats} renders per setting, median GPU time; error = mean relative error of r+g+b against the Monte Carlo reference, {} pixels, {} directions per strategy)",
@@ -590,8 +592,10 @@ fn sweep(
     let rows = harness::sweep::shadow_sweep(&loaded.scene, kind, repeats, |what| {
         eprintln!("  {what} ...");
     })?;
+    let text = serde_json::to_string_pretty(&rows)?;
+    save_sweep(&loaded.scene.name, "shadow", &text);
     if json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
+        println!("{text}");
     } else {
         println!(
             "shadow sweep of {} on {kind} ({repeats} renders per setting, median GPU time)",
@@ -600,6 +604,24 @@ fn sweep(
         print!("{}", harness::sweep::table(&rows));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Keeps a sweep's results (target/harness/sweep_<scene>_<knob>.json) for the check report; a
+/// failure to write them is a warning.
+fn save_sweep(scene: &str, knob: &str, json: &str) {
+    let path = default_out_dir().join(harness::sweep::result_file(scene, knob));
+    let written = std::fs::create_dir_all(default_out_dir())
+        .map_err(|e| e.to_string())
+        .and_then(|_| {
+            harness::images::write_atomically(&path, json.as_bytes()).map_err(|e| e.to_string())
+        });
+    match written {
+        Ok(()) => eprintln!(
+            "wrote {} (shown in the next `harness check` report)",
+            path.display()
+        ),
+        Err(e) => eprintln!("warning: sweep results not kept: {e}"),
+    }
 }
 
 fn bench(

@@ -288,6 +288,7 @@ figcaption{{font-size:12px}} code{{font-size:12px}}
     out.push_str("</table>");
     if let Some(dir) = bench_dir {
         out.push_str(&crate::bench::report_sections(dir));
+        out.push_str(&crate::sweep::report_sections(dir));
     }
     out.push_str("</body></html>\n");
     out

@@ -36,6 +36,11 @@ pub struct SweepRow {
     pub misclassified: f64,
     /// Mean |term - soft reference| over lit-surface pixels (soft filters only).
     pub error_vs_soft_reference: Option<f64>,
+    /// Whether this is the scene's own setting.
+    pub is_default: bool,
+    /// Whether no other setting is both faster (shadow + lighting GPU time) and more accurate
+    /// (misclassified fraction): on the Pareto front.
+    pub pareto: bool,
 }
 
 /// Why a sweep failed.
@@ -111,6 +116,15 @@ pub fn shadow_sweep(
             }
         )
     });
+    let own = match &scene.lights[light] {
+        Light::Directional {
+            shadow: Some(s), ..
+        }
+        | Light::Point {
+            shadow: Some(s), ..
+        } => Some((s.filter, s.map_size)),
+        _ => None,
+    };
     let mut backend = backend::create(kind).map_err(|e| SweepError::Render(e.to_string()))?;
     let term_name = plan::shadow_term_target_name(light);
     let wanted = [
@@ -164,8 +178,22 @@ pub fn shadow_sweep(
                 lighting_ms: pass_ms(&frames, "lighting_"),
                 misclassified: visibility.fraction,
                 error_vs_soft_reference: soft,
+                is_default: own == Some((filter, map_size)),
+                pareto: false,
             });
         }
+    }
+    let points: Vec<(f64, f64)> = rows
+        .iter()
+        .map(|r| {
+            (
+                r.shadow_ms.unwrap_or(0.0) + r.lighting_ms.unwrap_or(0.0),
+                r.misclassified,
+            )
+        })
+        .collect();
+    for (row, on_front) in rows.iter_mut().zip(pareto_front(&points)) {
+        row.pareto = on_front;
     }
     Ok(rows)
 }
@@ -193,23 +221,136 @@ fn mean_abs_difference(a: &[f32], b: &[f32], frame: &Frame) -> f64 {
 /// The sweep as a table.
 pub fn table(rows: &[SweepRow]) -> String {
     let mut out = format!(
-        "{:<10} {:>6} {:>11} {:>13} {:>14} {:>16}\n",
-        "filter", "map", "shadow ms", "lighting ms", "misclassified", "vs soft ref"
+        "{:<10} {:>6} {:>11} {:>13} {:>14} {:>16}  {}\n",
+        "filter", "map", "shadow ms", "lighting ms", "misclassified", "vs soft ref", "front"
     );
     let ms = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.2}"));
     for r in rows {
         out.push_str(&format!(
-            "{:<10} {:>6} {:>11} {:>13} {:>13.3}% {:>16}\n",
+            "{:<10} {:>6} {:>11} {:>13} {:>13.3}% {:>16}  {}{}\n",
             r.filter,
             r.map_size,
             ms(r.shadow_ms),
             ms(r.lighting_ms),
             r.misclassified * 100.0,
             r.error_vs_soft_reference
-                .map_or("-".to_owned(), |e| format!("{e:.4}"))
+                .map_or("-".to_owned(), |e| format!("{e:.4}")),
+            if r.pareto { "*" } else { "" },
+            if r.is_default { " (default)" } else { "" }
+        ));
+    }
+    out.push_str("front: * = on the Pareto front of GPU time (shadow + lighting) against misclassification\n");
+    out
+}
+
+/// The shadow sweep's errors without times (which vary run to run), rounded so that the text
+/// is stable: the insta snapshot of the canonical scenes' sweep.
+pub fn stable_table(rows: &[SweepRow]) -> String {
+    let mut out = format!(
+        "{:<10} {:>6} {:>14} {:>12}\n",
+        "filter", "map", "misclassified", "vs soft ref"
+    );
+    for r in rows {
+        out.push_str(&format!(
+            "{:<10} {:>6} {:>13.1}% {:>12}{}\n",
+            r.filter,
+            r.map_size,
+            r.misclassified * 100.0,
+            r.error_vs_soft_reference
+                .map_or("-".to_owned(), |e| format!("{e:.3}")),
+            if r.is_default { "  (default)" } else { "" }
         ));
     }
     out
+}
+
+/// Which points (cost, error) are on the Pareto front: no other point is at most as costly
+/// and at most as wrong, and strictly better in one of the two.
+pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
+    points
+        .iter()
+        .map(|&(cost, error)| {
+            !points
+                .iter()
+                .any(|&(c, e)| c <= cost && e <= error && (c < cost || e < error))
+        })
+        .collect()
+}
+
+/// A small SVG scatter plot of error against cost, Pareto front in color and joined, the
+/// default setting ringed.
+pub fn pareto_svg(title: &str, x_label: &str, points: &[(String, f64, f64, bool, bool)]) -> String {
+    let (w, h, left, bottom, top, right) = (420.0, 240.0, 55.0, 35.0, 22.0, 20.0);
+    let escape = |t: &str| {
+        t.replace('&', "&amp;")
+            .replace('<', "&lt;")
+            .replace('>', "&gt;")
+    };
+    let mut svg = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
+         style=\"background:#fff;border:1px solid #ccc\">\
+         <text x=\"{left}\" y=\"14\" font-size=\"12\">{}</text>",
+        escape(title)
+    );
+    if points.is_empty() {
+        svg.push_str("</svg>");
+        return svg;
+    }
+    let (x1, y1) = points
+        .iter()
+        .fold((0.0f64, 0.0f64), |(a, b), p| (a.max(p.1), b.max(p.2)));
+    let (x1, y1) = (x1.max(1e-9), y1.max(1e-9));
+    // The cost axis starts just below the cheapest setting (costs cluster far from zero).
+    let x0 = points.iter().map(|p| p.1).fold(f64::MAX, f64::min) * 0.95;
+    let sx = |x: f64| left + (x - x0) / (x1 - x0).max(1e-9) * (w - left - right);
+    let sy = |y: f64| h - bottom - y / y1 * (h - bottom - top);
+    svg.push_str(&format!(
+        "<line x1=\"{left}\" y1=\"{0}\" x2=\"{1}\" y2=\"{0}\" stroke=\"#888\"/>\
+         <line x1=\"{left}\" y1=\"{top}\" x2=\"{left}\" y2=\"{0}\" stroke=\"#888\"/>\
+         <text x=\"4\" y=\"{2}\" font-size=\"10\">{y1:.3}</text>\
+         <text x=\"4\" y=\"{0}\" font-size=\"10\">0</text>\
+         <text x=\"{1}\" y=\"{3}\" font-size=\"10\" text-anchor=\"end\">{4} ({x0:.2} to {x1:.2})</text>",
+        h - bottom,
+        w - right,
+        top + 4.0,
+        h - 6.0,
+        escape(x_label)
+    ));
+    let mut front: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|p| p.3)
+        .map(|p| (sx(p.1), sy(p.2)))
+        .collect();
+    front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let line: Vec<String> = front
+        .iter()
+        .map(|(x, y)| format!("{x:.1},{y:.1}"))
+        .collect();
+    svg.push_str(&format!(
+        "<polyline fill=\"none\" stroke=\"#2a6\" stroke-width=\"1.5\" points=\"{}\"/>",
+        line.join(" ")
+    ));
+    for (label, x, y, on_front, is_default) in points {
+        let color = if *on_front { "#2a6" } else { "#999" };
+        svg.push_str(&format!(
+            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"3.5\" fill=\"{color}\"/>\
+             <text x=\"{:.1}\" y=\"{:.1}\" font-size=\"9\">{}</text>",
+            sx(*x),
+            sy(*y),
+            sx(*x) + 5.0,
+            sy(*y) - 4.0,
+            escape(label)
+        ));
+        if *is_default {
+            svg.push_str(&format!(
+                "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"7\" fill=\"none\" stroke=\"#c60\" stroke-width=\"1.5\"/>",
+                sx(*x),
+                sy(*y)
+            ));
+        }
+    }
+    svg.push_str("</svg>");
+    svg
 }
 
 /// One setting of the IBL sweep.
@@ -231,6 +372,10 @@ pub struct IblSweepRow {
     /// Mean relative error per material family (rows) and roughness (columns: roughness, error,
     /// pixels).
     pub by_family: Vec<crate::ibl_reference::FamilyRow>,
+    /// Whether these are the default settings.
+    pub is_default: bool,
+    /// Whether no other setting has both a shorter precompute and a smaller mean error.
+    pub pareto: bool,
 }
 
 /// The settings the IBL sweep visits: the default, then one knob changed at a time.
@@ -335,6 +480,7 @@ pub fn ibl_sweep(
             .map(|r| r.mean_relative * r.pixels as f64)
             .sum::<f64>()
             / total.max(1) as f64;
+        let is_default = settings == engine::ibl::IblSettings::default();
         rows.push(IblSweepRow {
             setting: name,
             settings,
@@ -343,7 +489,16 @@ pub fn ibl_sweep(
             by_roughness,
             mean_relative,
             by_family,
+            is_default,
+            pareto: false,
         });
+    }
+    let points: Vec<(f64, f64)> = rows
+        .iter()
+        .map(|r| (r.precompute_s, r.mean_relative))
+        .collect();
+    for (row, on_front) in rows.iter_mut().zip(pareto_front(&points)) {
+        row.pareto = on_front;
     }
     Ok(rows)
 }
@@ -365,7 +520,7 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
     for r in rows {
         out.push_str(&format!(
             "{:<15} {:>13.3} {:>12}",
-            r.setting,
+            format!("{}{}", r.setting, if r.pareto { " *" } else { "" }),
             r.precompute_s,
             r.lighting_ms.map_or("-".to_owned(), |v| format!("{v:.1}"))
         ));
@@ -384,6 +539,7 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
         out.push_str(&format!(" {:>6.2}%", g.reference_noise * 100.0));
     }
     out.push('\n');
+    out.push_str("* = on the Pareto front of precompute time against mean error\n");
     out.push_str(&format!(
         "\n{} settings, mean relative error per material row:\n",
         first.setting
@@ -394,6 +550,126 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
             out.push_str(&format!(" {:>6.2}%", error * 100.0));
         }
         out.push('\n');
+    }
+    out
+}
+
+/// The IBL sweep's errors without times, rounded so that the text is stable: the insta
+/// snapshot of the canonical scenes' sweep.
+pub fn stable_ibl_table(rows: &[IblSweepRow]) -> String {
+    let Some(first) = rows.first() else {
+        return String::new();
+    };
+    let mut out = format!("{:<15}", "setting");
+    for g in &first.by_roughness {
+        out.push_str(&format!(" {:>6}", format!("r {:.1}", g.roughness)));
+    }
+    out.push_str(&format!(" {:>6}\n", "mean"));
+    for r in rows {
+        out.push_str(&format!("{:<15}", r.setting));
+        for g in &r.by_roughness {
+            out.push_str(&format!(" {:>5.1}%", g.mean_relative * 100.0));
+        }
+        out.push_str(&format!(" {:>5.1}%\n", r.mean_relative * 100.0));
+    }
+    out.push_str("\ndefault, per material row:\n");
+    for (family, cells) in &first.by_family {
+        out.push_str(&format!("{family:<15}"));
+        for (_, error, _) in cells {
+            out.push_str(&format!(" {:>5.1}%", error * 100.0));
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// File name of a sweep's results in the output folder (read by the check report).
+pub fn result_file(scene: &str, knob: &str) -> String {
+    format!("sweep_{scene}_{knob}.json")
+}
+
+/// HTML sections for the check report from the sweeps kept in `dir` (`harness sweep` writes
+/// them): per sweep, its table and a Pareto plot of error against cost. Empty without any.
+pub fn report_sections(dir: &std::path::Path) -> String {
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("sweep_") && n.ends_with(".json"))
+        })
+        .collect();
+    files.sort();
+    let mut out = String::new();
+    for path in files {
+        let Some(bytes) = std::fs::read(&path).ok() else {
+            continue;
+        };
+        let name = path
+            .file_stem()
+            .and_then(|n| n.to_str())
+            .unwrap_or("sweep")
+            .to_owned();
+        if let Ok(rows) = serde_json::from_slice::<Vec<serde_json::Value>>(&bytes) {
+            let is_ibl = rows
+                .first()
+                .is_some_and(|r| r.get("precompute_s").is_some());
+            let points: Vec<(String, f64, f64, bool, bool)> = rows
+                .iter()
+                .map(|r| {
+                    let label = if is_ibl {
+                        r["setting"].as_str().unwrap_or("?").to_owned()
+                    } else {
+                        format!(
+                            "{} {}",
+                            r["filter"].as_str().unwrap_or("?"),
+                            r["map_size"].as_u64().unwrap_or(0)
+                        )
+                    };
+                    let (cost, error) = if is_ibl {
+                        (
+                            r["precompute_s"].as_f64().unwrap_or(0.0),
+                            r["mean_relative"].as_f64().unwrap_or(0.0),
+                        )
+                    } else {
+                        (
+                            r["shadow_ms"].as_f64().unwrap_or(0.0)
+                                + r["lighting_ms"].as_f64().unwrap_or(0.0),
+                            r["misclassified"].as_f64().unwrap_or(0.0),
+                        )
+                    };
+                    (
+                        label,
+                        cost,
+                        error,
+                        r["pareto"].as_bool().unwrap_or(false),
+                        r["is_default"].as_bool().unwrap_or(false),
+                    )
+                })
+                .collect();
+            let (x_label, y_label) = if is_ibl {
+                ("precompute s", "mean relative error")
+            } else {
+                ("shadow + lighting GPU ms", "misclassified fraction")
+            };
+            out.push_str(&format!(
+                "<h2>Speed against error: <code>{name}</code> (latest <code>harness sweep</code>)</h2>\
+                 <p>{y_label} against {x_label}; green: Pareto front, ringed: the default.</p>{}<table>\
+                 <tr><th>setting</th><th>{x_label}</th><th>{y_label}</th><th>front</th></tr>",
+                pareto_svg(&name, x_label, &points)
+            ));
+            for (label, cost, error, front, default) in &points {
+                out.push_str(&format!(
+                    "<tr><td>{label}{}</td><td>{cost:.3}</td><td>{error:.4}</td><td>{}</td></tr>",
+                    if *default { " (default)" } else { "" },
+                    if *front { "*" } else { "" }
+                ));
+            }
+            out.push_str("</table>");
+        }
     }
     out
 }
