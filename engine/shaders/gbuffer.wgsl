@@ -3,8 +3,9 @@
 // depth-test with less-equal against the geometry pass's depth buffer.
 //
 // G-buffer layout (five RGBA16F targets, positions camera-relative in world orientation):
-//   0 position: xyz = world position - camera position, w = roughness
-//   1 normal:   xyz = unit normal after normal mapping,  w = specular
+//   0 position: xyz = world position - camera position, w = roughness (other storages with
+//               quality.gbuffer: world position, or nothing when rebuilt from depth)
+//   1 normal:   xyz = unit normal after normal mapping,  w = specular (octahedral: xy)
 //   2 tangent:  xyz = unit tangent orthogonal to the normal, w = handedness (+1 or -1)
 //   3 albedo:   rgb = linear base color, a = anisotropy (-1..1)
 //   4 material: metallic, clearcoat, clearcoat roughness, Blinn-Phong specular exponent
@@ -25,11 +26,15 @@ struct ObjectUniforms {
     params2: vec4<f32>,
     // 1.0 where a map replaces the scalar: base color, normal, roughness, metallic.
     maps: vec4<f32>,
-    // clearcoat, specular, -, -.
+    // clearcoat, specular (1.0 where a map replaces the scalar), position storage (0
+    // camera-relative, 1 world, 2 none: rebuilt from depth), normal encoding (0 fp16 xyz,
+    // 1 octahedral).
     maps2: vec4<f32>,
     // One-hot shader-mask value for mask targets 0 and 1.
     mask0: vec4<f32>,
     mask1: vec4<f32>,
+    // World position of the camera (f32), for world-space position storage.
+    camera_world: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> object: ObjectUniforms;
@@ -92,6 +97,16 @@ fn orthogonalise(t: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     return projected * inverseSqrt(length_squared);
 }
 
+// Octahedral encoding (Cigolle et al. 2014): a unit vector as two values in -1..1.
+fn octahedral_encode(n: vec3<f32>) -> vec2<f32> {
+    let p = n.xy / (abs(n.x) + abs(n.y) + abs(n.z));
+    if n.z >= 0.0 {
+        return p;
+    }
+    let signs = select(vec2<f32>(-1.0), vec2<f32>(1.0), p >= vec2<f32>(0.0));
+    return (vec2<f32>(1.0) - abs(p.yx)) * signs;
+}
+
 @fragment
 fn fs_gbuffer(in: VertexOut) -> GBuffer {
     // OBJ texture coordinates have v growing upwards; textures are stored top row first.
@@ -123,8 +138,18 @@ fn fs_gbuffer(in: VertexOut) -> GBuffer {
     let clearcoat = mix(object.params.w, clearcoat_sample.r, object.maps2.x);
 
     var out: GBuffer;
-    out.position = vec4<f32>(in.relative_position, roughness);
-    out.normal = vec4<f32>(n, specular);
+    var stored_position = in.relative_position;
+    if object.maps2.z > 1.5 {
+        stored_position = vec3<f32>(0.0);
+    } else if object.maps2.z > 0.5 {
+        stored_position = in.relative_position + object.camera_world.xyz;
+    }
+    out.position = vec4<f32>(stored_position, roughness);
+    if object.maps2.w > 0.5 {
+        out.normal = vec4<f32>(octahedral_encode(n), 0.0, specular);
+    } else {
+        out.normal = vec4<f32>(n, specular);
+    }
     out.tangent = vec4<f32>(t, handedness);
     out.albedo = vec4<f32>(base_color, object.base_color.a);
     out.material = vec4<f32>(metallic, clearcoat, object.params2.x, object.params2.y);

@@ -42,6 +42,13 @@ struct LightingUniforms {
     // IBL: x = environment intensity * exposure (0: none, or not the first batch), y = highest
     // specular lod (roughness 1), z, w = cos and sin of the environment's rotation about +Y.
     ibl: vec4<f32>,
+    // G-buffer storage: x = position (0 camera-relative, 1 world, 2 reconstructed from depth),
+    // y = normal (0 fp16 xyz, 1 octahedral in xy).
+    gbuffer: vec4<f32>,
+    // World position of the camera (f32), for world-space positions.
+    camera_world: vec4<f32>,
+    // Clip space to camera-relative world space, for positions from depth.
+    inverse_view_proj: mat4x4<f32>,
     lights: array<LightData, 16>,
 }
 
@@ -90,6 +97,10 @@ struct ShadowUniforms {
 @group(0) @binding(14) var ibl_specular: texture_cube<f32>;
 @group(0) @binding(15) var ibl_dfg: texture_2d<f32>;
 @group(0) @binding(16) var ibl_sampler: sampler;
+
+// The depth buffer (D32F, read as an unfilterable float texture: naga's GLSL output cannot
+// textureLoad a texture_depth_2d), for positions reconstructed from depth.
+@group(0) @binding(17) var scene_depth: texture_2d<f32>;
 
 fn shadow_tap(uv: vec2<f32>, reference: f32, bounds: vec4<f32>) -> f32 {
     return textureSampleCompareLevel(shadow_map, shadow_sampler, clamp(uv, bounds.xy, bounds.zw), reference);
@@ -306,6 +317,32 @@ fn masked(pixel: vec2<i32>) -> bool {
     return dot(textureLoad(shader_mask, pixel, 0), u.mask_select) < 0.5;
 }
 
+// Octahedral decoding (Cigolle et al. 2014) of a unit vector stored as two values in -1..1.
+fn octahedral_decode(e: vec2<f32>) -> vec3<f32> {
+    var v = vec3<f32>(e, 1.0 - abs(e.x) - abs(e.y));
+    if v.z < 0.0 {
+        let signs = select(vec2<f32>(-1.0), vec2<f32>(1.0), v.xy >= vec2<f32>(0.0));
+        v = vec3<f32>((vec2<f32>(1.0) - abs(v.yx)) * signs, v.z);
+    }
+    return normalize(v);
+}
+
+// The camera-relative position at a pixel, as the G-buffer stores it.
+fn surface_position(pixel: vec2<i32>, stored: vec3<f32>) -> vec3<f32> {
+    if u.gbuffer.x < 0.5 {
+        return stored;
+    }
+    if u.gbuffer.x < 1.5 {
+        return stored - u.camera_world.xyz;
+    }
+    let size = vec2<f32>(textureDimensions(scene_depth));
+    let depth = textureLoad(scene_depth, pixel, 0).r;
+    let uv = (vec2<f32>(pixel) + 0.5) / size;
+    let clip = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
+    let relative = u.inverse_view_proj * clip;
+    return relative.xyz / relative.w;
+}
+
 fn load_surface(pixel: vec2<i32>) -> Surface {
     let p = textureLoad(gbuffer_position, pixel, 0);
     let n = textureLoad(gbuffer_normal, pixel, 0);
@@ -314,9 +351,9 @@ fn load_surface(pixel: vec2<i32>) -> Surface {
     let m = textureLoad(gbuffer_material, pixel, 0);
     var s: Surface;
     s.pixel = pixel;
-    s.position = p.xyz;
+    s.position = surface_position(pixel, p.xyz);
     s.roughness = clamp(p.w, 0.0, 1.0);
-    s.normal = normalize(n.xyz);
+    s.normal = select(normalize(n.xyz), octahedral_decode(n.xy), u.gbuffer.y > 0.5);
     s.specular = n.w;
     s.tangent = t.xyz;
     s.base_color = a.rgb;

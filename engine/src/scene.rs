@@ -442,6 +442,66 @@ impl PointShadowPass {
     }
 }
 
+/// How the G-buffer stores positions (a precision knob).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PositionStorage {
+    /// World position minus the camera position, in fp16 (the default): precise at any distance
+    /// from the origin.
+    CameraRelative,
+    /// World position in fp16: the naive layout, which breaks far from the origin (spacing 8 m
+    /// at 10 km). Kept to show why.
+    World,
+    /// Nothing stored: the lighting pass reconstructs the position from the depth buffer (D32F)
+    /// and the inverse view-projection.
+    Depth,
+}
+
+/// How the G-buffer stores normals (a precision knob).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum NormalEncoding {
+    /// xyz in fp16 (the default).
+    Fp16,
+    /// Octahedral: two fp16 components (the third channel left zero).
+    Octahedral,
+}
+
+/// G-buffer precision settings (`[quality.gbuffer]`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GbufferSettings {
+    /// Position storage.
+    pub position: PositionStorage,
+    /// Normal encoding.
+    pub normal: NormalEncoding,
+}
+
+impl Default for GbufferSettings {
+    fn default() -> Self {
+        Self {
+            position: PositionStorage::CameraRelative,
+            normal: NormalEncoding::Fp16,
+        }
+    }
+}
+
+impl GbufferSettings {
+    /// Short name, e.g. `camera-relative/fp16`.
+    pub fn name(&self) -> String {
+        let position = match self.position {
+            PositionStorage::CameraRelative => "camera-relative",
+            PositionStorage::World => "world",
+            PositionStorage::Depth => "depth",
+        };
+        let normal = match self.normal {
+            NormalEncoding::Fp16 => "fp16",
+            NormalEncoding::Octahedral => "octahedral",
+        };
+        format!("{position}/{normal}")
+    }
+}
+
 /// Output size and the knobs that trade time for error.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Quality {
@@ -462,6 +522,8 @@ pub struct Quality {
     pub point_shadows: PointShadowPass,
     /// Image-based lighting precompute settings (used only with an environment).
     pub ibl: crate::ibl::IblSettings,
+    /// G-buffer position storage and normal encoding.
+    pub gbuffer: GbufferSettings,
 }
 
 impl Default for Quality {
@@ -475,6 +537,7 @@ impl Default for Quality {
             debug_shadow_terms: false,
             point_shadows: PointShadowPass::SixPasses,
             ibl: crate::ibl::IblSettings::default(),
+            gbuffer: GbufferSettings::default(),
         }
     }
 }

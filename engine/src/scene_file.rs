@@ -131,6 +131,9 @@ pub struct QualitySpec {
     pub point_shadows: Option<PointShadowPass>,
     /// `[quality.ibl]`: image-based lighting precompute (defaults in [`IblSettings`]).
     pub ibl: Option<IblSettings>,
+    /// `[quality.gbuffer]`: position storage and normal encoding (defaults: camera-relative,
+    /// fp16).
+    pub gbuffer: Option<GbufferSettings>,
 }
 
 /// `[environment]`.
@@ -306,6 +309,7 @@ impl QualitySpec {
             debug_shadow_terms: None,
             point_shadows: None,
             ibl: None,
+            gbuffer: None,
         }
     }
 }
@@ -543,6 +547,7 @@ impl Resolver {
             debug_shadow_terms: q.debug_shadow_terms.unwrap_or(defaults.debug_shadow_terms),
             point_shadows: q.point_shadows.unwrap_or(defaults.point_shadows),
             ibl: q.ibl.clone().unwrap_or(defaults.ibl),
+            gbuffer: q.gbuffer.unwrap_or(defaults.gbuffer),
         };
         let environment = match &file.environment {
             Some(spec) => {

@@ -97,12 +97,13 @@ enum Command {
     },
     /// Speed against error for a quality knob, timed with GPU timestamps: `shadow` (filter x map
     /// size, against ray casting and the converged soft filter) or `ibl` (samples, specular size,
-    /// SH9 irradiance, against a Monte Carlo reference, with the precompute time).
+    /// SH9 irradiance, against a Monte Carlo reference, with the precompute time) or `gbuffer`
+    /// (position storage x normal encoding, at 0, 1 km and 10 km from the origin).
     Sweep {
         /// Canonical scene name or scene file.
         #[arg(long, default_value = "chess")]
         scene: String,
-        /// The knob: shadow or ibl.
+        /// The knob: shadow, ibl or gbuffer.
         #[arg(long, default_value = "shadow")]
         knob: String,
         /// Backend.
@@ -583,6 +584,23 @@ fn sweep(
                 harness::sweep::IBL_REFERENCE_SAMPLES
             );
             print!("{}", harness::sweep::ibl_table(&rows));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    if knob == "gbuffer" {
+        let rows = harness::sweep::gbuffer_sweep(&loaded.scene, kind, repeats, |what| {
+            eprintln!("  {what} ...");
+        })?;
+        let text = serde_json::to_string_pretty(&rows)?;
+        save_sweep(&loaded.scene.name, "gbuffer", &text);
+        if json {
+            println!("{text}");
+        } else {
+            println!(
+                "gbuffer sweep of {} on {kind} ({repeats} renders per setting, median GPU time; error = light buffer against the scene at the origin with the default storage)",
+                loaded.scene.name
+            );
+            print!("{}", harness::sweep::gbuffer_table(&rows));
         }
         return Ok(ExitCode::SUCCESS);
     }

@@ -47,7 +47,7 @@ pub struct SweepRow {
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
     /// The knob is not one the sweep knows.
-    #[error("unknown knob `{0}` (known: shadow, ibl)")]
+    #[error("unknown knob `{0}` (known: shadow, ibl, gbuffer)")]
     UnknownKnob(String),
     /// The scene has no environment (for the `ibl` knob).
     #[error("scene `{0}` has no environment")]
@@ -617,10 +617,19 @@ pub fn report_sections(dir: &std::path::Path) -> String {
             let is_ibl = rows
                 .first()
                 .is_some_and(|r| r.get("precompute_s").is_some());
+            let is_gbuffer = rows
+                .first()
+                .is_some_and(|r| r.get("p99_relative").is_some());
             let points: Vec<(String, f64, f64, bool, bool)> = rows
                 .iter()
                 .map(|r| {
-                    let label = if is_ibl {
+                    let label = if is_gbuffer {
+                        format!(
+                            "{} at {}",
+                            r["setting"].as_str().unwrap_or("?"),
+                            r["distance"].as_f64().unwrap_or(0.0)
+                        )
+                    } else if is_ibl {
                         r["setting"].as_str().unwrap_or("?").to_owned()
                     } else {
                         format!(
@@ -629,7 +638,12 @@ pub fn report_sections(dir: &std::path::Path) -> String {
                             r["map_size"].as_u64().unwrap_or(0)
                         )
                     };
-                    let (cost, error) = if is_ibl {
+                    let (cost, error) = if is_gbuffer {
+                        (
+                            r["gpu_ms"].as_f64().unwrap_or(0.0),
+                            r["p99_relative"].as_f64().unwrap_or(0.0),
+                        )
+                    } else if is_ibl {
                         (
                             r["precompute_s"].as_f64().unwrap_or(0.0),
                             r["mean_relative"].as_f64().unwrap_or(0.0),
@@ -650,7 +664,12 @@ pub fn report_sections(dir: &std::path::Path) -> String {
                     )
                 })
                 .collect();
-            let (x_label, y_label) = if is_ibl {
+            let (x_label, y_label) = if is_gbuffer {
+                (
+                    "geometry + lighting GPU ms",
+                    "p99 relative error of the light buffer",
+                )
+            } else if is_ibl {
                 ("precompute s", "mean relative error")
             } else {
                 ("shadow + lighting GPU ms", "misclassified fraction")
@@ -670,6 +689,183 @@ pub fn report_sections(dir: &std::path::Path) -> String {
             }
             out.push_str("</table>");
         }
+    }
+    out
+}
+
+/// One setting and distance of the G-buffer sweep.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct GbufferSweepRow {
+    /// Position storage / normal encoding.
+    pub setting: String,
+    /// Distance the scene (camera too) is moved from the origin, in scene units.
+    pub distance: f64,
+    /// Median GPU time of the geometry and lighting passes, ms.
+    pub gpu_ms: Option<f64>,
+    /// 99th percentile of the light buffer's relative error against the reference (the scene at
+    /// the origin with the default storage), over covered pixels.
+    pub p99_relative: f64,
+    /// Largest relative error.
+    pub max_relative: f64,
+    /// Whether this is the default storage.
+    pub is_default: bool,
+    /// On the Pareto front of time against p99 error among the settings at this distance.
+    pub pareto: bool,
+}
+
+/// The G-buffer settings the sweep visits.
+pub fn gbuffer_settings() -> Vec<engine::scene::GbufferSettings> {
+    use engine::scene::{GbufferSettings, NormalEncoding, PositionStorage};
+    let mut out = Vec::new();
+    for position in [
+        PositionStorage::CameraRelative,
+        PositionStorage::World,
+        PositionStorage::Depth,
+    ] {
+        for normal in [NormalEncoding::Fp16, NormalEncoding::Octahedral] {
+            out.push(GbufferSettings { position, normal });
+        }
+    }
+    out
+}
+
+/// Distances the G-buffer sweep moves the scene by (the offset is along (1, 0.5, -1), so that
+/// no coordinate stays small).
+pub const GBUFFER_DISTANCES: [f64; 3] = [0.0, 1e3, 1e4];
+
+fn relative_errors(reference: &Frame, frame: &Frame) -> (f64, f64) {
+    let (Some(a), Some(b)) = (
+        reference.output(plan::LIGHT).and_then(|i| i.as_f32()),
+        frame.output(plan::LIGHT).and_then(|i| i.as_f32()),
+    ) else {
+        return (f64::NAN, f64::NAN);
+    };
+    let mask = reference
+        .outputs
+        .get("mask")
+        .and_then(|m| m.as_u8())
+        .unwrap_or_default();
+    let peak = a.iter().copied().fold(0.0f32, f32::max).max(1e-6);
+    let floor = 1e-3 * peak;
+    let mut errors: Vec<f64> = Vec::new();
+    for i in 0..a.len().min(b.len()) / 4 {
+        let covered = mask
+            .get(i * 4..i * 4 + 4)
+            .is_some_and(|m| m.iter().any(|&v| v > 127));
+        if !covered {
+            continue;
+        }
+        for c in 0..3 {
+            let (x, y) = (a[i * 4 + c], b[i * 4 + c]);
+            errors.push(f64::from((x - y).abs() / x.abs().max(floor)));
+        }
+    }
+    errors.sort_by(f64::total_cmp);
+    let p99 = errors
+        .get((errors.len() * 99 / 100).min(errors.len().saturating_sub(1)))
+        .copied()
+        .unwrap_or(0.0);
+    (p99, errors.last().copied().unwrap_or(0.0))
+}
+
+/// Runs the G-buffer sweep on one backend: every position storage and normal encoding, with
+/// the scene at the origin and moved 1 km and 10 km away, against the scene at the origin with
+/// the default storage.
+pub fn gbuffer_sweep(
+    scene: &Scene,
+    kind: BackendKind,
+    repeats: usize,
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<GbufferSweepRow>, SweepError> {
+    let mut backend = backend::create(kind).map_err(|e| SweepError::Render(e.to_string()))?;
+    let wanted = [plan::LIGHT, "mask"];
+    let mut render = |scene: &Scene| {
+        renderer::render(backend.as_mut(), scene, Readback::Only(&wanted))
+            .map_err(|e| SweepError::Render(e.to_string()))
+    };
+    let mut base = scene.clone();
+    base.quality.gbuffer = engine::scene::GbufferSettings::default();
+    progress("reference (default storage at the origin)");
+    let reference = render(&base)?;
+    let mut rows = Vec::new();
+    for distance in GBUFFER_DISTANCES {
+        let first = rows.len();
+        for settings in gbuffer_settings() {
+            progress(&format!("{} at {distance}", settings.name()));
+            let mut variant = base.translated(glam::DVec3::new(1.0, 0.5, -1.0) * (distance / 1.5));
+            variant.quality.gbuffer = settings;
+            let frames = (0..repeats.max(1))
+                .map(|_| render(&variant))
+                .collect::<Result<Vec<_>, _>>()?;
+            let (p99, max) = relative_errors(&reference, &frames[0]);
+            let gpu_ms = pass_ms(&frames, "geometry")
+                .zip(pass_ms(&frames, "lighting_"))
+                .map(|(g, l)| g + l);
+            rows.push(GbufferSweepRow {
+                setting: settings.name(),
+                distance,
+                gpu_ms,
+                p99_relative: p99,
+                max_relative: max,
+                is_default: settings == engine::scene::GbufferSettings::default(),
+                pareto: false,
+            });
+        }
+        let points: Vec<(f64, f64)> = rows[first..]
+            .iter()
+            .map(|r| (r.gpu_ms.unwrap_or(0.0), r.p99_relative))
+            .collect();
+        for (row, on_front) in rows[first..].iter_mut().zip(pareto_front(&points)) {
+            row.pareto = on_front;
+        }
+    }
+    Ok(rows)
+}
+
+/// The G-buffer sweep as a table.
+pub fn gbuffer_table(rows: &[GbufferSweepRow]) -> String {
+    let mut out = format!(
+        "{:<28} {:>9} {:>14} {:>12} {:>12}  {}\n",
+        "storage (position/normal)", "distance", "geom+light ms", "p99 rel", "max rel", "front"
+    );
+    for r in rows {
+        out.push_str(&format!(
+            "{:<28} {:>9} {:>14} {:>12.2e} {:>12.2e}  {}{}\n",
+            r.setting,
+            r.distance,
+            r.gpu_ms.map_or("-".to_owned(), |v| format!("{v:.2}")),
+            r.p99_relative,
+            r.max_relative,
+            if r.pareto { "*" } else { "" },
+            if r.is_default { " (default)" } else { "" }
+        ));
+    }
+    out.push_str("front: * = on the Pareto front of GPU time against p99 error at that distance\n");
+    out
+}
+
+/// The G-buffer sweep's p99 errors without times, as power-of-ten bands so that the text is
+/// stable: the insta snapshot of the canonical scene's sweep.
+pub fn stable_gbuffer_table(rows: &[GbufferSweepRow]) -> String {
+    let band = |e: f64| {
+        if e <= 0.0 {
+            "0".to_owned()
+        } else {
+            format!("1e{}", e.log10().ceil() as i32)
+        }
+    };
+    let mut out = format!(
+        "{:<28} {:>9} {:>10}\n",
+        "storage (position/normal)", "distance", "p99 <="
+    );
+    for r in rows {
+        out.push_str(&format!(
+            "{:<28} {:>9} {:>10}{}\n",
+            r.setting,
+            r.distance,
+            band(r.p99_relative),
+            if r.is_default { "  (default)" } else { "" }
+        ));
     }
     out
 }

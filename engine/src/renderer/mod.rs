@@ -726,6 +726,7 @@ fn record_and_submit(
             view_projection,
             channel,
             faults,
+            &scene.quality.gbuffer,
         );
         let uniform = scope.buffer(
             backend,
@@ -911,6 +912,7 @@ fn record_and_submit(
             binding: 16,
             kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
         },
+        texture_layout(17),
     ]);
     let ibl_textures = ibl::upload(backend, scope, ibl_maps)?;
     let jitter_layers = (shadows::SOFT_RINGS * shadows::SOFT_SECTORS / 2) as u32;
@@ -955,7 +957,7 @@ fn record_and_submit(
             ..SamplerDesc::linear("shadow moments", AddressMode::ClampToEdge)
         },
     )?;
-    // Bind group of a lighting-shader draw (`lighting.wgsl` bindings 0..16).
+    // Bind group of a lighting-shader draw (`lighting.wgsl` bindings 0..17).
     let lighting_bind_group = |uniform, mask, draw: &LightDraw| {
         let mut bindings = vec![binding(0, BindingResource::Buffer(uniform))];
         bindings.extend(
@@ -976,6 +978,7 @@ fn record_and_submit(
             binding(14, BindingResource::Texture(ibl_textures.specular)),
             binding(15, BindingResource::Texture(ibl_textures.dfg)),
             binding(16, BindingResource::Sampler(ibl_textures.sampler)),
+            binding(17, BindingResource::Texture(targets[plan::DEPTH])),
         ]);
         bindings
     };
@@ -1055,6 +1058,7 @@ fn record_and_submit(
         for (index, draw) in batches.iter().enumerate() {
             let data = uniforms::lighting_uniforms(
                 scene,
+                &camera,
                 *channel,
                 &draw.lights,
                 index == 0,
@@ -1120,7 +1124,8 @@ fn record_and_submit(
                 continue;
             };
             let channel = plan.mask_channels[0];
-            let data = uniforms::lighting_uniforms(scene, channel, &draw.lights, false, 0.0);
+            let data =
+                uniforms::lighting_uniforms(scene, &camera, channel, &draw.lights, false, 0.0);
             let uniform = scope.buffer(
                 backend,
                 &format!("{name} uniforms"),

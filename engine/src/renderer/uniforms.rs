@@ -6,7 +6,10 @@ use glam::{DVec3, Mat4};
 
 use super::{object_matrices, CameraMatrices, Faults};
 use crate::plan::{MaskChannel, MAX_LIGHTS_PER_DRAW};
-use crate::scene::{EnvironmentImage, Light, Object, Scene, Transform};
+use crate::scene::{
+    EnvironmentImage, GbufferSettings, Light, NormalEncoding, Object, PositionStorage, Scene,
+    Transform,
+};
 
 /// `LightData` in `lighting.wgsl`.
 #[repr(C)]
@@ -73,6 +76,7 @@ pub(super) fn object_uniforms(
     view_projection: Mat4,
     channel: MaskChannel,
     faults: &Faults,
+    gbuffer: &GbufferSettings,
 ) -> Vec<f32> {
     let (model, normal) = object_matrices(transform, camera_position);
     let m = &object.material;
@@ -102,15 +106,39 @@ pub(super) fn object_uniforms(
         flag(m.roughness_map),
         flag(m.metallic_map),
     ]);
-    data.extend_from_slice(&[flag(m.clearcoat_map), flag(m.specular_map), 0.0, 0.0]);
+    let (position_mode, normal_mode) = gbuffer_modes(gbuffer);
+    data.extend_from_slice(&[
+        flag(m.clearcoat_map),
+        flag(m.specular_map),
+        position_mode,
+        normal_mode,
+    ]);
     data.extend_from_slice(&one_hot[0]);
     data.extend_from_slice(&one_hot[1]);
+    let c = camera_position.as_vec3();
+    data.extend_from_slice(&[c.x, c.y, c.z, 0.0]);
     data
+}
+
+/// The G-buffer settings as the shaders' flags: position (0 camera-relative, 1 world, 2 depth)
+/// and normal (0 fp16, 1 octahedral).
+pub(super) fn gbuffer_modes(gbuffer: &GbufferSettings) -> (f32, f32) {
+    let position = match gbuffer.position {
+        PositionStorage::CameraRelative => 0.0,
+        PositionStorage::World => 1.0,
+        PositionStorage::Depth => 2.0,
+    };
+    let normal = match gbuffer.normal {
+        NormalEncoding::Fp16 => 0.0,
+        NormalEncoding::Octahedral => 1.0,
+    };
+    (position, normal)
 }
 
 /// `LightingUniforms` in `lighting.wgsl`, as bytes.
 pub(super) fn lighting_uniforms(
     scene: &Scene,
+    camera: &CameraMatrices,
     channel: MaskChannel,
     batch: &[LightData],
     first_batch: bool,
@@ -142,6 +170,17 @@ pub(super) fn lighting_uniforms(
     bytes.extend_from_slice(bytemuck::cast_slice(&ambient));
     bytes.extend_from_slice(bytemuck::cast_slice(&counts));
     bytes.extend_from_slice(bytemuck::cast_slice(&ibl));
+    let (position_mode, normal_mode) = gbuffer_modes(&scene.quality.gbuffer);
+    bytes.extend_from_slice(bytemuck::cast_slice(&[
+        position_mode,
+        normal_mode,
+        0.0,
+        0.0,
+    ]));
+    let c = scene.camera.position.as_vec3();
+    bytes.extend_from_slice(bytemuck::cast_slice(&[c.x, c.y, c.z, 0.0]));
+    let inverse = camera.view_projection().inverse().as_mat4();
+    bytes.extend_from_slice(bytemuck::cast_slice(&inverse.to_cols_array()));
     bytes.extend_from_slice(bytemuck::cast_slice(&lights));
     bytes
 }
