@@ -140,6 +140,17 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Run the numerical hard cases (scenes/hard/ and chess moved 1e4/1e5 and scaled
+    /// 0.001/1000) on every available backend: no NaN/Inf, the light buffer in range, and each
+    /// case's own check. Prints the table, keeps it for the check report, exits 1 on a failure.
+    Hard {
+        /// Only this backend (repeatable). Default: every available one.
+        #[arg(long = "backend")]
+        backends: Vec<BackendKind>,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// List the canonical scenes with their descriptions.
     Scenes,
     /// List every backend with its availability, the reason and fix when unavailable, and the
@@ -189,6 +200,7 @@ fn main() -> ExitCode {
             .map_err(Into::into),
         Command::Inspect { path, json } => inspect(&path, json),
         Command::Scenes => scenes(),
+        Command::Hard { backends, json } => hard(&backends, json),
         Command::Selftest { json } => selftest(json),
         Command::Sweep {
             scene,
@@ -622,6 +634,57 @@ fn sweep(
         print!("{}", harness::sweep::table(&rows));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+fn hard(backends: &[BackendKind], json: bool) -> anyhow::Result<ExitCode> {
+    let kinds: Vec<BackendKind> = if backends.is_empty() {
+        BackendKind::ALL
+            .into_iter()
+            .filter(|&k| {
+                let status = engine::backend::probe(k);
+                if !status.available {
+                    eprintln!(
+                        "skipping {k}: {} (fix: {})",
+                        status.reason.unwrap_or_default(),
+                        status.fix.unwrap_or_default()
+                    );
+                }
+                status.available
+            })
+            .collect()
+    } else {
+        backends.to_vec()
+    };
+    let mut rows = Vec::new();
+    for kind in kinds {
+        rows.extend(
+            harness::hard_cases::run(kind, |case| eprintln!("  {case} on {kind} ..."))
+                .map_err(|e| anyhow::anyhow!("{kind}: {e}"))?,
+        );
+    }
+    let text = serde_json::to_string_pretty(&rows)?;
+    let path = default_out_dir().join(harness::hard_cases::RESULTS_JSON);
+    match std::fs::create_dir_all(default_out_dir())
+        .map_err(|e| e.to_string())
+        .and_then(|_| {
+            harness::images::write_atomically(&path, text.as_bytes()).map_err(|e| e.to_string())
+        }) {
+        Ok(()) => eprintln!(
+            "wrote {} (shown in the next `harness check` report)",
+            path.display()
+        ),
+        Err(e) => eprintln!("warning: hard-case results not kept: {e}"),
+    }
+    if json {
+        println!("{text}");
+    } else {
+        print!("{}", harness::hard_cases::table(&rows));
+    }
+    Ok(if rows.iter().all(|r| r.passed) {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
 }
 
 /// Keeps a sweep's results (target/harness/sweep_<scene>_<knob>.json) for the check report; a

@@ -289,6 +289,7 @@ figcaption{{font-size:12px}} code{{font-size:12px}}
     if let Some(dir) = bench_dir {
         out.push_str(&crate::bench::report_sections(dir));
         out.push_str(&crate::sweep::report_sections(dir));
+        out.push_str(&crate::hard_cases::report_section(dir));
     }
     out.push_str("</body></html>\n");
     out
