@@ -70,11 +70,12 @@ struct ShadowUniforms {
     // w = normal offset (texels).
     params: vec4<f32>,
     // x = filter (0 hard, 1 3x3 PCF, 2 stratified soft, 3 stratified soft without early-out,
-    // 4 converged soft reference, 5 variance shadow map),
+    // 4 converged soft reference, 5 variance shadow map, 6 Vogel disk of soft.z samples),
     // y = 1 / map width, z = 1 / map height,
     // w = texel size in meters (directional) or per meter of distance (point).
     map: vec4<f32>,
-    // x = soft radius (texels), y = reach of the filter in texels (scales the biases).
+    // x = soft radius (texels), y = reach of the filter in texels (scales the biases),
+    // z = samples of the Vogel-disk filters (1024 for the reference).
     soft: vec4<f32>,
     // VSM: x = minimum variance, y = light-bleeding reduction.
     vsm: vec4<f32>,
@@ -186,15 +187,17 @@ fn shadow_soft(look: ShadowLookup, early_out: bool) -> f32 {
     return sum / 16.0;
 }
 
-// The converged soft filter for sweeps: 1024 samples on a golden-angle (Vogel) disk.
-fn shadow_soft_reference(look: ShadowLookup) -> f32 {
+// Soft filter on a golden-angle (Vogel) disk of soft.z samples, no jitter: the `vogel` filter,
+// and at 1024 samples the converged reference for sweeps.
+fn shadow_vogel(look: ShadowLookup) -> f32 {
+    let count = max(i32(shadow.soft.z), 1);
     var sum = 0.0;
-    for (var i = 0; i < 1024; i++) {
-        let r = sqrt((f32(i) + 0.5) / 1024.0);
+    for (var i = 0; i < count; i++) {
+        let r = sqrt((f32(i) + 0.5) / f32(count));
         let angle = f32(i) * 2.39996323;
         sum += soft_tap(look, vec2<f32>(cos(angle), sin(angle)) * r);
     }
-    return sum / 1024.0;
+    return sum / f32(count);
 }
 
 // Variance shadow maps (directional lights): Chebyshev's upper bound on the lit fraction from
@@ -215,11 +218,14 @@ fn shadow_vsm(look: ShadowLookup) -> f32 {
 // Filtered comparison of the receiver against the map, by the draw's filter; hard and 3x3 PCF
 // taps stay in the map's uv space, clamped inside `bounds` (a point light's face).
 fn shadow_lookup(look: ShadowLookup) -> f32 {
+    if shadow.map.x > 5.5 {
+        return shadow_vogel(look);
+    }
     if shadow.map.x > 4.5 {
         return shadow_vsm(look);
     }
     if shadow.map.x > 3.5 {
-        return shadow_soft_reference(look);
+        return shadow_vogel(look);
     }
     if shadow.map.x > 1.5 {
         return shadow_soft(look, shadow.map.x < 2.5);

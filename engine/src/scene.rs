@@ -264,6 +264,9 @@ pub enum ShadowFilter {
     /// The converged soft filter: 1024 samples on a Vogel (golden-angle) disk of `soft_radius`
     /// texels, no jitter. The reference the soft filters' error is measured against in sweeps.
     SoftReference,
+    /// `soft_samples` samples on a Vogel (golden-angle) disk of `soft_radius` texels, no jitter:
+    /// the soft filter with its sample count as a knob (`soft-reference` is this at 1024).
+    Vogel,
     /// Variance shadow maps (the r2 seed; directional lights only): the map stores depth and
     /// depth squared, blurred by a separable Gaussian, sampled bilinearly, and turned into a
     /// visibility by Chebyshev's bound with a minimum variance and light-bleeding reduction.
@@ -279,6 +282,7 @@ impl ShadowFilter {
             ShadowFilter::Soft => "soft",
             ShadowFilter::SoftFull => "soft-full",
             ShadowFilter::SoftReference => "soft-reference",
+            ShadowFilter::Vogel => "vogel",
             ShadowFilter::Vsm => "vsm",
         }
     }
@@ -303,6 +307,8 @@ pub struct ShadowSettings {
     pub filter: ShadowFilter,
     /// Radius of the soft filters' sample disk, in texels.
     pub soft_radius: f32,
+    /// Samples of the `vogel` filter (1..=4096).
+    pub soft_samples: u32,
     /// VSM: radius of the Gaussian blur of the moments, in texels (0: no blur passes).
     pub vsm_blur_radius: u32,
     /// VSM: the smallest variance Chebyshev's bound uses, in squared map depth (0..1) units;
@@ -319,9 +325,10 @@ impl ShadowSettings {
         match self.filter {
             ShadowFilter::Hard => 1.0,
             ShadowFilter::Pcf3 => 2.0,
-            ShadowFilter::Soft | ShadowFilter::SoftFull | ShadowFilter::SoftReference => {
-                1.0 + self.soft_radius.max(0.0)
-            }
+            ShadowFilter::Soft
+            | ShadowFilter::SoftFull
+            | ShadowFilter::SoftReference
+            | ShadowFilter::Vogel => 1.0 + self.soft_radius.max(0.0),
             // Chebyshev's bound is soft near the mean, so VSM needs only the hard filter's bias
             // (measured: a larger reach adds peter-panning and no acne goes away).
             ShadowFilter::Vsm => 1.0,
@@ -338,6 +345,7 @@ impl Default for ShadowSettings {
             normal_offset: 0.5,
             filter: ShadowFilter::Pcf3,
             soft_radius: 2.5,
+            soft_samples: 64,
             vsm_blur_radius: 2,
             vsm_min_variance: 1e-6,
             vsm_bleeding_reduction: 0.2,

@@ -225,10 +225,12 @@ pub struct ShadowSpec {
     pub slope_bias: Option<f32>,
     /// Normal offset in shadow-map texels.
     pub normal_offset: Option<f32>,
-    /// `hard`, `pcf3` (default), `soft`, `soft-full`, `soft-reference` or `vsm`.
+    /// `hard`, `pcf3` (default), `soft`, `soft-full`, `soft-reference`, `vogel` or `vsm`.
     pub filter: Option<ShadowFilter>,
     /// Sample-disk radius of the soft filters, in texels (default 2.5).
     pub soft_radius: Option<f32>,
+    /// Samples of the `vogel` filter (default 64).
+    pub soft_samples: Option<u32>,
     /// VSM blur radius in texels (default 2).
     pub vsm_blur_radius: Option<u32>,
     /// VSM minimum variance (default 1e-6).
@@ -655,6 +657,7 @@ impl Resolver {
                         normal_offset: s.normal_offset.unwrap_or(d.normal_offset),
                         filter: s.filter.unwrap_or(d.filter),
                         soft_radius: s.soft_radius.unwrap_or(d.soft_radius),
+                        soft_samples: s.soft_samples.unwrap_or(d.soft_samples),
                         vsm_blur_radius: s.vsm_blur_radius.unwrap_or(d.vsm_blur_radius),
                         vsm_min_variance: s.vsm_min_variance.unwrap_or(d.vsm_min_variance),
                         vsm_bleeding_reduction: s

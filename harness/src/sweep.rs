@@ -61,6 +61,15 @@ pub enum SweepError {
 }
 
 fn with_shadow(scene: &Scene, filter: ShadowFilter, map_size: u32) -> Scene {
+    with_shadow_samples(scene, filter, map_size, None)
+}
+
+fn with_shadow_samples(
+    scene: &Scene,
+    filter: ShadowFilter,
+    map_size: u32,
+    samples: Option<u32>,
+) -> Scene {
     let mut scene = scene.clone();
     scene.quality.debug_shadow_terms = true;
     for light in &mut scene.lights {
@@ -73,6 +82,9 @@ fn with_shadow(scene: &Scene, filter: ShadowFilter, map_size: u32) -> Scene {
         {
             s.filter = filter;
             s.map_size = map_size;
+            if let Some(samples) = samples {
+                s.soft_samples = samples;
+            }
         }
     }
     scene
@@ -142,18 +154,25 @@ pub fn shadow_sweep(
         progress(&format!("soft reference at {map_size}"));
         let reference_scene = with_shadow(scene, ShadowFilter::SoftReference, map_size);
         let reference = render(&reference_scene)?;
-        for filter in [
-            ShadowFilter::Hard,
-            ShadowFilter::Pcf3,
-            ShadowFilter::Soft,
-            ShadowFilter::SoftFull,
-            ShadowFilter::Vsm,
+        for (filter, samples) in [
+            (ShadowFilter::Hard, None),
+            (ShadowFilter::Pcf3, None),
+            (ShadowFilter::Soft, None),
+            (ShadowFilter::SoftFull, None),
+            (ShadowFilter::Vogel, Some(16)),
+            (ShadowFilter::Vogel, Some(64)),
+            (ShadowFilter::Vogel, Some(256)),
+            (ShadowFilter::Vsm, None),
         ] {
             if filter == ShadowFilter::Vsm && any_point_shadows {
                 continue; // VSM is for directional lights
             }
-            progress(&format!("{} at {map_size}", filter.name()));
-            let mutated = with_shadow(scene, filter, map_size);
+            let label = match samples {
+                Some(n) => format!("{}-{n}", filter.name()),
+                None => filter.name().to_owned(),
+            };
+            progress(&format!("{label} at {map_size}"));
+            let mutated = with_shadow_samples(scene, filter, map_size, samples);
             let frames = (0..repeats.max(1))
                 .map(|_| render(&mutated))
                 .collect::<Result<Vec<_>, _>>()?;
@@ -162,7 +181,10 @@ pub fn shadow_sweep(
                 .map_err(SweepError::Render)?;
             let soft = matches!(
                 filter,
-                ShadowFilter::Soft | ShadowFilter::SoftFull | ShadowFilter::Vsm
+                ShadowFilter::Soft
+                    | ShadowFilter::SoftFull
+                    | ShadowFilter::Vogel
+                    | ShadowFilter::Vsm
             )
             .then(|| {
                 mean_abs_difference(
@@ -172,7 +194,7 @@ pub fn shadow_sweep(
                 )
             });
             rows.push(SweepRow {
-                filter: filter.name().to_owned(),
+                filter: label,
                 map_size,
                 shadow_ms: pass_ms(&frames, "shadow_"),
                 lighting_ms: pass_ms(&frames, "lighting_"),

@@ -41,6 +41,12 @@ pub fn settings_problem(light: &Light) -> Option<String> {
                 .to_owned(),
         );
     }
+    if !(1..=4096).contains(&s.soft_samples) {
+        return Some(format!(
+            "soft_samples {} must be in 1..4096",
+            s.soft_samples
+        ));
+    }
     if s.filter == ShadowFilter::Vsm {
         if matches!(light, Light::Point { .. }) {
             return Some(
@@ -216,12 +222,17 @@ pub fn shadow_uniforms(view: Option<&ShadowView>) -> Vec<f32> {
             ShadowFilter::SoftFull => 3.0,
             ShadowFilter::SoftReference => 4.0,
             ShadowFilter::Vsm => 5.0,
+            ShadowFilter::Vogel => 6.0,
         },
         1.0 / w as f32,
         1.0 / h as f32,
         view.texel_world as f32,
     ]);
-    data.extend_from_slice(&[s.soft_radius, s.reach(), 0.0, 0.0]);
+    let samples = match s.filter {
+        ShadowFilter::SoftReference => 1024,
+        _ => s.soft_samples,
+    };
+    data.extend_from_slice(&[s.soft_radius, s.reach(), samples as f32, 0.0]);
     data.extend_from_slice(&[s.vsm_min_variance, s.vsm_bleeding_reduction, 0.0, 0.0]);
     data
 }
