@@ -378,6 +378,22 @@ pub fn reference_pixels(
     Ok(results)
 }
 
+/// Relative error (r + g + b) of the light buffer at every reference pixel.
+pub fn pixel_errors(frame: &Frame, references: &[PixelReference]) -> Vec<f64> {
+    let light = frame
+        .output(plan::LIGHT)
+        .and_then(|i| i.as_f32())
+        .unwrap_or(&[]);
+    references
+        .iter()
+        .filter_map(|r| {
+            let g = light.get(r.index * 4..r.index * 4 + 3)?;
+            let expected = r.radiance.element_sum();
+            Some((f64::from(g[0] + g[1] + g[2]) - expected).abs() / expected.max(1e-6))
+        })
+        .collect()
+}
+
 /// Error of the light buffer against the reference, grouped by roughness (rounded to 0.1).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct RoughnessError {

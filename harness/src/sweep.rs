@@ -36,6 +36,8 @@ pub struct SweepRow {
     pub misclassified: f64,
     /// Mean |term - soft reference| over lit-surface pixels (soft filters only).
     pub error_vs_soft_reference: Option<f64>,
+    /// 99th percentile and maximum of |term - soft reference| (soft filters only).
+    pub soft_reference_p99_max: Option<(f64, f64)>,
     /// Whether this is the scene's own setting.
     pub is_default: bool,
     /// Whether no other setting is both faster (shadow + lighting GPU time) and more accurate
@@ -187,7 +189,7 @@ pub fn shadow_sweep(
                     | ShadowFilter::Vsm
             )
             .then(|| {
-                mean_abs_difference(
+                abs_difference_stats(
                     frame.outputs[&term_name].as_f32().unwrap_or_default(),
                     reference.outputs[&term_name].as_f32().unwrap_or_default(),
                     frame,
@@ -199,7 +201,8 @@ pub fn shadow_sweep(
                 shadow_ms: pass_ms(&frames, "shadow_"),
                 lighting_ms: pass_ms(&frames, "lighting_"),
                 misclassified: visibility.fraction,
-                error_vs_soft_reference: soft,
+                error_vs_soft_reference: soft.map(|s| s.0),
+                soft_reference_p99_max: soft.map(|s| (s.1, s.2)),
                 is_default: own == Some((filter, map_size)),
                 pareto: false,
             });
@@ -220,43 +223,63 @@ pub fn shadow_sweep(
     Ok(rows)
 }
 
-/// Mean absolute difference of two shadow terms over the covered pixels.
-fn mean_abs_difference(a: &[f32], b: &[f32], frame: &Frame) -> f64 {
+/// Mean, 99th percentile and maximum absolute difference of two shadow terms over the covered
+/// pixels.
+fn abs_difference_stats(a: &[f32], b: &[f32], frame: &Frame) -> (f64, f64, f64) {
     let mask = frame
         .outputs
         .get("mask")
         .and_then(|m| m.as_u8())
         .unwrap_or_default();
-    let (mut sum, mut n) = (0.0, 0usize);
+    let mut differences = Vec::new();
     for i in 0..a.len().min(b.len()) / 4 {
         if mask
             .get(i * 4..i * 4 + 4)
             .is_some_and(|m| m.iter().any(|&v| v > 127))
         {
-            sum += f64::from((a[i * 4] - b[i * 4]).abs());
-            n += 1;
+            differences.push(f64::from((a[i * 4] - b[i * 4]).abs()));
         }
     }
-    sum / n.max(1) as f64
+    stats(differences)
+}
+
+/// Mean, 99th percentile and maximum of some errors (zeros when there are none).
+pub fn stats(mut errors: Vec<f64>) -> (f64, f64, f64) {
+    if errors.is_empty() {
+        return (0.0, 0.0, 0.0);
+    }
+    errors.sort_by(f64::total_cmp);
+    let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+    let p99 = errors[(errors.len() * 99 / 100).min(errors.len() - 1)];
+    (mean, p99, errors[errors.len() - 1])
 }
 
 /// The sweep as a table.
 pub fn table(rows: &[SweepRow]) -> String {
     let mut out = format!(
-        "{:<10} {:>6} {:>11} {:>13} {:>14} {:>16}  {}\n",
-        "filter", "map", "shadow ms", "lighting ms", "misclassified", "vs soft ref", "front"
+        "{:<10} {:>6} {:>11} {:>13} {:>14} {:>24}  {}\n",
+        "filter",
+        "map",
+        "shadow ms",
+        "lighting ms",
+        "misclassified",
+        "vs soft ref mean/p99/max",
+        "front"
     );
     let ms = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.2}"));
     for r in rows {
         out.push_str(&format!(
-            "{:<10} {:>6} {:>11} {:>13} {:>13.3}% {:>16}  {}{}\n",
+            "{:<10} {:>6} {:>11} {:>13} {:>13.3}% {:>24}  {}{}\n",
             r.filter,
             r.map_size,
             ms(r.shadow_ms),
             ms(r.lighting_ms),
             r.misclassified * 100.0,
             r.error_vs_soft_reference
-                .map_or("-".to_owned(), |e| format!("{e:.4}")),
+                .zip(r.soft_reference_p99_max)
+                .map_or("-".to_owned(), |(mean, (p99, max))| format!(
+                    "{mean:.4}/{p99:.3}/{max:.2}"
+                )),
             if r.pareto { "*" } else { "" },
             if r.is_default { " (default)" } else { "" }
         ));
@@ -299,80 +322,73 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
         .collect()
 }
 
-/// A small SVG scatter plot of error against cost, Pareto front in color and joined, the
-/// default setting ringed.
-pub fn pareto_svg(title: &str, x_label: &str, points: &[(String, f64, f64, bool, bool)]) -> String {
-    let (w, h, left, bottom, top, right) = (420.0, 240.0, 55.0, 35.0, 22.0, 20.0);
-    let escape = |t: &str| {
-        t.replace('&', "&amp;")
-            .replace('<', "&lt;")
-            .replace('>', "&gt;")
-    };
-    let mut svg = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
-         style=\"background:#fff;border:1px solid #ccc\">\
-         <text x=\"{left}\" y=\"14\" font-size=\"12\">{}</text>",
-        escape(title)
-    );
-    if points.is_empty() {
-        svg.push_str("</svg>");
-        return svg;
-    }
-    let (x1, y1) = points
-        .iter()
-        .fold((0.0f64, 0.0f64), |(a, b), p| (a.max(p.1), b.max(p.2)));
-    let (x1, y1) = (x1.max(1e-9), y1.max(1e-9));
-    // The cost axis starts just below the cheapest setting (costs cluster far from zero).
-    let x0 = points.iter().map(|p| p.1).fold(f64::MAX, f64::min) * 0.95;
-    let sx = |x: f64| left + (x - x0) / (x1 - x0).max(1e-9) * (w - left - right);
-    let sy = |y: f64| h - bottom - y / y1 * (h - bottom - top);
-    svg.push_str(&format!(
-        "<line x1=\"{left}\" y1=\"{0}\" x2=\"{1}\" y2=\"{0}\" stroke=\"#888\"/>\
-         <line x1=\"{left}\" y1=\"{top}\" x2=\"{left}\" y2=\"{0}\" stroke=\"#888\"/>\
-         <text x=\"4\" y=\"{2}\" font-size=\"10\">{y1:.3}</text>\
-         <text x=\"4\" y=\"{0}\" font-size=\"10\">0</text>\
-         <text x=\"{1}\" y=\"{3}\" font-size=\"10\" text-anchor=\"end\">{4} ({x0:.2} to {x1:.2})</text>",
-        h - bottom,
-        w - right,
-        top + 4.0,
-        h - 6.0,
-        escape(x_label)
-    ));
-    let mut front: Vec<(f64, f64)> = points
-        .iter()
-        .filter(|p| p.3)
-        .map(|p| (sx(p.1), sy(p.2)))
-        .collect();
-    front.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let line: Vec<String> = front
-        .iter()
-        .map(|(x, y)| format!("{x:.1},{y:.1}"))
-        .collect();
-    svg.push_str(&format!(
-        "<polyline fill=\"none\" stroke=\"#2a6\" stroke-width=\"1.5\" points=\"{}\"/>",
-        line.join(" ")
-    ));
-    for (label, x, y, on_front, is_default) in points {
-        let color = if *on_front { "#2a6" } else { "#999" };
-        svg.push_str(&format!(
-            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"3.5\" fill=\"{color}\"/>\
-             <text x=\"{:.1}\" y=\"{:.1}\" font-size=\"9\">{}</text>",
-            sx(*x),
-            sy(*y),
-            sx(*x) + 5.0,
-            sy(*y) - 4.0,
-            escape(label)
-        ));
-        if *is_default {
-            svg.push_str(&format!(
-                "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"7\" fill=\"none\" stroke=\"#c60\" stroke-width=\"1.5\"/>",
-                sx(*x),
-                sy(*y)
-            ));
+/// An SVG scatter plot (plotters) of error against cost: every setting labelled, the Pareto
+/// front joined and in green, the default ringed in orange.
+pub fn pareto_svg(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    points: &[(String, f64, f64, bool, bool)],
+) -> String {
+    use plotters::prelude::*;
+    let mut svg = String::new();
+    let drawn = (|| -> Result<(), Box<dyn std::error::Error>> {
+        let root = SVGBackend::with_string(&mut svg, (480, 300)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
+        let (x0, x1) = points.iter().fold((f64::MAX, f64::MIN), |(a, b), p| {
+            (a.min(finite(p.1)), b.max(finite(p.1)))
+        });
+        let y1 = points.iter().map(|p| finite(p.2)).fold(0.0, f64::max);
+        let pad = ((x1 - x0) * 0.08).max(1e-6);
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 14))
+            .margin(10)
+            .x_label_area_size(32)
+            .y_label_area_size(56)
+            .build_cartesian_2d((x0 - pad)..(x1 + pad), 0.0..(y1 * 1.1).max(1e-9))?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .label_style(("sans-serif", 10))
+            .draw()?;
+        let mut front: Vec<(f64, f64)> = points
+            .iter()
+            .filter(|p| p.3)
+            .map(|p| (finite(p.1), finite(p.2)))
+            .collect();
+        front.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let green = RGBColor(34, 160, 102);
+        chart.draw_series(LineSeries::new(front, green.stroke_width(2)))?;
+        for (label, x, y, on_front, is_default) in points {
+            let at = (finite(*x), finite(*y));
+            let color = if *on_front {
+                green
+            } else {
+                RGBColor(150, 150, 150)
+            };
+            chart.draw_series(std::iter::once(Circle::new(at, 4, color.filled())))?;
+            if *is_default {
+                chart.draw_series(std::iter::once(Circle::new(
+                    at,
+                    8,
+                    RGBColor(204, 102, 0).stroke_width(2),
+                )))?;
+            }
+            chart.draw_series(std::iter::once(Text::new(
+                label.clone(),
+                at,
+                ("sans-serif", 9).into_font(),
+            )))?;
         }
+        root.present()?;
+        Ok(())
+    })();
+    match drawn {
+        Ok(()) => svg,
+        Err(e) => format!("<p>plot failed: {e}</p>"),
     }
-    svg.push_str("</svg>");
-    svg
 }
 
 /// One setting of the IBL sweep.
@@ -391,6 +407,8 @@ pub struct IblSweepRow {
     pub by_roughness: Vec<crate::ibl_reference::RoughnessError>,
     /// Mean relative error over every reference pixel.
     pub mean_relative: f64,
+    /// 99th percentile and maximum relative error over every reference pixel.
+    pub p99_max_relative: (f64, f64),
     /// Mean relative error per material family (rows) and roughness (columns: roughness, error,
     /// pixels).
     pub by_family: Vec<crate::ibl_reference::FamilyRow>,
@@ -496,6 +514,7 @@ pub fn ibl_sweep(
         let references = references.as_deref().unwrap_or_default();
         let by_roughness = crate::ibl_reference::error_by_roughness(&frames[0], references);
         let by_family = crate::ibl_reference::error_by_family(&frames[0], references);
+        let (_, p99, max) = stats(crate::ibl_reference::pixel_errors(&frames[0], references));
         let total: usize = by_roughness.iter().map(|r| r.pixels).sum();
         let mean_relative = by_roughness
             .iter()
@@ -510,6 +529,7 @@ pub fn ibl_sweep(
             lighting_ms: pass_ms(&frames, "lighting"),
             by_roughness,
             mean_relative,
+            p99_max_relative: (p99, max),
             by_family,
             is_default,
             pareto: false,
@@ -538,7 +558,7 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
     for g in &first.by_roughness {
         out.push_str(&format!(" {:>7}", format!("r {:.1}", g.roughness)));
     }
-    out.push_str(&format!(" {:>7}\n", "mean"));
+    out.push_str(&format!(" {:>7} {:>7} {:>7}\n", "mean", "p99", "max"));
     for r in rows {
         out.push_str(&format!(
             "{:<15} {:>13.3} {:>12}",
@@ -549,7 +569,12 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
         for g in &r.by_roughness {
             out.push_str(&format!(" {:>6.2}%", g.mean_relative * 100.0));
         }
-        out.push_str(&format!(" {:>6.2}%\n", r.mean_relative * 100.0));
+        out.push_str(&format!(
+            " {:>6.2}% {:>6.1}% {:>6.1}%\n",
+            r.mean_relative * 100.0,
+            r.p99_max_relative.0 * 100.0,
+            r.p99_max_relative.1 * 100.0
+        ));
         out.push_str(&format!("{:<15} {:>13} {:>12}", "  (median)", "", ""));
         for g in &r.by_roughness {
             out.push_str(&format!(" {:>6.2}%", g.median_relative * 100.0));
@@ -686,6 +711,17 @@ pub fn report_sections(dir: &std::path::Path) -> String {
                     )
                 })
                 .collect();
+            // The G-buffer sweep's front is per distance: plot the farthest distance only.
+            let farthest = rows
+                .iter()
+                .filter_map(|r| r["distance"].as_f64())
+                .fold(0.0, f64::max);
+            let plotted: Vec<(String, f64, f64, bool, bool)> = points
+                .iter()
+                .zip(&rows)
+                .filter(|(_, r)| !is_gbuffer || r["distance"].as_f64() == Some(farthest))
+                .map(|(p, _)| p.clone())
+                .collect();
             let (x_label, y_label) = if is_gbuffer {
                 (
                     "geometry + lighting GPU ms",
@@ -700,7 +736,16 @@ pub fn report_sections(dir: &std::path::Path) -> String {
                 "<h2>Speed against error: <code>{name}</code> (latest <code>harness sweep</code>)</h2>\
                  <p>{y_label} against {x_label}; green: Pareto front, ringed: the default.</p>{}<table>\
                  <tr><th>setting</th><th>{x_label}</th><th>{y_label}</th><th>front</th></tr>",
-                pareto_svg(&name, x_label, &points)
+                pareto_svg(
+                    &if is_gbuffer {
+                        format!("{name} at distance {farthest}")
+                    } else {
+                        name.clone()
+                    },
+                    x_label,
+                    y_label,
+                    &plotted
+                )
             ));
             for (label, cost, error, front, default) in &points {
                 out.push_str(&format!(
@@ -724,8 +769,10 @@ pub struct GbufferSweepRow {
     pub distance: f64,
     /// Median GPU time of the geometry and lighting passes, ms.
     pub gpu_ms: Option<f64>,
-    /// 99th percentile of the light buffer's relative error against the reference (the scene at
-    /// the origin with the default storage), over covered pixels.
+    /// Mean relative error of the light buffer against the reference (the scene at the origin
+    /// with the default storage), over covered pixels.
+    pub mean_relative: f64,
+    /// Its 99th percentile.
     pub p99_relative: f64,
     /// Largest relative error.
     pub max_relative: f64,
@@ -755,12 +802,12 @@ pub fn gbuffer_settings() -> Vec<engine::scene::GbufferSettings> {
 /// no coordinate stays small).
 pub const GBUFFER_DISTANCES: [f64; 3] = [0.0, 1e3, 1e4];
 
-fn relative_errors(reference: &Frame, frame: &Frame) -> (f64, f64) {
+fn relative_errors(reference: &Frame, frame: &Frame) -> (f64, f64, f64) {
     let (Some(a), Some(b)) = (
         reference.output(plan::LIGHT).and_then(|i| i.as_f32()),
         frame.output(plan::LIGHT).and_then(|i| i.as_f32()),
     ) else {
-        return (f64::NAN, f64::NAN);
+        return (f64::NAN, f64::NAN, f64::NAN);
     };
     let mask = reference
         .outputs
@@ -782,12 +829,7 @@ fn relative_errors(reference: &Frame, frame: &Frame) -> (f64, f64) {
             errors.push(f64::from((x - y).abs() / x.abs().max(floor)));
         }
     }
-    errors.sort_by(f64::total_cmp);
-    let p99 = errors
-        .get((errors.len() * 99 / 100).min(errors.len().saturating_sub(1)))
-        .copied()
-        .unwrap_or(0.0);
-    (p99, errors.last().copied().unwrap_or(0.0))
+    stats(errors)
 }
 
 /// Runs the G-buffer sweep on one backend: every position storage and normal encoding, with
@@ -819,7 +861,7 @@ pub fn gbuffer_sweep(
             let frames = (0..repeats.max(1))
                 .map(|_| render(&variant))
                 .collect::<Result<Vec<_>, _>>()?;
-            let (p99, max) = relative_errors(&reference, &frames[0]);
+            let (mean, p99, max) = relative_errors(&reference, &frames[0]);
             let gpu_ms = pass_ms(&frames, "geometry")
                 .zip(pass_ms(&frames, "lighting_"))
                 .map(|(g, l)| g + l);
@@ -827,6 +869,7 @@ pub fn gbuffer_sweep(
                 setting: settings.name(),
                 distance,
                 gpu_ms,
+                mean_relative: mean,
                 p99_relative: p99,
                 max_relative: max,
                 is_default: settings == engine::scene::GbufferSettings::default(),
@@ -847,15 +890,22 @@ pub fn gbuffer_sweep(
 /// The G-buffer sweep as a table.
 pub fn gbuffer_table(rows: &[GbufferSweepRow]) -> String {
     let mut out = format!(
-        "{:<28} {:>9} {:>14} {:>12} {:>12}  {}\n",
-        "storage (position/normal)", "distance", "geom+light ms", "p99 rel", "max rel", "front"
+        "{:<28} {:>9} {:>14} {:>10} {:>10} {:>10}  {}\n",
+        "storage (position/normal)",
+        "distance",
+        "geom+light ms",
+        "mean rel",
+        "p99 rel",
+        "max rel",
+        "front"
     );
     for r in rows {
         out.push_str(&format!(
-            "{:<28} {:>9} {:>14} {:>12.2e} {:>12.2e}  {}{}\n",
+            "{:<28} {:>9} {:>14} {:>10.2e} {:>10.2e} {:>10.2e}  {}{}\n",
             r.setting,
             r.distance,
             r.gpu_ms.map_or("-".to_owned(), |v| format!("{v:.2}")),
+            r.mean_relative,
             r.p99_relative,
             r.max_relative,
             if r.pareto { "*" } else { "" },
