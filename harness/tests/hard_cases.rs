@@ -34,3 +34,34 @@ fn every_hard_scene_file_is_tested() {
     files.sort();
     assert_eq!(files, hard_cases::SCENE_CASES.to_vec());
 }
+
+/// The grazing case really reaches N.V ~ 1e-6 (measured on the read-back G-buffer).
+#[test]
+fn grazing_case_reaches_a_millionth() {
+    let scene = hard_cases::scene("grazing").unwrap();
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        let frame =
+            engine::renderer::render(backend.as_mut(), &scene, engine::renderer::Readback::All)
+                .unwrap();
+        let get = |name: &str| frame.output(name).unwrap();
+        let (p, n) = (
+            get("gbuffer_position").as_f32().unwrap(),
+            get("gbuffer_normal").as_f32().unwrap(),
+        );
+        let mask = get("mask").as_u8().unwrap();
+        let min = (0..p.len() / 4)
+            .filter(|i| mask[i * 4..i * 4 + 4].iter().any(|&m| m > 127))
+            .map(|i| {
+                let position =
+                    glam::DVec3::new(p[i * 4].into(), p[i * 4 + 1].into(), p[i * 4 + 2].into());
+                let normal =
+                    glam::DVec3::new(n[i * 4].into(), n[i * 4 + 1].into(), n[i * 4 + 2].into());
+                normal.normalize().dot(-position.normalize())
+            })
+            .filter(|d| *d > 0.0)
+            .fold(1.0, f64::min);
+        eprintln!("grazing on {kind}: smallest N.V {min:e}");
+        assert!(min < 2e-6, "{kind}: smallest N.V {min}");
+    }
+}
