@@ -52,7 +52,9 @@ struct LightingUniforms {
     lights: array<LightData, 16>,
 }
 
-@group(0) @binding(0) var<uniform> u: LightingUniforms;
+// Read-only storage rather than uniform: Mesa 22.3's lavapipe would otherwise recompile this
+// shader for every draw, specialised on the values that steer its loops and branches.
+@group(0) @binding(0) var<storage, read> u: LightingUniforms;
 @group(0) @binding(1) var gbuffer_position: texture_2d<f32>;
 @group(0) @binding(2) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(3) var gbuffer_tangent: texture_2d<f32>;
@@ -83,7 +85,7 @@ struct ShadowUniforms {
 
 @group(0) @binding(7) var shadow_map: texture_depth_2d;
 @group(0) @binding(8) var shadow_sampler: sampler_comparison;
-@group(0) @binding(9) var<uniform> shadow: ShadowUniforms;
+@group(0) @binding(9) var<storage, read> shadow: ShadowUniforms;
 // Stratified soft shadows: per-pixel jittered sample offsets (unit disk), 32x32 tile, 8 layers;
 // layer 2r + k holds two samples of ring r (ring 3 is the outer one) as (x, y, x, y).
 @group(0) @binding(10) var shadow_jitter: texture_2d_array<f32>;

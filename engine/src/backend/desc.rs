@@ -184,6 +184,9 @@ pub enum BufferUsage {
     Index,
     /// Uniform data (std140 / WGSL uniform layout).
     Uniform,
+    /// Read-only storage data (`var<storage, read>`), for parameters a driver must not
+    /// specialise shaders on (see [`BindingKind::StorageBuffer`]).
+    Storage,
 }
 
 /// Describes a buffer.
@@ -373,6 +376,11 @@ pub enum SamplerBindingKind {
 pub enum BindingKind {
     /// `var<uniform>`.
     UniformBuffer,
+    /// `var<storage, read>`: read-only storage. Used for the lighting pass's parameters: Mesa
+    /// 22.3's lavapipe inlines uniform-buffer values that steer loops and branches, compiling a
+    /// new shader for every draw that binds a new uniform buffer and never freeing the old one
+    /// (~3.7 MiB per frame); it does not look into storage buffers.
+    StorageBuffer,
     /// A sampled texture.
     Texture {
         /// Sample type.

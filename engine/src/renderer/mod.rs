@@ -875,7 +875,12 @@ fn record_and_submit(
     }
 
     let lighting_shader = shader(scope, backend, shaders::LIGHTING)?;
-    let mut lighting_bindings = vec![uniform_layout()];
+    // The lighting pass reads its parameters from read-only storage buffers, not uniform
+    // buffers: see `BindingKind::StorageBuffer` (lavapipe's per-draw shader recompiles).
+    let mut lighting_bindings = vec![BindingLayout {
+        binding: 0,
+        kind: BindingKind::StorageBuffer,
+    }];
     lighting_bindings.extend((1..=6).map(texture_layout));
     lighting_bindings.extend([
         BindingLayout {
@@ -891,7 +896,7 @@ fn record_and_submit(
         },
         BindingLayout {
             binding: 9,
-            kind: BindingKind::UniformBuffer,
+            kind: BindingKind::StorageBuffer,
         },
         BindingLayout {
             binding: 10,
@@ -993,7 +998,7 @@ fn record_and_submit(
     let no_shadow_uniform = scope.buffer(
         backend,
         "no shadow uniforms",
-        BufferUsage::Uniform,
+        BufferUsage::Storage,
         bytemuck::cast_slice(&shadows::shadow_uniforms(None)),
     )?;
     let unshadowed = |lights: Vec<uniforms::LightData>| LightDraw {
@@ -1009,7 +1014,7 @@ fn record_and_submit(
         let uniform = scope.buffer(
             backend,
             &format!("shadow uniforms light {}", view.light),
-            BufferUsage::Uniform,
+            BufferUsage::Storage,
             bytemuck::cast_slice(&shadows::shadow_uniforms(Some(view))),
         )?;
         let moments = plan::shadow_moments_target_name(view.light);
@@ -1067,7 +1072,7 @@ fn record_and_submit(
             let uniform = scope.buffer(
                 backend,
                 &format!("lighting {model} batch {index}"),
-                BufferUsage::Uniform,
+                BufferUsage::Storage,
                 bytemuck::cast_slice(&data),
             )?;
             let bindings = lighting_bind_group(uniform, mask_targets[channel.target], draw);
@@ -1129,7 +1134,7 @@ fn record_and_submit(
             let uniform = scope.buffer(
                 backend,
                 &format!("{name} uniforms"),
-                BufferUsage::Uniform,
+                BufferUsage::Storage,
                 bytemuck::cast_slice(&data),
             )?;
             let bindings = lighting_bind_group(uniform, mask_targets[0], draw);

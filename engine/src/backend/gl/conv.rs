@@ -131,5 +131,6 @@ pub(super) fn buffer_target(u: BufferUsage) -> u32 {
         BufferUsage::Vertex => glow::ARRAY_BUFFER,
         BufferUsage::Index => glow::ELEMENT_ARRAY_BUFFER,
         BufferUsage::Uniform => glow::UNIFORM_BUFFER,
+        BufferUsage::Storage => glow::SHADER_STORAGE_BUFFER,
     }
 }

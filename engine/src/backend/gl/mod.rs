@@ -307,7 +307,11 @@ impl GlBackend {
                     })?;
                 match bound.resource {
                     BindingResource::Buffer(b) => gl.bind_buffer_base(
-                        glow::UNIFORM_BUFFER,
+                        if layout.kind == BindingKind::StorageBuffer {
+                            glow::SHADER_STORAGE_BUFFER
+                        } else {
+                            glow::UNIFORM_BUFFER
+                        },
                         layout.binding,
                         Some(self.buffers.get(b)?.raw),
                     ),

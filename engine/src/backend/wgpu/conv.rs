@@ -73,6 +73,11 @@ pub(super) fn binding_type(kind: BindingKind) -> wgpu::BindingType {
             has_dynamic_offset: false,
             min_binding_size: None,
         },
+        BindingKind::StorageBuffer => wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
         BindingKind::Texture { sample_type, view } => wgpu::BindingType::Texture {
             sample_type: match sample_type {
                 TextureSampleType::Float => wgpu::TextureSampleType::Float { filterable: true },
@@ -146,6 +151,7 @@ pub(super) fn buffer_usage(u: BufferUsage) -> wgpu::BufferUsages {
             BufferUsage::Vertex => wgpu::BufferUsages::VERTEX,
             BufferUsage::Index => wgpu::BufferUsages::INDEX,
             BufferUsage::Uniform => wgpu::BufferUsages::UNIFORM,
+            BufferUsage::Storage => wgpu::BufferUsages::STORAGE,
         }
 }
 
