@@ -187,16 +187,6 @@ pub enum MapsSource {
     Memory,
 }
 
-impl MapsSource {
-    /// Seconds this frame spent on the precompute.
-    pub fn seconds(self) -> f64 {
-        match self {
-            MapsSource::Built { seconds } | MapsSource::Disk { seconds } => seconds,
-            MapsSource::Memory => 0.0,
-        }
-    }
-}
-
 /// The maps for an environment and settings: from this process's memory, else from the disk
 /// cache set with [`cache::set_directory`], else built (and then stored in both). A disk cache
 /// that cannot be written (full disk, read-only folder) is a warning naming the file, not an

@@ -26,7 +26,7 @@ use crate::plan::{self, MaskChannel, PassKind, RenderPlan, MAX_LIGHTS_PER_DRAW};
 use crate::scene::{Light, LightingModel, Scene, ToneMap, Transform};
 use crate::shaders;
 
-pub use uniforms::{ambient_radiance, environment_mean, light_uniforms};
+pub use uniforms::{ambient_radiance, light_uniforms};
 
 /// Why a frame could not be rendered.
 #[derive(Debug, thiserror::Error)]
@@ -99,8 +99,6 @@ pub struct Frame {
     pub outputs: BTreeMap<String, Image>,
     /// GPU time per pass, in plan order.
     pub timings: Vec<PassTiming>,
-    /// Where the IBL maps came from (with an environment only).
-    pub ibl: Option<crate::ibl::MapsSource>,
 }
 
 impl Frame {
@@ -159,7 +157,7 @@ pub fn render_with_faults(
     let ibl_maps = scene
         .environment
         .as_ref()
-        .map(|environment| crate::ibl::prepare(&environment.image, &scene.quality.ibl));
+        .map(|environment| crate::ibl::prepare(&environment.image, &scene.quality.ibl).0);
     let mut scope = ResourceScope::default();
     let result = record_and_submit(
         backend,
@@ -167,7 +165,7 @@ pub fn render_with_faults(
         &plan,
         &wanted,
         faults,
-        ibl_maps.as_ref().map(|(maps, _)| maps.as_ref()),
+        ibl_maps.as_deref(),
         &mut scope,
     );
     scope.destroy(backend);
@@ -182,7 +180,6 @@ pub fn render_with_faults(
         plan,
         outputs,
         timings,
-        ibl: ibl_maps.map(|(_, source)| source),
     })
 }
 

@@ -7,8 +7,7 @@ use glam::{DVec3, Mat4};
 use super::{object_matrices, CameraMatrices, Faults};
 use crate::plan::{MaskChannel, MAX_LIGHTS_PER_DRAW};
 use crate::scene::{
-    EnvironmentImage, GbufferSettings, Light, NormalEncoding, Object, PositionStorage, Scene,
-    Transform,
+    GbufferSettings, Light, NormalEncoding, Object, PositionStorage, Scene, Transform,
 };
 
 /// `LightData` in `lighting.wgsl`.
@@ -205,26 +204,4 @@ pub(super) fn skybox_uniforms(scene: &Scene, camera: &CameraMatrices) -> Vec<f32
 /// An environment lights the scene through the IBL maps instead.
 pub fn ambient_radiance(scene: &Scene) -> [f32; 3] {
     scene.ambient
-}
-
-/// Solid-angle-weighted mean of an equirectangular image (rows weighted by sin(latitude angle)).
-pub fn environment_mean(image: &EnvironmentImage) -> [f64; 3] {
-    let (w, h) = (image.width as usize, image.height as usize);
-    let mut sum = [0.0f64; 3];
-    let mut weight = 0.0;
-    for (y, row) in image.texels.chunks_exact(w.max(1)).take(h).enumerate() {
-        let theta = std::f64::consts::PI * (y as f64 + 0.5) / h as f64;
-        let row_weight = theta.sin();
-        for texel in row {
-            for c in 0..3 {
-                sum[c] += f64::from(texel[c]) * row_weight;
-            }
-        }
-        weight += row_weight * w as f64;
-    }
-    if weight > 0.0 {
-        sum.map(|s| s / weight)
-    } else {
-        [0.0; 3]
-    }
 }
