@@ -378,19 +378,26 @@ pub fn reference_pixels(
     Ok(results)
 }
 
-/// Relative error (r + g + b) of the light buffer at every reference pixel.
-pub fn pixel_errors(frame: &Frame, references: &[PixelReference]) -> Vec<f64> {
-    let light = frame
+fn light_buffer(frame: &Frame) -> &[f32] {
+    frame
         .output(plan::LIGHT)
         .and_then(|i| i.as_f32())
-        .unwrap_or(&[]);
+        .unwrap_or(&[])
+}
+
+/// Relative error (r + g + b) of the light buffer at one reference pixel.
+fn pixel_error(light: &[f32], r: &PixelReference) -> Option<f64> {
+    let g = light.get(r.index * 4..r.index * 4 + 3)?;
+    let expected = r.radiance.element_sum();
+    Some((f64::from(g[0] + g[1] + g[2]) - expected).abs() / expected.max(1e-6))
+}
+
+/// Relative error (r + g + b) of the light buffer at every reference pixel.
+pub fn pixel_errors(frame: &Frame, references: &[PixelReference]) -> Vec<f64> {
+    let light = light_buffer(frame);
     references
         .iter()
-        .filter_map(|r| {
-            let g = light.get(r.index * 4..r.index * 4 + 3)?;
-            let expected = r.radiance.element_sum();
-            Some((f64::from(g[0] + g[1] + g[2]) - expected).abs() / expected.max(1e-6))
-        })
+        .filter_map(|r| pixel_error(light, r))
         .collect()
 }
 
@@ -413,19 +420,13 @@ pub struct RoughnessError {
 
 /// Per-roughness error of `frame`'s light buffer against `references`.
 pub fn error_by_roughness(frame: &Frame, references: &[PixelReference]) -> Vec<RoughnessError> {
-    let light = frame
-        .output(plan::LIGHT)
-        .and_then(|i| i.as_f32())
-        .unwrap_or(&[]);
+    let light = light_buffer(frame);
     let mut groups: std::collections::BTreeMap<i64, Vec<(f64, f64)>> = Default::default();
     for r in references {
-        let Some(g) = light.get(r.index * 4..r.index * 4 + 3) else {
+        let Some(error) = pixel_error(light, r) else {
             continue;
         };
-        let gpu = f64::from(g[0] + g[1] + g[2]);
-        let expected = r.radiance.element_sum();
-        let error = (gpu - expected).abs() / expected.max(1e-6);
-        let noise = r.standard_error.element_sum() / expected.max(1e-6);
+        let noise = r.standard_error.element_sum() / r.radiance.element_sum().max(1e-6);
         groups
             .entry((r.surface.roughness * 10.0).round() as i64)
             .or_default()
@@ -469,17 +470,12 @@ pub fn material_family(s: &Surface) -> &'static str {
 /// Mean relative error (r + g + b) per material family and roughness (rounded to 0.1), as
 /// rows of a table: family, then (roughness, mean error, pixels) per column.
 pub fn error_by_family(frame: &Frame, references: &[PixelReference]) -> Vec<FamilyRow> {
-    let light = frame
-        .output(plan::LIGHT)
-        .and_then(|i| i.as_f32())
-        .unwrap_or(&[]);
+    let light = light_buffer(frame);
     let mut groups: std::collections::BTreeMap<(&str, i64), Vec<f64>> = Default::default();
     for r in references {
-        let Some(g) = light.get(r.index * 4..r.index * 4 + 3) else {
+        let Some(error) = pixel_error(light, r) else {
             continue;
         };
-        let expected = r.radiance.element_sum();
-        let error = (f64::from(g[0] + g[1] + g[2]) - expected).abs() / expected.max(1e-6);
         groups
             .entry((
                 material_family(&r.surface),

@@ -146,29 +146,43 @@ pub fn material_grid(size: u32) -> Scene {
     scene
 }
 
+/// A unit sphere at the origin seen from 3 units away, alone, clamp tone mapping: the furnaces.
+fn lone_sphere(
+    name: &str,
+    size: u32,
+    mesh: MeshData,
+    material: Material,
+    lighting: LightingModel,
+) -> Scene {
+    let mut scene = empty_scene(name, size, camera(DVec3::new(0.0, 0.0, 3.0), DVec3::ZERO));
+    scene.objects.push(sphere_at(
+        "sphere".to_owned(),
+        &Arc::new(mesh),
+        DVec3::ZERO,
+        1.0,
+        material,
+        lighting,
+    ));
+    scene.quality.tone_map = ToneMap::Clamp;
+    scene
+}
+
 /// A white Lambert sphere under uniform unit ambient radiance and nothing else: every lit pixel
 /// of the light buffer must equal the albedo (the white furnace).
 pub fn white_furnace(size: u32, albedo: f32) -> Scene {
-    let mesh = Arc::new(mesh::uv_sphere(48, 24));
-    let mut scene = empty_scene(
+    let material = Material {
+        base_color: [albedo; 3],
+        specular: 0.0,
+        ..Material::default()
+    };
+    let mut scene = lone_sphere(
         "white_furnace",
         size,
-        camera(DVec3::new(0.0, 0.0, 3.0), DVec3::ZERO),
-    );
-    scene.objects.push(sphere_at(
-        "sphere".to_owned(),
-        &mesh,
-        DVec3::ZERO,
-        1.0,
-        Material {
-            base_color: [albedo; 3],
-            specular: 0.0,
-            ..Material::default()
-        },
+        mesh::uv_sphere(48, 24),
+        material,
         LightingModel::Pbr,
-    ));
+    );
     scene.ambient = [1.0; 3];
-    scene.quality.tone_map = ToneMap::Clamp;
     scene
 }
 
@@ -259,20 +273,13 @@ pub fn many_point_lights(size: u32, count: usize) -> Scene {
 /// A sphere under a uniform environment of radiance 1 and nothing else (the IBL white
 /// furnace), with the given material and lighting model.
 pub fn ibl_furnace(size: u32, material: Material, lighting: LightingModel) -> Scene {
-    let mesh = Arc::new(mesh::uv_sphere(64, 32));
-    let mut scene = empty_scene(
+    let mut scene = lone_sphere(
         "ibl_furnace",
         size,
-        camera(DVec3::new(0.0, 0.0, 3.0), DVec3::ZERO),
-    );
-    scene.objects.push(sphere_at(
-        "sphere".to_owned(),
-        &mesh,
-        DVec3::ZERO,
-        1.0,
+        mesh::uv_sphere(64, 32),
         material,
         lighting,
-    ));
+    );
     scene.environment = Some(Environment {
         image: Arc::new(EnvironmentImage {
             label: "uniform radiance 1".to_owned(),
@@ -283,6 +290,5 @@ pub fn ibl_furnace(size: u32, material: Material, lighting: LightingModel) -> Sc
         rotation_degrees: 0.0,
         intensity: 1.0,
     });
-    scene.quality.tone_map = ToneMap::Clamp;
     scene
 }
