@@ -5,6 +5,9 @@
 struct ToneMapUniforms {
     // x = operator.
     tone_operator: vec4<u32>,
+    // x = scale applied to the light buffer before the curve: 1, except when the mutation
+    // self-test injects a tone-mapping fault (engine::renderer::Faults).
+    input_scale: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> u: ToneMapUniforms;
@@ -22,7 +25,7 @@ fn aces(x: vec3<f32>) -> vec3<f32> {
 
 @fragment
 fn fs_tonemap(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let hdr = max(textureLoad(light_buffer, vec2<i32>(frag.xy), 0).rgb, vec3<f32>(0.0));
+    let hdr = max(textureLoad(light_buffer, vec2<i32>(frag.xy), 0).rgb * u.input_scale.x, vec3<f32>(0.0));
     var ldr: vec3<f32>;
     switch u.tone_operator.x {
         case 0u: { ldr = aces(hdr); }

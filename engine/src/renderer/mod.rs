@@ -110,10 +110,13 @@ impl Frame {
 
 /// Deliberate faults, for the harness's mutation self-test (proof that the golden tolerances
 /// catch a broken pass). All off by default; [`render`] never sets them.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Faults {
     /// The geometry pass writes albedo with red and blue swapped.
     pub swap_albedo_red_blue: bool,
+    /// The tone-mapping pass scales the light buffer by this before its curve (a fault in the
+    /// last pass only: the light buffer stays as it was).
+    pub tonemap_input_scale: Option<f32>,
 }
 
 /// Renders `scene` and reads back the requested outputs. Everything created is destroyed before
@@ -1163,11 +1166,12 @@ fn record_and_submit(
         ToneMap::Reinhard => 1,
         ToneMap::Clamp => 2,
     };
+    let input_scale = faults.tonemap_input_scale.unwrap_or(1.0);
     let tonemap_uniform = scope.buffer(
         backend,
         "tonemap uniforms",
         BufferUsage::Uniform,
-        bytemuck::cast_slice(&[operator, 0, 0, 0]),
+        bytemuck::cast_slice(&[operator, 0, 0, 0, input_scale.to_bits(), 0, 0, 0]),
     )?;
     passes.push(RenderPass {
         name: "tonemap".to_owned(),
