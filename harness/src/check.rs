@@ -9,10 +9,11 @@ use engine::renderer::Frame;
 use engine::Image;
 
 use crate::golden::{self, GoldenStore};
+use crate::metrics::Channels;
 use crate::suite::{self, Case, PassCheck};
 
 /// A backend's status in a check run.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct BackendRun {
     /// Backend name.
     pub backend: String,
@@ -23,7 +24,7 @@ pub struct BackendRun {
 }
 
 /// The largest disagreement between two backends on one pass.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct CrossBackend {
     /// Scene.
     pub scene: String,
@@ -34,15 +35,17 @@ pub struct CrossBackend {
     /// Second backend.
     pub b: String,
     /// Largest channel difference (8-bit in 0..1 units).
+    #[serde(deserialize_with = "crate::tolerance::null_as_infinity")]
     pub max_abs: f64,
-    /// Fraction of pixels differing by more than 2/255 (8-bit) or 1e-3 relative (float).
+    /// Fraction of pixels differing by more than 2/255 (8-bit) or 1e-3 relative (float, above an
+    /// absolute floor of 1e-3).
     pub fraction_over: f64,
     /// Whether the pair is within the pass's tolerance (one backend taken as the golden).
     pub within_tolerance: bool,
 }
 
 /// GPU time of one pass.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Timing {
     /// Scene.
     pub scene: String,
@@ -55,7 +58,7 @@ pub struct Timing {
 }
 
 /// Everything a check run found.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct CheckRun {
     /// Backends, available or not.
     pub backends: Vec<BackendRun>,
@@ -67,6 +70,10 @@ pub struct CheckRun {
     pub cross: Vec<CrossBackend>,
     /// GPU timings.
     pub timings: Vec<Timing>,
+    /// Information, not failures: where this run's drivers differ from the ones the goldens
+    /// were blessed with.
+    #[serde(default)]
+    pub driver_notes: Vec<String>,
 }
 
 impl CheckRun {
@@ -76,27 +83,63 @@ impl CheckRun {
     }
 }
 
+/// Where the backends of this run differ from the drivers the goldens were blessed with (from
+/// each scene's blessed.toml): information, since the noise model's tolerances are there to
+/// absorb such differences.
+pub fn driver_notes(cases: &[Case], store: &GoldenStore, backends: &[BackendRun]) -> Vec<String> {
+    // (backend, blessed driver) -> scenes.
+    let mut blessed: BTreeMap<(String, String), Vec<String>> = BTreeMap::new();
+    for case in cases {
+        for record in store.records(case.name()).unwrap_or_default().into_values() {
+            let scenes = blessed.entry((record.backend, record.driver)).or_default();
+            if !scenes.iter().any(|s| s == case.name()) {
+                scenes.push(case.name().to_owned());
+            }
+        }
+    }
+    let mut notes = Vec::new();
+    for ((backend, driver), scenes) in blessed {
+        let Some(current) = backends
+            .iter()
+            .find(|b| b.backend == backend)
+            .and_then(|b| b.fingerprint.as_ref())
+        else {
+            continue;
+        };
+        if *current != driver {
+            notes.push(format!(
+                "goldens of {} were blessed on {backend} with `{driver}`; {backend} here is \
+                 `{current}`: differences within the noise model (golden/noise.toml) are \
+                 expected, and are not failures",
+                scenes.join(", ")
+            ));
+        }
+    }
+    notes
+}
+
 /// Compares two backends' outputs of one pass.
 pub fn cross_compare(case: &Case, pass: &str, a: &Image, b: &Image) -> Option<(f64, f64, bool)> {
     let pair = crate::metrics::Pair::new(a, b).ok()?;
     let fraction = if golden::is_eight_bit(a) {
-        pair.fraction_over(2.0 / 255.0, 0)
+        pair.fraction_over(2.0 / 255.0, 0, None, Channels::All)
     } else {
-        let errors = pair.relative_errors(1e-3);
-        errors.iter().filter(|&&e| e > 1e-3).count() as f64 / errors.len().max(1) as f64
+        pair.fraction_over(1e-3, 0, Some(1e-3), Channels::All)
     };
     let within = golden::check(a, Some(b), &case.rules[pass]).passed();
-    Some((pair.max_abs(0), fraction, within))
+    Some((pair.max_abs(0, Channels::All), fraction, within))
 }
 
-/// Runs the check. `progress` is called before each render with (done, total, what). Returns
-/// the run and every golden pass output, for the report.
+/// Runs the check on the backends in `only` (every one when empty; an unavailable one is
+/// reported as such). `progress` is called before each render with (done, total, what).
+/// Returns the run and every golden pass output, for the report.
 pub fn run(
     cases: &[Case],
     store: &GoldenStore,
+    only: &[BackendKind],
     progress: impl FnMut(usize, usize, &str),
 ) -> (CheckRun, crate::report::Outputs) {
-    run_with(cases, store, &|kind| backend::create(kind), progress)
+    run_with(cases, store, only, &|kind| backend::create(kind), progress)
 }
 
 /// Creates the backend for one render of [`run_with`].
@@ -108,6 +151,7 @@ pub type BackendFactory<'a> =
 pub fn run_with(
     cases: &[Case],
     store: &GoldenStore,
+    only: &[BackendKind],
     create: &BackendFactory<'_>,
     mut progress: impl FnMut(usize, usize, &str),
 ) -> (CheckRun, crate::report::Outputs) {
@@ -115,6 +159,9 @@ pub fn run_with(
     let mut backends = Vec::new();
     let mut available = Vec::new();
     for kind in BackendKind::ALL {
+        if !only.is_empty() && !only.contains(&kind) {
+            continue;
+        }
         let status = backend::probe(kind);
         if status.available {
             available.push(kind);
@@ -209,8 +256,10 @@ pub fn run_with(
         }
     }
     progress(done, total, "done");
+    let driver_notes = driver_notes(cases, store, &backends);
     (
         CheckRun {
+            driver_notes,
             backends,
             results,
             render_errors,

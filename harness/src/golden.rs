@@ -17,17 +17,6 @@ use engine::{Image, ImageData};
 use crate::images::{self, ImageFileError};
 use crate::tolerance::{Rule, Verdict};
 
-/// Pass outputs that get goldens, when the scene's plan has them.
-pub const GOLDEN_PASSES: [&str; 7] = [
-    "gbuffer_normal",
-    "gbuffer_albedo",
-    "depth",
-    "mask",
-    "mask_1",
-    "light",
-    "final",
-];
-
 /// Why a golden operation failed.
 #[derive(Debug, thiserror::Error)]
 pub enum GoldenError {
@@ -220,7 +209,7 @@ impl GoldenStore {
 }
 
 /// Outcome of checking one pass output against its golden.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub enum Outcome {
     /// Within tolerance.
     Passed(Verdict),
@@ -255,11 +244,11 @@ pub fn check(actual: &Image, golden: Option<&Image>, rule: &Rule) -> Outcome {
 /// intensity, on a black-red-yellow-white ramp (RGBA8).
 pub fn diff_heatmap(actual: &Image, golden: &Image, scale: f64) -> Option<Image> {
     let pair = crate::metrics::Pair::new(actual, golden).ok()?;
-    let differences = pair.pixel_differences(0);
+    let differences = pair.pixel_differences();
     let mut data = Vec::with_capacity(differences.len() * 4);
     for d in differences {
         let t = if d.is_finite() {
-            (f64::from(d) / scale.max(1e-12)).clamp(0.0, 1.0)
+            (d / scale.max(1e-12)).clamp(0.0, 1.0)
         } else {
             1.0
         };

@@ -11,6 +11,7 @@ pub mod ibl_reference;
 pub mod images;
 pub mod inspect;
 pub mod metrics;
+pub mod noise;
 pub mod reference;
 pub mod report;
 pub mod selftest;

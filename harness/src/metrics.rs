@@ -1,13 +1,20 @@
-//! Image-difference metrics, written once and used by tolerances, the report and bless.
+//! Image-difference metrics, written once and used by tolerances, the noise model, the report
+//! and bless.
 //!
 //! Every metric compares an `actual` image with a `golden` (expected) one of the same size and
 //! channel count. 8-bit images are compared in 0..1 units (1/255 per step); float images in their
 //! own units. Each metric is tested on synthetic images with known answers.
 //!
+//! - a per-value *error* is the absolute difference `|a - g|`, or, given an absolute `floor` (in
+//!   the image's units), the relative difference `|a - g| / max(|g|, floor)`: relative where the
+//!   golden is bright, absolute (scaled by `1 / floor`) where it is darker than the floor. The
+//!   floor is a fixed level, not a fraction of the image's maximum, so a sun in the frame does
+//!   not make every other pixel's error vanish;
+//! - [`Channels`] picks the channels compared: `rgb` (the first three) or `all`;
 //! - `max_abs`: largest per-channel absolute difference (per channel and overall).
-//! - `fraction_over(t)`: fraction of pixels with some channel differing by more than `t`.
+//! - `fraction_over(t)`: fraction of pixels whose largest channel error is over `t`.
 //! - `rmse` and `psnr` (peak 1 for 8-bit images, the golden's largest value for float images).
-//! - `relative`: `|a - g| / max(|g|, 1e-3 * max(g))` per channel; its percentile and maximum.
+//! - `relative`: a percentile of the per-value relative error (RGB by default).
 //! - `flip_mean` / `flip_percentile`: NVIDIA FLIP (LDR) via `nv-flip`, for sRGB 8-bit images.
 //! - a shift radius `r` makes `max_abs` and `fraction_over` forgiving of edge jitter: each actual
 //!   pixel is compared with the best-matching golden pixel within `r` pixels.
@@ -15,6 +22,49 @@
 //! Non-finite values are counted separately and always fail (see [`crate::tolerance`]).
 
 use engine::{Image, ImageData};
+
+/// Which channels a metric compares.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Channels {
+    /// Every channel of the image.
+    #[default]
+    All,
+    /// The first three (color without alpha; all of a one- or two-channel image).
+    Rgb,
+}
+
+impl Channels {
+    /// How many leading channels of a `channels`-channel image are compared.
+    pub fn count(self, channels: usize) -> usize {
+        match self {
+            Channels::All => channels,
+            Channels::Rgb => channels.min(3),
+        }
+    }
+
+    /// The name used in tolerance tables (`rgb`, `all`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Channels::All => "all",
+            Channels::Rgb => "rgb",
+        }
+    }
+}
+
+/// The error of one value against its golden: absolute, or relative above an absolute floor.
+fn value_error(actual: f32, golden: f32, floor: Option<f64>) -> f64 {
+    let (a, g) = (f64::from(actual), f64::from(golden));
+    let e = match floor {
+        None => (a - g).abs(),
+        Some(floor) => (a - g).abs() / g.abs().max(floor).max(f64::MIN_POSITIVE),
+    };
+    if e.is_nan() {
+        f64::INFINITY
+    } else {
+        e
+    }
+}
 
 /// Why two images cannot be compared.
 #[derive(Debug, thiserror::Error)]
@@ -92,16 +142,18 @@ impl Pair {
         self.actual.iter().filter(|v| !v.is_finite()).count()
     }
 
-    /// Per-pixel largest channel difference, comparing each actual pixel with the closest golden
-    /// pixel within `shift` pixels (0: the same pixel).
-    pub fn pixel_differences(&self, shift: u32) -> Vec<f32> {
+    /// Per-pixel largest channel error (absolute, or relative above `floor`; see the module
+    /// docs) over `channels`, comparing each actual pixel with the closest golden pixel within
+    /// `shift` pixels (0: the same pixel).
+    pub fn pixel_errors(&self, shift: u32, floor: Option<f64>, channels: Channels) -> Vec<f64> {
         let c = self.channels;
+        let used = channels.count(c);
         let r = shift as isize;
         let mut out = Vec::with_capacity(self.pixels());
         for y in 0..self.height {
             for x in 0..self.width {
-                let a = &self.actual[(y * self.width + x) * c..][..c];
-                let mut best = f32::INFINITY;
+                let a = &self.actual[(y * self.width + x) * c..][..used];
+                let mut best = f64::INFINITY;
                 for dy in -r..=r {
                     for dx in -r..=r {
                         let (gx, gy) = (x as isize + dx, y as isize + dy);
@@ -112,22 +164,26 @@ impl Pair {
                         {
                             continue;
                         }
-                        let g = &self.golden[(gy as usize * self.width + gx as usize) * c..][..c];
-                        let d = a
+                        let g =
+                            &self.golden[(gy as usize * self.width + gx as usize) * c..][..used];
+                        let e = a
                             .iter()
                             .zip(g)
-                            .map(|(a, g)| (a - g).abs())
-                            .fold(
-                                0.0f32,
-                                |m, d| if d.is_nan() { f32::INFINITY } else { m.max(d) },
-                            );
-                        best = best.min(d);
+                            .map(|(&a, &g)| value_error(a, g, floor))
+                            .fold(0.0f64, f64::max);
+                        best = best.min(e);
                     }
                 }
                 out.push(best);
             }
         }
         out
+    }
+
+    /// Per-pixel largest absolute channel difference over every channel, no shift (for diff
+    /// images).
+    pub fn pixel_differences(&self) -> Vec<f64> {
+        self.pixel_errors(0, None, Channels::All)
     }
 
     /// Largest absolute difference per channel (no shift).
@@ -145,19 +201,26 @@ impl Pair {
         max
     }
 
-    /// Largest absolute difference over all channels, with a shift radius.
-    pub fn max_abs(&self, shift: u32) -> f64 {
-        self.pixel_differences(shift)
+    /// Largest absolute difference over `channels`, with a shift radius.
+    pub fn max_abs(&self, shift: u32, channels: Channels) -> f64 {
+        self.pixel_errors(shift, None, channels)
             .into_iter()
-            .fold(0.0f64, |m, d| m.max(f64::from(d)))
+            .fold(0.0f64, f64::max)
     }
 
-    /// Fraction of pixels with a channel differing by more than `threshold`, with a shift radius.
-    pub fn fraction_over(&self, threshold: f64, shift: u32) -> f64 {
+    /// Fraction of pixels whose largest error over `channels` (absolute, or relative above
+    /// `floor`) is more than `threshold`, with a shift radius.
+    pub fn fraction_over(
+        &self,
+        threshold: f64,
+        shift: u32,
+        floor: Option<f64>,
+        channels: Channels,
+    ) -> f64 {
         let over = self
-            .pixel_differences(shift)
+            .pixel_errors(shift, floor, channels)
             .into_iter()
-            .filter(|&d| f64::from(d) > threshold)
+            .filter(|&e| e > threshold)
             .count();
         over as f64 / self.pixels().max(1) as f64
     }
@@ -192,35 +255,30 @@ impl Pair {
         }
     }
 
-    /// Relative error per channel, `|a - g| / max(|g|, floor * max|g|)`, sorted ascending.
-    pub fn relative_errors(&self, floor: f64) -> Vec<f64> {
-        let golden_max = self
-            .golden
-            .iter()
-            .filter(|v| v.is_finite())
-            .fold(0.0f64, |m, &v| m.max(f64::from(v).abs()));
-        let denominator_floor = (floor * golden_max).max(f64::MIN_POSITIVE);
+    /// Relative error of every value of `channels`, `|a - g| / max(|g|, floor)` with `floor`
+    /// absolute (in the image's units), sorted ascending.
+    pub fn relative_errors(&self, floor: f64, channels: Channels) -> Vec<f64> {
+        let c = self.channels;
+        let used = channels.count(c);
         let mut errors: Vec<f64> = self
             .actual
-            .iter()
-            .zip(&self.golden)
-            .map(|(&a, &g)| {
-                let (a, g) = (f64::from(a), f64::from(g));
-                let e = (a - g).abs() / g.abs().max(denominator_floor);
-                if e.is_nan() {
-                    f64::INFINITY
-                } else {
-                    e
-                }
+            .chunks_exact(c)
+            .zip(self.golden.chunks_exact(c))
+            .flat_map(|(a, g)| {
+                a[..used]
+                    .iter()
+                    .zip(&g[..used])
+                    .map(|(&a, &g)| value_error(a, g, Some(floor)))
             })
             .collect();
         errors.sort_by(f64::total_cmp);
         errors
     }
 
-    /// The `percentile` (0..1) of the relative error.
-    pub fn relative_percentile(&self, percentile: f64, floor: f64) -> f64 {
-        percentile_of_sorted(&self.relative_errors(floor), percentile)
+    /// The `percentile` (0..1) of the relative error over `channels` (see
+    /// [`Pair::relative_errors`]).
+    pub fn relative_percentile(&self, percentile: f64, floor: f64, channels: Channels) -> f64 {
+        percentile_of_sorted(&self.relative_errors(floor, channels), percentile)
     }
 
     /// FLIP error map of two 8-bit images (values 0..1 per pixel).
@@ -292,8 +350,8 @@ mod tests {
     fn identical_images_have_zero_error() {
         let a = u8_image(8, 8, |x, y| [x as u8 * 30, y as u8 * 30, 7, 255]);
         let pair = Pair::new(&a, &a).unwrap();
-        assert_eq!(pair.max_abs(0), 0.0);
-        assert_eq!(pair.fraction_over(0.0, 0), 0.0);
+        assert_eq!(pair.max_abs(0, Channels::All), 0.0);
+        assert_eq!(pair.fraction_over(0.0, 0, None, Channels::All), 0.0);
         assert_eq!(pair.rmse(), 0.0);
         assert!(pair.psnr().is_infinite());
         let map = Pair::flip_map(&a, &a).unwrap();
@@ -308,10 +366,10 @@ mod tests {
             [if x == 3 { 151 } else { 100 }, 100, 100, 255]
         });
         let pair = Pair::new(&actual, &golden).unwrap();
-        assert!((pair.max_abs(0) - 0.2).abs() < 1e-6);
+        assert!((pair.max_abs(0, Channels::All) - 0.2).abs() < 1e-6);
         assert_eq!(pair.max_abs_per_channel()[1], 0.0);
-        assert!((pair.fraction_over(0.1, 0) - 0.1).abs() < 1e-12);
-        assert_eq!(pair.fraction_over(0.25, 0), 0.0);
+        assert!((pair.fraction_over(0.1, 0, None, Channels::All) - 0.1).abs() < 1e-12);
+        assert_eq!(pair.fraction_over(0.25, 0, None, Channels::All), 0.0);
         // RMSE: 10 of 400 values off by 0.2 -> sqrt(10 * 0.04 / 400) = sqrt(0.001).
         assert!((pair.rmse() - 0.001f64.sqrt()).abs() < 1e-6);
         assert!((pair.psnr() - 30.0).abs() < 1e-3);
@@ -322,21 +380,55 @@ mod tests {
         let golden = u8_image(16, 4, |x, _| if x < 8 { [0; 4] } else { [255; 4] });
         let actual = u8_image(16, 4, |x, _| if x < 9 { [0; 4] } else { [255; 4] });
         let pair = Pair::new(&actual, &golden).unwrap();
-        assert!((pair.fraction_over(0.5, 0) - 4.0 / 64.0).abs() < 1e-12);
-        assert_eq!(pair.fraction_over(0.5, 1), 0.0);
-        assert_eq!(pair.max_abs(1), 0.0);
+        assert!((pair.fraction_over(0.5, 0, None, Channels::All) - 4.0 / 64.0).abs() < 1e-12);
+        assert_eq!(pair.fraction_over(0.5, 1, None, Channels::All), 0.0);
+        assert_eq!(pair.max_abs(1, Channels::All), 0.0);
     }
 
     #[test]
-    fn relative_error_uses_the_floor_for_dark_pixels() {
+    fn relative_error_uses_an_absolute_floor_for_dark_pixels() {
         let golden = f32_image(2, 1, |x, _| if x == 0 { [100.0; 4] } else { [0.0; 4] });
         let actual = f32_image(2, 1, |x, _| if x == 0 { [101.0; 4] } else { [0.05; 4] });
         let pair = Pair::new(&actual, &golden).unwrap();
-        let errors = pair.relative_errors(1e-3);
-        // Bright pixel: 1/100; dark pixel: 0.05 / (1e-3 * 100) = 0.5.
+        // RGB only: 6 values. Bright pixel: 1/100; dark pixel: 0.05 / floor 0.1 = 0.5, however
+        // bright the rest of the image is.
+        let errors = pair.relative_errors(0.1, Channels::Rgb);
+        assert_eq!(errors.len(), 6);
         assert!((errors[0] - 0.01).abs() < 1e-9);
-        assert!((errors[7] - 0.5).abs() < 1e-6);
-        assert!((pair.relative_percentile(0.5, 1e-3) - 0.01).abs() < 1e-9);
+        assert!((errors[5] - 0.5).abs() < 1e-6);
+        assert!((pair.relative_percentile(0.5, 0.1, Channels::Rgb) - 0.01).abs() < 1e-9);
+        // A sun 1000x brighter elsewhere does not change the dark pixel's error.
+        let sunny = f32_image(3, 1, |x, _| match x {
+            0 => [100.0; 4],
+            1 => [0.0; 4],
+            _ => [1e5; 4],
+        });
+        let sunny_actual = f32_image(3, 1, |x, _| match x {
+            0 => [101.0; 4],
+            1 => [0.05; 4],
+            _ => [1e5; 4],
+        });
+        let pair = Pair::new(&sunny_actual, &sunny).unwrap();
+        assert!((pair.relative_percentile(1.0, 0.1, Channels::Rgb) - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn channels_and_relative_fraction_over() {
+        // Alpha differs everywhere, RGB on one pixel of four by 2% relative.
+        let golden = f32_image(4, 1, |_, _| [2.0, 2.0, 2.0, 1.0]);
+        let actual = f32_image(4, 1, |x, _| {
+            let v = if x == 0 { 2.04 } else { 2.0 };
+            [v, 2.0, 2.0, 2.0]
+        });
+        let pair = Pair::new(&actual, &golden).unwrap();
+        assert_eq!(pair.fraction_over(0.5, 0, None, Channels::All), 1.0);
+        assert_eq!(pair.fraction_over(0.5, 0, None, Channels::Rgb), 0.0);
+        // Relative above a floor of 1: 0.04 / 2 = 2%.
+        assert_eq!(pair.fraction_over(0.01, 0, Some(1.0), Channels::Rgb), 0.25);
+        assert_eq!(pair.fraction_over(0.03, 0, Some(1.0), Channels::Rgb), 0.0);
+        // Below the floor the error is absolute / floor: 0.04 / 4 = 1%.
+        assert_eq!(pair.fraction_over(0.011, 0, Some(4.0), Channels::Rgb), 0.0);
+        assert!((pair.max_abs(0, Channels::Rgb) - 0.04).abs() < 1e-6);
     }
 
     #[test]
@@ -351,8 +443,10 @@ mod tests {
         });
         let pair = Pair::new(&actual, &golden).unwrap();
         assert_eq!(pair.non_finite(), 1);
-        assert!(pair.max_abs(0).is_infinite());
-        assert!(pair.relative_percentile(1.0, 1e-3).is_infinite());
+        assert!(pair.max_abs(0, Channels::All).is_infinite());
+        assert!(pair
+            .relative_percentile(1.0, 1e-3, Channels::Rgb)
+            .is_infinite());
     }
 
     #[test]

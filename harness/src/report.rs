@@ -131,7 +131,7 @@ pub fn html(
 body{{font-family:system-ui,sans-serif;margin:1.5em;background:#fafafa;color:#222}}
 h1 .fail{{color:#b00}} h1 .pass{{color:#070}}
 table{{border-collapse:collapse;margin:0.5em 0 1.5em}} td,th{{border:1px solid #ccc;padding:2px 8px;font-size:13px;text-align:left}}
-.passed{{background:#e8f6e8}} .failed{{background:#fbe3e3}}
+.passed{{background:#e8f6e8}} .failed{{background:#fbe3e3}} .note{{background:#eef3fb}}
 .pass-block{{border:1px solid #ddd;background:#fff;margin:1em 0;padding:0.5em 1em}}
 figure{{display:inline-block;margin:4px;text-align:center;vertical-align:top}} figure img{{image-rendering:pixelated;border:1px solid #999;max-width:256px}}
 figure.missing div{{width:128px;height:128px;border:1px dashed #999;line-height:128px;color:#999}}
@@ -166,6 +166,9 @@ figcaption{{font-size:12px}} code{{font-size:12px}}
         );
     }
     out.push_str("</table>");
+    for note in &run.driver_notes {
+        let _ = write!(out, "<p class=\"note\">Note: {}</p>", escape(note));
+    }
     for (scene, backend, error) in &run.render_errors {
         let _ = write!(
             out,

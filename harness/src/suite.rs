@@ -5,14 +5,17 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use engine::backend::TextureFormat;
 use engine::backend::{self, BackendKind};
-use engine::plan::RenderPlan;
+use engine::plan::{self, RenderPlan, TargetSpec};
 use engine::renderer::{self, Frame, Readback};
 use engine::scene_file::LoadedScene;
 use engine::Image;
 
-use crate::golden::{self, GoldenStore, Outcome, GOLDEN_PASSES};
+use crate::golden::{self, GoldenStore, Outcome};
 use crate::images;
+use crate::metrics::Channels;
+use crate::noise::{NoiseError, NoiseModel};
 use crate::tolerance::{Metric, Rule, RuleError};
 
 /// The backend goldens are blessed from by default (the others are checked against them).
@@ -24,6 +27,9 @@ pub enum SuiteError {
     /// A scene failed to load.
     #[error(transparent)]
     Scene(#[from] engine::scene_file::SceneFileError),
+    /// The noise model (golden/noise.toml) cannot be read.
+    #[error(transparent)]
+    Noise(#[from] NoiseError),
     /// A tolerance in a scene file is malformed.
     #[error("{path}: [tolerances]: {source}")]
     Tolerance {
@@ -46,28 +52,134 @@ pub enum SuiteError {
     },
 }
 
+/// What a golden pass holds, which decides the shape of its rule.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
+pub enum PassKind {
+    /// A G-buffer target (RGBA16F): positions, normals, tangents, albedo, material.
+    GBuffer,
+    /// Depth: the camera's (`depth`) or a light's shadow map (`shadow_<light>`), D32F.
+    Depth,
+    /// The lighting-model mask (RGBA8, one-hot).
+    Mask,
+    /// A shadowed light's visibility per pixel (`shadow_term_<light>`).
+    ShadowTerm,
+    /// The HDR light buffer (RGBA16F).
+    Light,
+    /// The tone-mapped sRGB image.
+    Final,
+}
+
+fn numbered(pass: &str, prefix: &str) -> bool {
+    pass.strip_prefix(prefix)
+        .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()))
+}
+
+/// The kind of a golden pass, or `None` for an output that gets no golden (VSM moments, blur
+/// targets, ...).
+pub fn pass_kind(pass: &str) -> Option<PassKind> {
+    Some(match pass {
+        p if p.starts_with("gbuffer_") => PassKind::GBuffer,
+        plan::DEPTH => PassKind::Depth,
+        p if numbered(p, "shadow_") => PassKind::Depth,
+        p if numbered(p, "shadow_term_") => PassKind::ShadowTerm,
+        "mask" | "mask_1" => PassKind::Mask,
+        plan::LIGHT => PassKind::Light,
+        plan::FINAL => PassKind::Final,
+        _ => return None,
+    })
+}
+
+/// The checks of a kind of pass (all must pass), each with the limit used when the noise model
+/// has no figure for it in any scene (only a scene-less model: `golden/noise.toml` normally
+/// gives every limit; see [`crate::noise`]).
+///
+/// - G-buffer: pixels with a channel more than 0.01 off, relative above 1 (so positions far
+///   away compare relatively and unit quantities absolutely; one fp16 step is at most 1e-3).
+/// - depth and shadow maps: pixels more than 1e-4 off, relative above 1e-3 (the rasterizers
+///   disagree by up to 1e-5 in lavapipe's shadow maps; 1e-4 of depth is about 0.1 mm at the
+///   canonical scenes' distances).
+/// - mask, shadow term: pixels with a channel flipped (0.5) or a visibility more than 0.01 off.
+/// - light buffer: pixels whose RGB radiance moved more than 0.5% relative, above a floor of
+///   0.01 (a change of a few fp16 steps, which no rounding of one value makes; radiance below
+///   0.01 is near black after tone mapping, so its changes count in absolute terms).
+/// - final: pixels with a channel more than 0.006 (1.53/255) off (±1 LSB is rounding; 2 is a
+///   change), and
+///   the mean FLIP error (a perceptual last net; ±1 LSB of rounding moves it by ~5e-3).
+pub fn rule_shape(kind: PassKind) -> Vec<(Metric, f64)> {
+    let pixels_over =
+        |threshold: f64, floor: Option<f64>, channels: Channels| Metric::FractionOver {
+            threshold,
+            floor,
+            shift: 0,
+            channels,
+        };
+    match kind {
+        PassKind::GBuffer => vec![(pixels_over(0.01, Some(1.0), Channels::All), 1.2e-4)],
+        PassKind::Depth => vec![(pixels_over(1e-4, Some(1e-3), Channels::All), 1.2e-4)],
+        PassKind::Mask => vec![(pixels_over(0.5, None, Channels::All), 1.2e-4)],
+        PassKind::ShadowTerm => vec![(pixels_over(0.01, None, Channels::Rgb), 1.2e-4)],
+        PassKind::Light => vec![(pixels_over(0.005, Some(0.01), Channels::Rgb), 3.5e-4)],
+        PassKind::Final => vec![
+            (pixels_over(0.006, None, Channels::Rgb), 1.2e-4),
+            (Metric::FlipMean, 0.021),
+        ],
+    }
+}
+
+/// Where a pass's limits came from.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub enum LimitSource {
+    /// The scene file's `[tolerances.<pass>]`.
+    SceneFile,
+    /// The scene's own figures in `golden/noise.toml`.
+    NoiseModel,
+    /// No figures for this scene: the largest limit of the same kind of pass in other scenes.
+    Borrowed,
+    /// No figures at all: the rule shape's fallback.
+    Fallback,
+}
+
 /// One scene of the suite with its golden passes and their rules.
 pub struct Case {
-    /// The loaded scene.
+    /// The loaded scene (with its shadow terms turned on: they are golden outputs).
     pub loaded: LoadedScene,
     /// Golden passes, in plan order.
     pub passes: Vec<String>,
     /// Rule per golden pass.
     pub rules: BTreeMap<String, Rule>,
+    /// Where each pass's limits came from.
+    pub limit_sources: BTreeMap<String, LimitSource>,
+    /// Size and format per pass output.
+    targets: BTreeMap<String, TargetSpec>,
 }
 
 impl Case {
-    /// Loads a scene (canonical name or path) and its tolerances.
+    /// Loads a scene (canonical name or path), its tolerances, and the limits of the workspace's
+    /// noise model.
     pub fn load(name_or_path: &str) -> Result<Case, SuiteError> {
-        let loaded = crate::load_scene(name_or_path)?;
+        let model = NoiseModel::load(&GoldenStore::workspace())?;
+        Case::load_with(name_or_path, &model)
+    }
+
+    /// [`Case::load`] with the limits of `model`.
+    pub fn load_with(name_or_path: &str, model: &NoiseModel) -> Result<Case, SuiteError> {
+        let mut loaded = crate::load_scene(name_or_path)?;
+        // A shadowed light's shadow term is where a shadow change first shows: golden renders
+        // read it back (a full-screen pass per shadowed light).
+        loaded.scene.quality.debug_shadow_terms = true;
         let plan = RenderPlan::new(&loaded.scene);
         let passes: Vec<String> = plan
             .target_names()
             .into_iter()
-            .filter(|t| GOLDEN_PASSES.contains(t) || t.starts_with("shadow_"))
+            .filter(|t| pass_kind(t).is_some())
             .map(str::to_owned)
             .collect();
+        let targets = passes
+            .iter()
+            .filter_map(|p| Some((p.clone(), plan.target(p)?.clone())))
+            .collect();
         let mut rules = BTreeMap::new();
+        let mut limit_sources = BTreeMap::new();
         for (pass, value) in &loaded.tolerances {
             if !passes.contains(pass) {
                 return Err(SuiteError::UnknownPass {
@@ -81,22 +193,67 @@ impl Case {
                 source,
             })?;
             rules.insert(pass.clone(), rule);
+            limit_sources.insert(pass.clone(), LimitSource::SceneFile);
         }
+        let scene = loaded.scene.name.clone();
         for pass in &passes {
-            rules
-                .entry(pass.clone())
-                .or_insert_with(|| default_rule(pass));
+            if rules.contains_key(pass) {
+                continue;
+            }
+            let kind = pass_kind(pass).expect("golden passes have a kind");
+            let mut source = LimitSource::NoiseModel;
+            let checks = rule_shape(kind)
+                .into_iter()
+                .map(|(metric, fallback)| {
+                    let key = metric.to_string();
+                    let limit = match model.figures(&scene, pass, &key) {
+                        Some(figures) => figures.limit,
+                        None => match model.borrowed_limit(pass, &key) {
+                            Some(limit) => {
+                                source = LimitSource::Borrowed;
+                                limit
+                            }
+                            None => {
+                                source = LimitSource::Fallback;
+                                fallback
+                            }
+                        },
+                    };
+                    Rule::Check { metric, limit }
+                })
+                .collect();
+            rules.insert(pass.clone(), Rule::All(checks));
+            limit_sources.insert(pass.clone(), source);
         }
         Ok(Case {
             loaded,
             passes,
             rules,
+            limit_sources,
+            targets,
         })
     }
 
     /// Scene name.
     pub fn name(&self) -> &str {
         &self.loaded.scene.name
+    }
+
+    /// Pixels of a pass's output (0 for an unknown pass).
+    pub fn pixels(&self, pass: &str) -> usize {
+        self.targets
+            .get(pass)
+            .map_or(0, |t| t.width as usize * t.height as usize)
+    }
+
+    /// Whether a pass's output is 8-bit (its golden a PNG).
+    pub fn is_eight_bit(&self, pass: &str) -> bool {
+        self.targets.get(pass).is_some_and(|t| {
+            matches!(
+                t.format,
+                TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb
+            )
+        })
     }
 
     /// Renders the golden passes on a new backend of this kind.
@@ -115,77 +272,15 @@ impl Case {
 
 /// Every canonical scene (the `.toml` files directly in `scenes/`).
 pub fn canonical_cases() -> Result<Vec<Case>, SuiteError> {
+    let model = NoiseModel::load(&GoldenStore::workspace())?;
     engine::scene_file::canonical_scenes(&crate::scenes_dir())
         .iter()
-        .map(|name| Case::load(name))
+        .map(|name| Case::load_with(name, &model))
         .collect()
 }
 
-fn check(metric: Metric, limit: f64) -> Rule {
-    Rule::Check { metric, limit }
-}
-
-/// The tolerance a pass gets when its scene file gives none. Tight enough that the mutation
-/// self-test catches every listed change, loose enough for llvmpipe vs lavapipe (measured; see
-/// the README's tolerance table).
-pub fn default_rule(pass: &str) -> Rule {
-    const STEP: f64 = 1.0 / 255.0;
-    match pass {
-        // 1e-4 of the pixels is 26 at 512x512: 4x the llvmpipe/lavapipe disagreement measured on
-        // chess (6 pixels), 2.5x under the smallest mutation the self-test must catch (shadow
-        // bias x4 on chess, 65 pixels).
-        "final" => Rule::All(vec![
-            check(
-                Metric::FractionOver {
-                    threshold: 2.0 * STEP,
-                    shift: 0,
-                },
-                1e-4,
-            ),
-            check(Metric::FlipMean, 0.002),
-        ]),
-        "mask" | "mask_1" => check(
-            Metric::FractionOver {
-                threshold: 0.5,
-                shift: 0,
-            },
-            0.001,
-        ),
-        p if p == "depth" || p.starts_with("shadow_") => check(
-            Metric::Relative {
-                percentile: 0.999,
-                floor: 1e-3,
-            },
-            1e-5,
-        ),
-        "light" => Rule::All(vec![
-            check(
-                Metric::Relative {
-                    percentile: 0.5,
-                    floor: 1e-3,
-                },
-                2e-3,
-            ),
-            check(
-                Metric::Relative {
-                    percentile: 0.99,
-                    floor: 1e-3,
-                },
-                0.02,
-            ),
-        ]),
-        _ => check(
-            Metric::FractionOver {
-                threshold: 0.01,
-                shift: 0,
-            },
-            0.002,
-        ),
-    }
-}
-
 /// Files written for a failed (or missing) check, to look at.
-#[derive(Clone, Debug, Default, serde::Serialize)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Artifacts {
     /// The rendered output.
     pub actual: Option<PathBuf>,
@@ -196,7 +291,7 @@ pub struct Artifacts {
 }
 
 /// Outcome of one scene x pass x backend.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct PassCheck {
     /// Scene.
     pub scene: String,

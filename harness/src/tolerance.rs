@@ -8,22 +8,29 @@
 //!
 //! | metric | parameters | passes when |
 //! |---|---|---|
-//! | `max_abs` | `shift` (px, default 0) | largest channel difference <= `max` |
-//! | `fraction_over` | `threshold`, `shift` | fraction of pixels over `threshold` <= `max` |
+//! | `max_abs` | `shift` (px, default 0), `channels` | largest channel difference <= `max` |
+//! | `fraction_over` | `threshold`, `floor` (absent: absolute), `shift`, `channels` | fraction of pixels whose largest channel error is over `threshold` <= `max` |
 //! | `rmse` | | RMSE <= `max` |
 //! | `psnr` | | PSNR >= `min` (dB) |
-//! | `relative` | `percentile` (default 1), `floor` (default 1e-3) | that percentile of the relative error <= `max` |
+//! | `relative` | `percentile` (default 1), `floor` (default 1e-3), `channels` (default `rgb`) | that percentile of the relative error <= `max` |
 //! | `flip_mean` | | mean FLIP error <= `max` (8-bit images) |
 //! | `flip_percentile` | `percentile` | that percentile of FLIP <= `max` |
 //!
-//! 8-bit differences are in 0..1 units (one step is 1/255 = 0.00392). Any NaN or infinity in the
-//! actual image fails every rule, whatever the tree says.
+//! 8-bit differences are in 0..1 units (one step is 1/255 = 0.00392). `floor` is absolute, in the
+//! image's units: an error is `|a - g| / max(|g|, floor)` (see [`crate::metrics`]). `channels` is
+//! `"all"` (default, but `rgb` for `relative`) or `"rgb"` (alpha left out). Any NaN or infinity
+//! in the actual image fails every rule, whatever the tree says.
+//!
+//! A verdict also carries the rule's *ratio*: how far the image is from failing, `value / limit`
+//! for one check (`limit / value` for `psnr`), the largest over an `all`, the smallest over an
+//! `any`. It passes at ratio <= 1; the mutation self-test and the noise model read margins from
+//! it.
 
 use std::fmt;
 
 use engine::Image;
 
-use crate::metrics::{flip_stats, MetricError, Pair};
+use crate::metrics::{flip_stats, Channels, MetricError, Pair};
 
 /// A metric with its parameters.
 #[derive(Clone, Debug, PartialEq)]
@@ -32,13 +39,19 @@ pub enum Metric {
     MaxAbs {
         /// Shift radius in pixels.
         shift: u32,
+        /// Channels compared.
+        channels: Channels,
     },
     /// Fraction of pixels over a threshold.
     FractionOver {
-        /// Per-channel difference that counts a pixel as over.
+        /// Per-channel error that counts a pixel as over.
         threshold: f64,
+        /// Absolute floor: with one, the error is relative (see [`crate::metrics`]).
+        floor: Option<f64>,
         /// Shift radius in pixels.
         shift: u32,
+        /// Channels compared.
+        channels: Channels,
     },
     /// Root-mean-square difference.
     Rmse,
@@ -48,8 +61,10 @@ pub enum Metric {
     Relative {
         /// Percentile, 0..1.
         percentile: f64,
-        /// Denominator floor as a fraction of the golden's maximum.
+        /// Absolute denominator floor, in the image's units.
         floor: f64,
+        /// Channels compared.
+        channels: Channels,
     },
     /// Mean FLIP.
     FlipMean,
@@ -62,24 +77,50 @@ pub enum Metric {
 
 impl fmt::Display for Metric {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let shift = |s: &u32| {
-            if *s > 0 {
-                format!(", shift {s}px")
-            } else {
-                String::new()
+        let extras = |shift: u32, channels: Channels, default: Channels| {
+            let mut s = String::new();
+            if channels != default {
+                s.push_str(&format!(", {}", channels.name()));
             }
+            if shift > 0 {
+                s.push_str(&format!(", shift {shift}px"));
+            }
+            s
         };
         match self {
-            Metric::MaxAbs { shift: s } => write!(f, "max_abs{}", shift(s)),
+            Metric::MaxAbs { shift, channels } => {
+                let e = extras(*shift, *channels, Channels::All);
+                if e.is_empty() {
+                    write!(f, "max_abs")
+                } else {
+                    write!(f, "max_abs({})", &e[2..])
+                }
+            }
             Metric::FractionOver {
                 threshold,
-                shift: s,
-            } => write!(f, "fraction_over({threshold:.4}{})", shift(s)),
+                floor,
+                shift,
+                channels,
+            } => {
+                let relative = floor.map_or(String::new(), |fl| format!(" rel, floor {fl}"));
+                write!(
+                    f,
+                    "fraction_over(> {threshold}{relative}{})",
+                    extras(*shift, *channels, Channels::All)
+                )
+            }
             Metric::Rmse => write!(f, "rmse"),
             Metric::Psnr => write!(f, "psnr"),
-            Metric::Relative { percentile, floor } => {
-                write!(f, "relative(p{}, floor {floor})", percentile * 100.0)
-            }
+            Metric::Relative {
+                percentile,
+                floor,
+                channels,
+            } => write!(
+                f,
+                "relative(p{}, floor {floor}{})",
+                percentile * 100.0,
+                extras(0, *channels, Channels::Rgb)
+            ),
             Metric::FlipMean => write!(f, "flip_mean"),
             Metric::FlipPercentile { percentile } => write!(f, "flip(p{})", percentile * 100.0),
         }
@@ -162,11 +203,11 @@ impl Rule {
             .and_then(|v| v.as_str())
             .ok_or_else(|| err("expected `all`, `any` or `metric = \"...\"`".to_owned()))?;
         let allowed: &[&str] = match name {
-            "max_abs" => &["shift", "max"],
-            "fraction_over" => &["threshold", "shift", "max"],
+            "max_abs" => &["shift", "channels", "max"],
+            "fraction_over" => &["threshold", "floor", "shift", "channels", "max"],
             "rmse" | "flip_mean" => &["max"],
             "psnr" => &["min"],
-            "relative" => &["percentile", "floor", "max"],
+            "relative" => &["percentile", "floor", "channels", "max"],
             "flip_percentile" => &["percentile", "max"],
             other => {
                 return Err(err(format!(
@@ -196,18 +237,38 @@ impl Rule {
                 "`percentile` must be in (0, 1] (0.999 = 99.9th)".to_owned()
             ));
         }
+        let channels = match table.get("channels") {
+            None => None,
+            Some(toml::Value::String(c)) if c == "all" => Some(Channels::All),
+            Some(toml::Value::String(c)) if c == "rgb" => Some(Channels::Rgb),
+            Some(other) => {
+                return Err(err(format!(
+                    "`channels` must be \"all\" or \"rgb\", not {other}"
+                )))
+            }
+        };
+        let floor = number(table, "floor", path)?;
+        if floor.is_some_and(|f| f <= 0.0) {
+            return Err(err("`floor` must be positive".to_owned()));
+        }
         let metric = match name {
-            "max_abs" => Metric::MaxAbs { shift },
+            "max_abs" => Metric::MaxAbs {
+                shift,
+                channels: channels.unwrap_or_default(),
+            },
             "fraction_over" => Metric::FractionOver {
                 threshold: number(table, "threshold", path)?
                     .ok_or_else(|| err("fraction_over needs `threshold`".to_owned()))?,
+                floor,
                 shift,
+                channels: channels.unwrap_or_default(),
             },
             "rmse" => Metric::Rmse,
             "psnr" => Metric::Psnr,
             "relative" => Metric::Relative {
                 percentile,
-                floor: number(table, "floor", path)?.unwrap_or(1e-3),
+                floor: floor.unwrap_or(1e-3),
+                channels: channels.unwrap_or(Channels::Rgb),
             },
             "flip_mean" => Metric::FlipMean,
             _ => Metric::FlipPercentile { percentile },
@@ -223,15 +284,25 @@ impl Rule {
         let pair = Pair::new(actual, golden)?;
         let mut flip = None;
         let mut checks = Vec::new();
-        let passed = self.evaluate_with(&pair, actual, golden, &mut flip, &mut checks)?;
+        let ratio = self.evaluate_with(&pair, actual, golden, &mut flip, &mut checks)?;
         let non_finite = pair.non_finite();
         Ok(Verdict {
-            passed: passed && non_finite == 0,
+            passed: ratio <= 1.0 && non_finite == 0,
+            ratio: if non_finite > 0 { f64::INFINITY } else { ratio },
             non_finite,
             checks,
         })
     }
 
+    /// The checks of the tree, in tree order.
+    pub fn checks(&self) -> Vec<(&Metric, f64)> {
+        match self {
+            Rule::All(rules) | Rule::Any(rules) => rules.iter().flat_map(Rule::checks).collect(),
+            Rule::Check { metric, limit } => vec![(metric, *limit)],
+        }
+    }
+
+    /// Evaluates the tree and returns its ratio (passes at <= 1), pushing every check.
     fn evaluate_with(
         &self,
         pair: &Pair,
@@ -239,68 +310,103 @@ impl Rule {
         golden: &Image,
         flip: &mut Option<Vec<f32>>,
         checks: &mut Vec<CheckResult>,
-    ) -> Result<bool, MetricError> {
+    ) -> Result<f64, MetricError> {
         match self {
             Rule::All(rules) => {
-                let mut all = true;
+                let mut worst = 0.0f64;
                 for rule in rules {
-                    all &= rule.evaluate_with(pair, actual, golden, flip, checks)?;
+                    worst = worst.max(rule.evaluate_with(pair, actual, golden, flip, checks)?);
                 }
-                Ok(all)
+                Ok(worst)
             }
             Rule::Any(rules) => {
-                let mut any = false;
+                let mut best = f64::INFINITY;
                 for rule in rules {
-                    any |= rule.evaluate_with(pair, actual, golden, flip, checks)?;
+                    best = best.min(rule.evaluate_with(pair, actual, golden, flip, checks)?);
                 }
-                Ok(any)
+                Ok(best)
             }
             Rule::Check { metric, limit } => {
-                let mut flip_map = || -> Result<Vec<f32>, MetricError> {
-                    if flip.is_none() {
-                        *flip = Some(Pair::flip_map(actual, golden)?);
-                    }
-                    Ok(flip.clone().unwrap_or_default())
-                };
-                let value = match metric {
-                    Metric::MaxAbs { shift } => pair.max_abs(*shift),
-                    Metric::FractionOver { threshold, shift } => {
-                        pair.fraction_over(*threshold, *shift)
-                    }
-                    Metric::Rmse => pair.rmse(),
-                    Metric::Psnr => pair.psnr(),
-                    Metric::Relative { percentile, floor } => {
-                        pair.relative_percentile(*percentile, *floor)
-                    }
-                    Metric::FlipMean => flip_stats(&flip_map()?, 0.5).0,
-                    Metric::FlipPercentile { percentile } => {
-                        flip_stats(&flip_map()?, *percentile).1
-                    }
-                };
-                let passed = if *metric == Metric::Psnr {
-                    value >= *limit
-                } else {
-                    value <= *limit
-                };
+                let value = metric_value(metric, pair, actual, golden, flip)?;
+                let at_least = *metric == Metric::Psnr;
+                let ratio = ratio(value, *limit, at_least);
                 checks.push(CheckResult {
                     metric: metric.to_string(),
                     value,
                     limit: *limit,
-                    at_least: *metric == Metric::Psnr,
-                    passed,
+                    at_least,
+                    passed: ratio <= 1.0,
                 });
-                Ok(passed)
+                Ok(ratio)
             }
         }
     }
 }
 
+/// `value / limit` (`limit / value` for a lower bound); 0 when both are 0, infinite for NaN.
+fn ratio(value: f64, limit: f64, at_least: bool) -> f64 {
+    let (num, den) = if at_least {
+        (limit, value)
+    } else {
+        (value, limit)
+    };
+    if num.is_nan() || den.is_nan() {
+        f64::INFINITY
+    } else if num <= 0.0 {
+        0.0
+    } else if den <= 0.0 {
+        f64::INFINITY
+    } else {
+        num / den
+    }
+}
+
+/// Measures one metric (the FLIP map is computed once per evaluation and shared).
+pub fn metric_value(
+    metric: &Metric,
+    pair: &Pair,
+    actual: &Image,
+    golden: &Image,
+    flip: &mut Option<Vec<f32>>,
+) -> Result<f64, MetricError> {
+    if matches!(metric, Metric::FlipMean | Metric::FlipPercentile { .. }) && flip.is_none() {
+        *flip = Some(Pair::flip_map(actual, golden)?);
+    }
+    let flip_map = flip.as_deref().unwrap_or(&[]);
+    Ok(match metric {
+        Metric::MaxAbs { shift, channels } => pair.max_abs(*shift, *channels),
+        Metric::FractionOver {
+            threshold,
+            floor,
+            shift,
+            channels,
+        } => pair.fraction_over(*threshold, *shift, *floor, *channels),
+        Metric::Rmse => pair.rmse(),
+        Metric::Psnr => pair.psnr(),
+        Metric::Relative {
+            percentile,
+            floor,
+            channels,
+        } => pair.relative_percentile(*percentile, *floor, *channels),
+        Metric::FlipMean => flip_stats(flip_map, 0.5).0,
+        Metric::FlipPercentile { percentile } => flip_stats(flip_map, *percentile).1,
+    })
+}
+
+/// Reads a number that JSON wrote as `null` (serde_json writes infinities and NaN so) as
+/// infinity.
+pub(crate) fn null_as_infinity<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    use serde::Deserialize;
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
+}
+
 /// One metric measured against its limit.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct CheckResult {
     /// Metric and parameters.
     pub metric: String,
     /// Measured value.
+    #[serde(deserialize_with = "null_as_infinity")]
     pub value: f64,
     /// The limit.
     pub limit: f64,
@@ -308,6 +414,13 @@ pub struct CheckResult {
     pub at_least: bool,
     /// Whether it passed.
     pub passed: bool,
+}
+
+impl CheckResult {
+    /// `value / limit` (`limit / value` for a lower bound): passes at <= 1.
+    pub fn ratio(&self) -> f64 {
+        ratio(self.value, self.limit, self.at_least)
+    }
 }
 
 impl fmt::Display for CheckResult {
@@ -325,10 +438,13 @@ impl fmt::Display for CheckResult {
 }
 
 /// The outcome of a tolerance check.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Verdict {
     /// Whether the rule tree passed and the image is finite.
     pub passed: bool,
+    /// How far from failing: passes at <= 1 (see the module docs); infinite with NaN/Inf.
+    #[serde(deserialize_with = "null_as_infinity")]
+    pub ratio: f64,
     /// NaN/Inf values in the actual image.
     pub non_finite: usize,
     /// Every metric evaluated, in tree order.

@@ -204,6 +204,7 @@ fn write_failure_report(suite: &Suite) {
         render_errors: vec![],
         cross: vec![],
         timings: vec![],
+        driver_notes: vec![],
     };
     let html = harness::report::html(&run, &outputs, &suite.store, None);
     match harness::images::write_atomically(&report_path(), html.as_bytes()) {
