@@ -336,3 +336,77 @@ fn bench_json_gives_each_pass_its_time_and_ratio_to_the_floor() {
     assert!(json["precompute"][0]["ms"].as_f64().unwrap() >= 0.0);
     assert!(dir.path().join("bench.json").is_file());
 }
+
+/// `harness noise` measures a source in child processes (`check --json` per scene and backend)
+/// and renders recorded on another host, and judges both against the limits; a golden that no
+/// longer matches makes it exit 1. Refuses unknown sources and a partial `--write`.
+#[test]
+fn noise_measures_sources_and_fails_when_a_golden_moved() {
+    let backends = common::available_backends();
+    assert!(!backends.is_empty(), "no backend available");
+    let (code, stdout, stderr) = harness(&[
+        "noise",
+        "--source",
+        "cpu-sse4.1",
+        "--source",
+        "host-b",
+        "--scene",
+        "ibl",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    let json: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let names: Vec<&str> = json["sources"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["cpu-sse4.1", "host-b"]);
+    let measurements = json["measurements"].as_array().unwrap();
+    for backend in &backends {
+        assert!(
+            measurements
+                .iter()
+                .any(|m| m["source"] == "cpu-sse4.1" && m["backend"] == backend.name()),
+            "no cpu-sse4.1 measurement on {backend}"
+        );
+    }
+    assert!(measurements
+        .iter()
+        .any(|m| m["source"] == "host-b" && m["pass"] == "final"));
+    for ratio in json["ratios"].as_array().unwrap() {
+        assert!(ratio["ratio"].as_f64().unwrap() <= 0.5, "{ratio}");
+    }
+
+    let (code, _, stderr) = harness(&["noise", "--source", "nope"]);
+    assert_eq!(code, 1);
+    assert!(stderr.contains("unknown source `nope`"), "{stderr}");
+    let (code, _, stderr) = harness(&["noise", "--source", "drivers", "--write"]);
+    assert_eq!(code, 1);
+    assert!(stderr.contains("--write records every source"), "{stderr}");
+
+    // A golden darkened by 2/255 is no noise: the drivers source fails against it.
+    let root = common::temp_workspace();
+    let final_png = root.path().join("golden/ibl/final.png");
+    let mut image = image::open(&final_png).unwrap().to_rgba8();
+    for pixel in image.pixels_mut() {
+        for c in 0..3 {
+            pixel[c] = pixel[c].saturating_sub(2);
+        }
+    }
+    image.save(&final_png).unwrap();
+    let output = Command::new(env!("CARGO_BIN_EXE_harness"))
+        .args(["noise", "--source", "drivers", "--scene", "ibl"])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout
+            .lines()
+            .any(|l| l.starts_with("FAILED: drivers ibl final")),
+        "{stdout}"
+    );
+}

@@ -63,7 +63,7 @@ fn report_screenshot_shows_the_images() {
             "--disable-component-update",
             "--disable-sync",
             "--hide-scrollbars",
-            "--window-size=1280,2000",
+            "--window-size=1280,5000",
         ])
         .arg(format!("--user-data-dir={}", profile.display()))
         .arg(format!("--screenshot={}", screenshot.display()))
@@ -76,7 +76,9 @@ fn report_screenshot_shows_the_images() {
         String::from_utf8_lossy(&status.stderr)
     );
     let image = image::open(&screenshot).unwrap().to_rgb8();
-    assert_eq!(image.dimensions(), (1280, 2000));
+    // Tall enough to reach past the tables and the dark G-buffer targets (positions, tangents) into
+    // the lit passes.
+    assert_eq!(image.dimensions(), (1280, 5000));
     let colors: std::collections::HashSet<[u8; 3]> = image.pixels().map(|p| p.0).collect();
     // Text and tables give a few hundred colors; the embedded renders give thousands.
     assert!(
