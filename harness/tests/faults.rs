@@ -262,15 +262,19 @@ fn a_full_disk_while_blessing_keeps_the_old_golden_and_names_the_file() {
 
 #[test]
 fn a_full_disk_while_writing_the_report_names_the_file_and_fails() {
-    if common::available_backends().is_empty() {
+    if !common::available_backends().contains(&BackendKind::Gl) {
         return;
     }
     let out = tempfile::tempdir().unwrap();
+    // On gl only: the file-size limit that stands in for a full disk also caps memfd sizes, and
+    // Mesa 25's lavapipe backs device memory with memfds (it dies of SIGBUS in vkCreateDevice).
     let output = with_full_disk(
         &[
             "check",
             "--scene",
             "arrow",
+            "--backend",
+            "gl",
             "--out",
             out.path().to_str().unwrap(),
         ],
