@@ -249,48 +249,70 @@ fn env_source(name: &str, description: &str, vars: &[(&str, &str)], cheap: bool)
 /// Every source: the ones this machine can produce (the second Mesa only once installed: `Err`
 /// says how), and the recorded hosts in `golden/evidence/`.
 pub fn sources(store: &GoldenStore) -> (Vec<Source>, Vec<(String, String)>) {
-    let mut sources = vec![
-        env_source(
-            "drivers",
-            "this machine's drivers as they are (every backend)",
-            &[],
-            true,
-        ),
-        env_source(
+    // llvmpipe's and lavapipe's other code paths: (name, what, variable, value, cheap).
+    let code_paths = [
+        (
             "cpu-sse4.1",
             "llvmpipe/lavapipe limited to SSE4.1 code",
-            &[("GALLIUM_OVERRIDE_CPU_CAPS", "sse4.1")],
+            "GALLIUM_OVERRIDE_CPU_CAPS",
+            "sse4.1",
             true,
         ),
-        env_source(
+        (
             "cpu-avx",
             "llvmpipe/lavapipe limited to AVX code",
-            &[("GALLIUM_OVERRIDE_CPU_CAPS", "avx")],
+            "GALLIUM_OVERRIDE_CPU_CAPS",
+            "avx",
             true,
         ),
-        env_source(
+        (
             "vector-128",
             "llvmpipe/lavapipe with 128-bit vectors",
-            &[("LP_NATIVE_VECTOR_WIDTH", "128")],
+            "LP_NATIVE_VECTOR_WIDTH",
+            "128",
             false,
         ),
-        env_source(
+        (
             "threads-1",
             "llvmpipe/lavapipe rasterizing on one thread",
-            &[("LP_NUM_THREADS", "1")],
+            "LP_NUM_THREADS",
+            "1",
             false,
         ),
     ];
+    let mut sources = vec![env_source(
+        "drivers",
+        "this machine's drivers as they are (every backend)",
+        &[],
+        true,
+    )];
+    for (name, description, key, value, cheap) in code_paths {
+        sources.push(env_source(name, description, &[(key, value)], cheap));
+    }
     let mut missing = Vec::new();
     match mesa_backports() {
         Ok((version, vars)) => {
+            // The second Mesa alone and with each code path: a user's machine brings both at
+            // once (a newer Mesa on a CPU without AVX2, say), and they add up.
             let short = version.split('-').next().unwrap_or(&version).to_owned();
+            let mesa = format!("mesa-{short}");
+            let description = format!("Mesa {version} from bookworm-backports, private prefix");
             sources.push(Source {
-                name: format!("mesa-{short}"),
-                description: format!("Mesa {version} from bookworm-backports, private prefix"),
-                kind: SourceKind::Environment(vars),
+                name: mesa.clone(),
+                description: description.clone(),
+                kind: SourceKind::Environment(vars.clone()),
                 cheap: false,
             });
+            for (name, what, key, value, _) in code_paths {
+                let mut combined = vars.clone();
+                combined.push((key.to_owned(), value.to_owned()));
+                sources.push(Source {
+                    name: format!("{mesa}+{name}"),
+                    description: format!("{description}; {what}"),
+                    kind: SourceKind::Environment(combined),
+                    cheap: false,
+                });
+            }
         }
         Err(why) => missing.push(("mesa-backports".to_owned(), why)),
     }
@@ -757,9 +779,9 @@ pub fn measure(
     runs
 }
 
-/// A table of `ratios`: a row per scene, pass and metric, a column per source holding the worst
-/// `value / limit` over backends (`!` above [`MAX_NOISE_RATIO`], `FAIL` above 1), then the
-/// limit.
+/// A table of `ratios`: a row per scene, pass and metric, a numbered column per source holding
+/// the worst `value / limit` over backends (`!` above [`MAX_NOISE_RATIO`], `X` above 1), then
+/// the limit.
 pub fn table(ratios: &[Ratio], sources: &[String]) -> String {
     // (scene, pass, metric) -> (limit, ratio per source).
     type Row = (f64, BTreeMap<String, f64>);
@@ -770,10 +792,15 @@ pub fn table(ratios: &[Ratio], sources: &[String]) -> String {
             .or_insert((r.limit, BTreeMap::new()));
         row.1.insert(r.source.clone(), r.ratio);
     }
-    let short = |name: &str| -> String { name.chars().take(11).collect() };
-    let mut out = format!("{:<8} {:<17} {:<44}", "scene", "pass", "metric");
-    for s in sources {
-        out.push_str(&format!(" {:>11}", short(s)));
+    // Columns are numbered, with a legend above: source names are too long for a column.
+    let mut out = String::from("sources:");
+    for (i, s) in sources.iter().enumerate() {
+        out.push_str(&format!(" [{}] {s}", i + 1));
+    }
+    out.push('\n');
+    out.push_str(&format!("{:<8} {:<17} {:<44}", "scene", "pass", "metric"));
+    for i in 0..sources.len() {
+        out.push_str(&format!(" {:>7}", format!("[{}]", i + 1)));
     }
     out.push_str("  limit\n");
     for ((scene, pass, metric), (limit, cells)) in rows {
@@ -781,14 +808,17 @@ pub fn table(ratios: &[Ratio], sources: &[String]) -> String {
         for s in sources {
             let cell = match cells.get(s) {
                 None => "-".to_owned(),
-                Some(&r) if r > 1.0 => format!("FAIL {r:.2}"),
-                Some(&r) if r > MAX_NOISE_RATIO => format!("! {r:.2}"),
+                Some(&r) if r > 1.0 => format!("X{r:.2}"),
+                Some(&r) if r > MAX_NOISE_RATIO => format!("!{r:.2}"),
                 Some(&r) => format!("{r:.2}"),
             };
-            out.push_str(&format!(" {cell:>11}"));
+            out.push_str(&format!(" {cell:>7}"));
         }
         out.push_str(&format!("  {limit:.3e}\n"));
     }
+    out.push_str(&format!(
+        "cells: worst value / limit over backends; ! above {MAX_NOISE_RATIO}, X above 1 (fails)\n"
+    ));
     out
 }
 

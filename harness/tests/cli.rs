@@ -226,6 +226,17 @@ fn bless_rewrites_only_the_named_golden() {
     assert_eq!(output.status.code(), Some(1));
 }
 
+/// Darkens an 8-bit image's RGB by `steps` (of 255), in place.
+fn darken(png: &Path, steps: u8) {
+    let mut image = image::open(png).unwrap().to_rgba8();
+    for pixel in image.pixels_mut() {
+        for c in 0..3 {
+            pixel[c] = pixel[c].saturating_sub(steps);
+        }
+    }
+    image.save(png).unwrap();
+}
+
 /// A changed golden fails `check` with the metrics and leaves actual, golden, diff and the HTML
 /// report on disk; a missing golden fails with the exact bless command.
 #[test]
@@ -236,14 +247,7 @@ fn check_reports_failures_with_images_and_the_bless_command() {
     }
     let root = common::temp_workspace();
     // Darken the golden final image of `arrow` by 3/255: a change the tolerance must catch.
-    let final_png = root.path().join("golden/arrow/final.png");
-    let mut image = image::open(&final_png).unwrap().to_rgba8();
-    for pixel in image.pixels_mut() {
-        for c in 0..3 {
-            pixel[c] = pixel[c].saturating_sub(3);
-        }
-    }
-    image.save(&final_png).unwrap();
+    darken(&root.path().join("golden/arrow/final.png"), 3);
     std::fs::remove_file(root.path().join("golden/arrow/light.exr")).unwrap();
     let out = root.path().join("out");
     let output = Command::new(env!("CARGO_BIN_EXE_harness"))
@@ -388,14 +392,7 @@ fn noise_measures_sources_and_fails_when_a_golden_moved() {
 
     // A golden darkened by 2/255 is no noise: the drivers source fails against it.
     let root = common::temp_workspace();
-    let final_png = root.path().join("golden/ibl/final.png");
-    let mut image = image::open(&final_png).unwrap().to_rgba8();
-    for pixel in image.pixels_mut() {
-        for c in 0..3 {
-            pixel[c] = pixel[c].saturating_sub(2);
-        }
-    }
-    image.save(&final_png).unwrap();
+    darken(&root.path().join("golden/ibl/final.png"), 2);
     let output = Command::new(env!("CARGO_BIN_EXE_harness"))
         .args(["noise", "--source", "drivers", "--scene", "ibl"])
         .env("HARNESS_ROOT", root.path())
@@ -408,5 +405,49 @@ fn noise_measures_sources_and_fails_when_a_golden_moved() {
             .lines()
             .any(|l| l.starts_with("FAILED: drivers ibl final")),
         "{stdout}"
+    );
+}
+
+/// When the driver differs from the one the goldens were blessed with, `check` says so, as
+/// information: the run still passes.
+#[test]
+fn check_notes_a_driver_other_than_the_blessing_one() {
+    if !common::available_backends().contains(&engine::BackendKind::Gl) {
+        return;
+    }
+    let root = common::temp_workspace();
+    let record = root.path().join("golden/arrow/blessed.toml");
+    let text = std::fs::read_to_string(&record).unwrap();
+    let moved: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("driver = ") {
+                "driver = \"OpenGL 4.6 | some other GPU | Mesa 99.0\"".to_owned()
+            } else {
+                l.to_owned()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(&record, moved).unwrap();
+    let out = root.path().join("out");
+    let output = Command::new(env!("CARGO_BIN_EXE_harness"))
+        .args(["check", "--scene", "arrow", "--backend", "gl", "--out"])
+        .arg(&out)
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(
+        stderr.contains(
+            "note: goldens of arrow were blessed on gl with `OpenGL 4.6 | some other GPU"
+        ) && stderr.contains("are not failures"),
+        "{stderr}"
+    );
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        report.contains("some other GPU"),
+        "the report does not say it"
     );
 }
