@@ -12,12 +12,16 @@
 #
 # After an intended change to the pictures or the metrics, `harness noise --write` re-measures
 # every source and rewrites golden/noise.toml (review its diff like a golden's).
+#
+# HARNESS_PROFILE=dev builds the harness in cargo's dev profile instead of release (CI does, to
+# share the build with `cargo test`).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+profile=${HARNESS_PROFILE:-release}
 case "${1:-}" in
-  --cheap) exec cargo run --release -q -p harness -- noise --source cheap ;;
+  --cheap) exec cargo run --profile "$profile" -q -p harness -- noise --source cheap ;;
   "") ;;
   *) echo "usage: scripts/portability.sh [--cheap]" >&2; exit 2 ;;
 esac
 scripts/mesa-backports.sh
-exec cargo run --release -q -p harness -- noise
+exec cargo run --profile "$profile" -q -p harness -- noise

@@ -611,38 +611,7 @@ fn noise(
     let store = harness::golden::GoldenStore::workspace();
     let cases = load_cases(scenes)?;
     let (all, missing) = noise::sources(&store);
-    let chosen: Vec<noise::Source> = if names.is_empty() {
-        all.clone()
-    } else {
-        let mut chosen = Vec::new();
-        for name in names {
-            let matching: Vec<&noise::Source> = all
-                .iter()
-                .filter(|s| &s.name == name || (name == "cheap" && s.cheap))
-                .collect();
-            if matching.is_empty() {
-                if let Some((_, why)) = missing
-                    .iter()
-                    .find(|(m, _)| name.starts_with("mesa") && m == "mesa-backports")
-                {
-                    anyhow::bail!("source `{name}`: {why}");
-                }
-                anyhow::bail!(
-                    "unknown source `{name}` (sources: {}, or cheap)",
-                    all.iter()
-                        .map(|s| s.name.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                );
-            }
-            for s in matching {
-                if !chosen.contains(s) {
-                    chosen.push(s.clone());
-                }
-            }
-        }
-        chosen
-    };
+    let chosen = noise::select(&all, &missing, names).map_err(anyhow::Error::msg)?;
     if write && (!names.is_empty() || !missing.is_empty()) {
         anyhow::bail!(
             "--write records every source; {}",

@@ -353,6 +353,42 @@ pub fn sources(store: &GoldenStore) -> (Vec<Source>, Vec<(String, String)>) {
     (sources, missing)
 }
 
+/// The sources named (every one when `names` is empty; `cheap` picks the quick ones), in the
+/// order of `all`, or why a name matches none (`missing` says why a source is not here).
+pub fn select(
+    all: &[Source],
+    missing: &[(String, String)],
+    names: &[String],
+) -> Result<Vec<Source>, String> {
+    for name in names {
+        if !all.iter().any(|s| &s.name == name || name == "cheap") {
+            if let Some((_, why)) = missing
+                .iter()
+                .find(|(m, _)| name.starts_with("mesa") && m == "mesa-backports")
+            {
+                return Err(format!("source `{name}`: {why}"));
+            }
+            return Err(format!(
+                "unknown source `{name}` (sources: {}, or cheap)",
+                all.iter()
+                    .map(|s| s.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
+    }
+    Ok(all
+        .iter()
+        .filter(|s| {
+            names.is_empty()
+                || names
+                    .iter()
+                    .any(|n| *n == s.name || (n == "cheap" && s.cheap))
+        })
+        .cloned()
+        .collect())
+}
+
 /// One measurement: a render of one scene under one source, every golden pass's checks.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Measurement {
@@ -1043,6 +1079,27 @@ mod tests {
         );
         // 0.18 in fp16 storage is 0.17993, still 141.
         assert_eq!(grey.as_u8().unwrap(), [141, 141, 141, 255]);
+    }
+
+    #[test]
+    fn sources_are_selected_by_name_or_as_the_cheap_ones() {
+        let store = GoldenStore::new(std::env::temp_dir().join("no-such-golden-folder"));
+        let (all, missing) = sources(&store);
+        let names = |picked: Vec<Source>| picked.into_iter().map(|s| s.name).collect::<Vec<_>>();
+        assert_eq!(names(select(&all, &missing, &[]).unwrap()).len(), all.len());
+        let cheap = names(select(&all, &missing, &["cheap".to_owned()]).unwrap());
+        assert_eq!(
+            cheap,
+            ["drivers", "cpu-sse4.1", "cpu-avx", "synthetic-rounding"]
+        );
+        let one = select(
+            &all,
+            &missing,
+            &["threads-1".to_owned(), "drivers".to_owned()],
+        );
+        assert_eq!(names(one.unwrap()), ["drivers", "threads-1"]);
+        let err = select(&all, &missing, &["nope".to_owned()]).unwrap_err();
+        assert!(err.contains("unknown source `nope`"), "{err}");
     }
 
     #[test]
