@@ -26,7 +26,9 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use engine::assets::linear_to_srgb_u8;
 use engine::backend::BackendKind;
+use engine::ibl::splitmix64;
 use engine::scene::ToneMap;
 use engine::{Image, ImageData};
 
@@ -425,7 +427,7 @@ pub struct Missed {
 /// 22.3.6 always at 9-12 vertices, 25.0.7 similarly; the 256-bit default, llvmpipe, and
 /// valgrind runs are clean). A scene without such draws renders (ibl), so a render that does
 /// is measured; one that aborts is reported as this known crash.
-pub fn known_driver_crash(source: &Source, backend: BackendKind, _case: &Case) -> Option<String> {
+pub fn known_driver_crash(source: &Source, backend: BackendKind) -> Option<String> {
     let SourceKind::Environment(vars) = &source.kind else {
         return None;
     };
@@ -494,7 +496,7 @@ pub fn measure_environment(
                 .output();
             let _ = std::fs::remove_dir_all(&out);
             let mut miss = |error: String| {
-                let known = known_driver_crash(source, backend, case);
+                let known = known_driver_crash(source, backend);
                 missed.push(Missed {
                     source: source.name.clone(),
                     backend: backend.name().to_owned(),
@@ -606,15 +608,6 @@ pub fn synthetic_rounding(
     out
 }
 
-/// The sRGB encoding (IEC 61966-2-1), exact.
-pub fn srgb_encode(linear: f64) -> f64 {
-    if linear <= 0.003_130_8 {
-        12.92 * linear
-    } else {
-        1.055 * linear.powf(1.0 / 2.4) - 0.055
-    }
-}
-
 /// The tone-mapping pass's curve, in f64 (engine/shaders/tonemap.wgsl).
 pub fn tone_map(x: f64, operator: ToneMap) -> f64 {
     let x = x.max(0.0);
@@ -636,7 +629,7 @@ pub fn requantize_final(light: &Image, operator: ToneMap) -> Image {
     for pixel in values.chunks_exact(channels) {
         for c in 0..3 {
             let v = f64::from(pixel[c.min(channels - 1)]);
-            data.push((srgb_encode(tone_map(v, operator)) * 255.0).round() as u8);
+            data.push(linear_to_srgb_u8(tone_map(v, operator)));
         }
         data.push(255);
     }
@@ -646,14 +639,6 @@ pub fn requantize_final(light: &Image, operator: ToneMap) -> Image {
         format: engine::backend::TextureFormat::Rgba8UnormSrgb,
         data: ImageData::U8(data),
     }
-}
-
-/// A seeded hash (SplitMix64's finaliser): a different, repeatable number per input.
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_4476_D1CE_4E5B);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 /// Moves `x` by `steps` representable values of its storage: fp16 for RGBA16F outputs, f32
@@ -696,7 +681,7 @@ pub fn ulp_noise(image: &Image, seed: u64) -> Image {
     let mut out = image.clone();
     if let ImageData::F32(values) = &mut out.data {
         for (i, v) in values.iter_mut().enumerate() {
-            let step = (mix(seed.wrapping_mul(0x1_0000_0001) ^ i as u64) % 3) as i32 - 1;
+            let step = (splitmix64(seed.wrapping_mul(0x1_0000_0001) ^ i as u64) % 3) as i32 - 1;
             *v = step_ulps(*v, step, fp16);
         }
     }
@@ -948,13 +933,7 @@ pub fn ratios(cases: &[Case], measurements: &[Measurement]) -> Vec<Ratio> {
             let Some((_, value)) = m.values.iter().find(|(k, _)| *k == key) else {
                 continue;
             };
-            let ratio = if *value <= 0.0 {
-                0.0
-            } else if limit <= 0.0 {
-                f64::INFINITY
-            } else {
-                value / limit
-            };
+            let ratio = crate::tolerance::ratio(*value, limit, false);
             let entry = out
                 .entry((
                     m.source.clone(),
@@ -1067,7 +1046,8 @@ mod tests {
         assert_eq!(values[(n - 1) * 4], 255);
         // Mid-grey 0.18 -> ACES 0.26690 -> sRGB 0.55346 -> 141.13 -> 141.
         assert!((tone_map(0.18, ToneMap::Aces) - 0.266_899).abs() < 1e-6);
-        assert!((srgb_encode(0.266_899) - 0.553_457).abs() < 1e-6);
+        // sRGB 0.553457 x 255 = 141.13.
+        assert_eq!(linear_to_srgb_u8(0.266_899), 141);
         let grey = requantize_final(
             &Image {
                 width: 1,

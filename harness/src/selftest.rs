@@ -649,7 +649,7 @@ fn run_case(
                         scene: case.name().to_owned(),
                         backend: backend.to_owned(),
                         pass: pass.clone(),
-                        ratio: if value <= 0.0 { 0.0 } else { value / limit },
+                        ratio: crate::tolerance::ratio(value, limit, false),
                         live: false,
                     });
                 }

@@ -344,7 +344,7 @@ impl Rule {
 }
 
 /// `value / limit` (`limit / value` for a lower bound); 0 when both are 0, infinite for NaN.
-fn ratio(value: f64, limit: f64, at_least: bool) -> f64 {
+pub fn ratio(value: f64, limit: f64, at_least: bool) -> f64 {
     let (num, den) = if at_least {
         (limit, value)
     } else {

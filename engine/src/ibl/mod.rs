@@ -249,6 +249,15 @@ pub(crate) fn parallel_map<T: Send>(count: usize, f: impl Fn(usize) -> T + Sync)
     })
 }
 
+/// SplitMix64's output function: a fixed, well-mixed 64-bit hash of `z` (no global state), for
+/// seeded patterns that must be the same on every run and machine.
+pub fn splitmix64(z: u64) -> u64 {
+    let mut z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
 /// Point `i` of `n` of the Hammersley set, optionally rotated (Cranley-Patterson) by offsets
 /// derived from `seed`.
 pub fn hammersley(i: u32, n: u32, seed: u32) -> (f32, f32) {
@@ -257,13 +266,8 @@ pub fn hammersley(i: u32, n: u32, seed: u32) -> (f32, f32) {
     if seed == 0 {
         return (u1, u2);
     }
-    let offset = |salt: u64| {
-        // SplitMix64 of (seed, salt): a fixed function, no global state.
-        let mut z = (u64::from(seed) << 32 | salt).wrapping_add(0x9e37_79b9_7f4a_7c15);
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let offset =
+        |salt: u64| (splitmix64(u64::from(seed) << 32 | salt) >> 40) as f32 / (1u64 << 24) as f32;
     ((u1 + offset(1)).fract(), (u2 + offset(2)).fract())
 }
 
