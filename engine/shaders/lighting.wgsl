@@ -1,6 +1,7 @@
 // Lighting passes of the deferred renderer: one full-screen draw per lighting model (and per
-// batch of up to 16 lights), each shading only the pixels whose shader-mask channel is set, added
-// into the HDR light buffer (RGBA16F) with additive blending. Light colors arrive pre-multiplied
+// batch of up to 16 lights), each shading only the pixels whose shader-mask channel is set
+// (routed by a depth test, see fs_route), added into the HDR light buffer (RGBA16F) with additive
+// blending. Light colors arrive pre-multiplied
 // by intensity and exposure, so the light buffer holds exposed radiance and stays inside fp16.
 //
 // PBR follows Filament (surface_brdf.fs): f_r = (f_d k_d + f_s)(1 - F_c) + f_c with Lambert f_d,
@@ -15,6 +16,31 @@
 // anisotropy bends the reflection vector, and rough lobes lean towards N (the dominant
 // direction). Specular occlusion is left out. Other models get the
 // irradiance as diffuse ambient.
+
+// Specialisation: the render plan (engine::plan::LightingVariant) sets these per draw from the
+// scene, so that a draw compiles only the code its scene uses; a pipeline per distinct set. The
+// defaults are never used as such: every pipeline sets every constant.
+// The draw's shadowed light (slot 0): 0 none, 1 directional, 2 point.
+override SHADOW_KIND: u32 = 0u;
+// Its filter: 0 hard, 1 3x3 PCF, 2 stratified soft, 3 stratified soft without early-out,
+// 4 converged soft reference (Vogel, 1024 samples), 5 variance shadow map, 6 Vogel disk.
+override SHADOW_FILTER: u32 = 0u;
+// Lights in the draw (at most 16), and which types among them.
+override LIGHT_COUNT: u32 = 0u;
+override DIRECTIONAL_LIGHTS: bool = true;
+override POINT_LIGHTS: bool = true;
+// Image-based lighting in this draw (the first draw of a scene with an environment).
+override IBL: bool = false;
+// Whether any surface of this model can have clearcoat or anisotropy: per-pixel values, so when
+// true the shader still branches on the pixel's value.
+override CLEARCOAT: bool = true;
+override ANISOTROPY: bool = true;
+// G-buffer storage: position 0 camera-relative, 1 world, 2 reconstructed from depth; normal
+// 0 fp16 xyz, 1 octahedral in xy.
+override POSITION_MODE: u32 = 0u;
+override NORMAL_MODE: u32 = 0u;
+// Cost breakdown (harness bench --breakdown): read the inputs and write their sum, no shading.
+override INPUT_FLOOR: bool = false;
 
 const PI: f32 = 3.14159265358979;
 const MAX_LIGHTS: u32 = 16u;
@@ -37,13 +63,13 @@ struct LightingUniforms {
     mask_select: vec4<f32>,
     // rgb = uniform ambient radiance * exposure (zero after the first batch).
     ambient: vec4<f32>,
-    // x = number of lights in this batch; y = 1 to emit unlit albedo (first batch only).
+    // x = number of lights in this batch (LIGHT_COUNT in the shader); y = 1 to emit unlit
+    // albedo (first batch only).
     counts: vec4<u32>,
     // IBL: x = environment intensity * exposure (0: none, or not the first batch), y = highest
     // specular lod (roughness 1), z, w = cos and sin of the environment's rotation about +Y.
     ibl: vec4<f32>,
-    // G-buffer storage: x = position (0 camera-relative, 1 world, 2 reconstructed from depth),
-    // y = normal (0 fp16 xyz, 1 octahedral in xy).
+    // G-buffer storage, as POSITION_MODE and NORMAL_MODE.
     gbuffer: vec4<f32>,
     // World position of the camera (f32), for world-space positions.
     camera_world: vec4<f32>,
@@ -147,7 +173,6 @@ struct ShadowLookup {
     reference: f32,
     bounds: vec4<f32>,
     pixel: vec2<i32>,
-    point: bool,
     // Point lights: the light's camera-relative position, the receiver minus the light, and two
     // axes perpendicular to it whose length is the soft filter's radius at the receiver.
     light: vec3<f32>,
@@ -158,7 +183,7 @@ struct ShadowLookup {
 
 // One tap of a soft filter at `o` in the unit disk (scaled to the soft radius).
 fn soft_tap(look: ShadowLookup, o: vec2<f32>) -> f32 {
-    if !look.point {
+    if SHADOW_KIND != 2u {
         return shadow_tap(look.uv + o * (shadow.soft.x * shadow.map.yz), look.reference, look.bounds);
     }
     let q = normalize(look.d + o.x * look.axis_u + o.y * look.axis_v) * length(look.d);
@@ -220,19 +245,16 @@ fn shadow_vsm(look: ShadowLookup) -> f32 {
 // Filtered comparison of the receiver against the map, by the draw's filter; hard and 3x3 PCF
 // taps stay in the map's uv space, clamped inside `bounds` (a point light's face).
 fn shadow_lookup(look: ShadowLookup) -> f32 {
-    if shadow.map.x > 5.5 {
+    if SHADOW_FILTER == 6u || SHADOW_FILTER == 4u {
         return shadow_vogel(look);
     }
-    if shadow.map.x > 4.5 {
+    if SHADOW_FILTER == 5u {
         return shadow_vsm(look);
     }
-    if shadow.map.x > 3.5 {
-        return shadow_vogel(look);
+    if SHADOW_FILTER == 2u || SHADOW_FILTER == 3u {
+        return shadow_soft(look, SHADOW_FILTER == 2u);
     }
-    if shadow.map.x > 1.5 {
-        return shadow_soft(look, shadow.map.x < 2.5);
-    }
-    if shadow.map.x < 0.5 {
+    if SHADOW_FILTER == 0u {
         return shadow_tap(look.uv, look.reference, look.bounds);
     }
     var sum = 0.0;
@@ -247,15 +269,14 @@ fn shadow_lookup(look: ShadowLookup) -> f32 {
 
 // Fraction of the light reaching the surface (1 = lit) for the draw's shadowed light.
 fn shadow_visibility(s: Surface, l: vec3<f32>, light: LightData) -> f32 {
-    let kind = shadow.params.x;
-    if kind < 0.5 {
+    if SHADOW_KIND == 0u {
         return 1.0;
     }
     let n_dot_l = clamp(dot(s.normal, l), 0.0, 1.0);
     let tan_theta = min(sqrt(max(1.0 - n_dot_l * n_dot_l, 0.0)) / max(n_dot_l, 1e-4), 10.0);
     // Texel size at the receiver, in meters.
     var texel = shadow.map.w;
-    if kind > 1.5 {
+    if SHADOW_KIND == 2u {
         texel = shadow.map.w * length(light.position.xyz - s.position);
     }
     // Slope-scaled and normal-offset parts are in texels, times the filter's reach (3x3 PCF
@@ -265,7 +286,7 @@ fn shadow_visibility(s: Surface, l: vec3<f32>, light: LightData) -> f32 {
     let p = s.position + s.normal * (shadow.params.w * texel * reach) + l * bias;
     var look: ShadowLookup;
     look.pixel = s.pixel;
-    if kind < 1.5 {
+    if SHADOW_KIND == 1u {
         let clip = shadow.faces[0] * vec4<f32>(p, 1.0);
         let ndc = clip.xyz / clip.w;
         look.uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
@@ -275,7 +296,6 @@ fn shadow_visibility(s: Surface, l: vec3<f32>, light: LightData) -> f32 {
         // Receivers beyond the casters' far plane compare at the far plane.
         look.reference = min(ndc.z, 1.0);
         look.bounds = vec4<f32>(0.0, 0.0, 1.0, 1.0);
-        look.point = false;
         return shadow_lookup(look);
     }
     let d = p - light.position.xyz;
@@ -283,7 +303,6 @@ fn shadow_visibility(s: Surface, l: vec3<f32>, light: LightData) -> f32 {
     look.uv = tap.uv;
     look.reference = tap.reference;
     look.bounds = tap.bounds;
-    look.point = true;
     look.light = light.position.xyz;
     look.d = d;
     let n = safe_normalize(d, vec3<f32>(0.0, 0.0, 1.0));
@@ -320,7 +339,7 @@ struct Surface {
     specular_exponent: f32,
 }
 
-// Reads the G-buffer at a pixel, or returns false when the pixel is not this model's.
+// Whether a pixel is not this model's (its shader-mask channel is clear).
 fn masked(pixel: vec2<i32>) -> bool {
     return dot(textureLoad(shader_mask, pixel, 0), u.mask_select) < 0.5;
 }
@@ -337,10 +356,10 @@ fn octahedral_decode(e: vec2<f32>) -> vec3<f32> {
 
 // The camera-relative position at a pixel, as the G-buffer stores it.
 fn surface_position(pixel: vec2<i32>, stored: vec3<f32>) -> vec3<f32> {
-    if u.gbuffer.x < 0.5 {
+    if POSITION_MODE == 0u {
         return stored;
     }
-    if u.gbuffer.x < 1.5 {
+    if POSITION_MODE == 1u {
         return stored - u.camera_world.xyz;
     }
     let size = vec2<f32>(textureDimensions(scene_depth));
@@ -361,7 +380,11 @@ fn load_surface(pixel: vec2<i32>) -> Surface {
     s.pixel = pixel;
     s.position = surface_position(pixel, p.xyz);
     s.roughness = clamp(p.w, 0.0, 1.0);
-    s.normal = select(normalize(n.xyz), octahedral_decode(n.xy), u.gbuffer.y > 0.5);
+    if NORMAL_MODE == 1u {
+        s.normal = octahedral_decode(n.xy);
+    } else {
+        s.normal = normalize(n.xyz);
+    }
     s.specular = n.w;
     s.tangent = t.xyz;
     s.base_color = a.rgb;
@@ -381,7 +404,12 @@ struct Incoming {
 
 fn incoming(light: LightData, s: Surface) -> Incoming {
     var result: Incoming;
-    if light.position.w < 0.5 {
+    // Only a draw with both types looks at the light's own type.
+    var directional = DIRECTIONAL_LIGHTS;
+    if DIRECTIONAL_LIGHTS && POINT_LIGHTS {
+        directional = light.position.w < 0.5;
+    }
+    if directional {
         result.direction = light.position.xyz;
         result.radiance = light.color.rgb;
         return result;
@@ -455,7 +483,7 @@ fn pbr_brdf_times_cosine(s: Surface, v: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
 
     var d: f32;
     var vis: f32;
-    if s.anisotropy != 0.0 {
+    if ANISOTROPY && s.anisotropy != 0.0 {
         let t = s.tangent;
         let b = cross(n, t);
         let at = max(alpha * (1.0 + s.anisotropy), 0.001);
@@ -470,6 +498,9 @@ fn pbr_brdf_times_cosine(s: Surface, v: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
     let specular = fresnel * (d * vis);
     let k_d = (vec3<f32>(1.0) - fresnel) * (1.0 - s.metallic);
     let diffuse = s.base_color * k_d * (1.0 / PI);
+    if !CLEARCOAT {
+        return (diffuse + specular) * n_dot_l;
+    }
 
     let clearcoat_alpha = s.clearcoat_roughness * s.clearcoat_roughness + 0.001;
     let clearcoat_fresnel = (0.04 + 0.96 * pow5(1.0 - l_dot_h)) * s.clearcoat;
@@ -499,7 +530,7 @@ fn toon_times_cosine(s: Surface, l: vec3<f32>) -> vec3<f32> {
 
 // Shadow term of light slot `i`: only slot 0 of a draw can be shadowed.
 fn visibility(i: u32, s: Surface, l: vec3<f32>, light: LightData) -> f32 {
-    if i != 0u {
+    if SHADOW_KIND == 0u || i != 0u {
         return 1.0;
     }
     return shadow_visibility(s, l, light);
@@ -554,7 +585,7 @@ fn pbr_ibl(s: Surface, v: vec3<f32>) -> vec3<f32> {
     // Anisotropy: reflect about a normal bent towards the anisotropic direction (Filament's
     // getReflectedVector), scaled down for smooth surfaces.
     var bent = n;
-    if s.anisotropy != 0.0 {
+    if ANISOTROPY && s.anisotropy != 0.0 {
         let b = cross(n, s.tangent);
         let direction = select(s.tangent, b, s.anisotropy >= 0.0);
         let anisotropic_tangent = cross(direction, v);
@@ -568,28 +599,46 @@ fn pbr_ibl(s: Surface, v: vec3<f32>) -> vec3<f32> {
     let dominant = safe_normalize(mix(r, bent, s.roughness * s.roughness * s.roughness * s.roughness), r);
     let specular = ibl_prefiltered(dominant, s.roughness) * e;
     let diffuse = s.base_color * (1.0 - s.metallic) * (vec3<f32>(1.0) - e) * ibl_irradiance_at(n);
+    if !CLEARCOAT {
+        return diffuse + specular;
+    }
     let clearcoat_fresnel = (0.04 + 0.96 * pow5(1.0 - n_dot_v)) * s.clearcoat;
     let clearcoat = ibl_prefiltered(reflect(-v, n), s.clearcoat_roughness) * clearcoat_fresnel;
     return (diffuse + specular) * (1.0 - clearcoat_fresnel) + clearcoat;
 }
 
+// The lighting pass's input floor: every input a pixel's shading reads (the five G-buffer targets,
+// and depth where positions come from it), summed into the output, and no shading.
+fn input_floor(pixel: vec2<i32>) -> vec4<f32> {
+    var sum = textureLoad(gbuffer_position, pixel, 0) + textureLoad(gbuffer_normal, pixel, 0)
+        + textureLoad(gbuffer_tangent, pixel, 0) + textureLoad(gbuffer_albedo, pixel, 0)
+        + textureLoad(gbuffer_material, pixel, 0);
+    if POSITION_MODE == 2u {
+        sum += textureLoad(scene_depth, pixel, 0);
+    }
+    return finish(sum.rgb * 1e-3 + vec3<f32>(sum.a * 1e-3));
+}
+
 // Exposed radiance of a masked pixel under the draw's ambient and lights. Ambient is diffuse:
 // PBR scales it by (1 - metallic), the other models by the base color alone.
 fn shade(model: u32, pixel: vec2<i32>) -> vec4<f32> {
+    if INPUT_FLOOR {
+        return input_floor(pixel);
+    }
     let s = load_surface(pixel);
     let v = safe_normalize(-s.position, s.normal);
     var radiance = s.base_color * u.ambient.rgb;
     if model == MODEL_PBR {
         radiance *= 1.0 - s.metallic;
     }
-    if u.ibl.x > 0.0 {
+    if IBL {
         if model == MODEL_PBR {
             radiance += pbr_ibl(s, v) * u.ibl.x;
         } else {
             radiance += s.base_color * ibl_irradiance_at(s.normal) * u.ibl.x;
         }
     }
-    for (var i = 0u; i < min(u.counts.x, MAX_LIGHTS); i++) {
+    for (var i = 0u; i < min(LIGHT_COUNT, MAX_LIGHTS); i++) {
         let light = incoming(u.lights[i], s);
         radiance += brdf_times_cosine(model, s, v, light.direction) * light.radiance
             * visibility(i, s, light.direction, u.lights[i]);
@@ -599,38 +648,22 @@ fn shade(model: u32, pixel: vec2<i32>) -> vec4<f32> {
 
 @fragment
 fn fs_pbr(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let pixel = vec2<i32>(frag.xy);
-    if masked(pixel) {
-        discard;
-    }
-    return shade(MODEL_PBR, pixel);
+    return shade(MODEL_PBR, vec2<i32>(frag.xy));
 }
 
 @fragment
 fn fs_blinn_phong(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let pixel = vec2<i32>(frag.xy);
-    if masked(pixel) {
-        discard;
-    }
-    return shade(MODEL_BLINN_PHONG, pixel);
+    return shade(MODEL_BLINN_PHONG, vec2<i32>(frag.xy));
 }
 
 @fragment
 fn fs_lambert(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let pixel = vec2<i32>(frag.xy);
-    if masked(pixel) {
-        discard;
-    }
-    return shade(MODEL_LAMBERT, pixel);
+    return shade(MODEL_LAMBERT, vec2<i32>(frag.xy));
 }
 
 @fragment
 fn fs_toon(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let pixel = vec2<i32>(frag.xy);
-    if masked(pixel) {
-        discard;
-    }
-    return shade(MODEL_TOON, pixel);
+    return shade(MODEL_TOON, vec2<i32>(frag.xy));
 }
 
 // Debug output: the shadow term of the draw's shadowed light (slot 0), as the passes above use it.
@@ -642,11 +675,23 @@ fn fs_shadow_term(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> 
     return vec4<f32>(v, v, v, 1.0);
 }
 
+// The first draw of every lighting pass: writes depth 0 (vs_fullscreen's) into the pass's cleared
+// routing target where the pixel is this model's, and adds nothing to the light buffer. The
+// draws that shade follow with an equal-depth test, which the driver runs before their fragment
+// shaders: pixels of other models are never shaded, and no shading draw discards.
+@fragment
+fn fs_route(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    if masked(vec2<i32>(frag.xy)) {
+        discard;
+    }
+    return vec4<f32>(0.0);
+}
+
 @fragment
 fn fs_unlit(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let pixel = vec2<i32>(frag.xy);
-    if masked(pixel) {
-        discard;
+    if INPUT_FLOOR {
+        return input_floor(pixel);
     }
     let s = load_surface(pixel);
     return finish(s.base_color * f32(u.counts.y));

@@ -223,6 +223,7 @@ fn render_with(
             topology: Topology::TriangleList,
             cull: CullMode::Back,
             geometry: None,
+            constants: vec![],
         },
     )?;
 

@@ -9,7 +9,9 @@
 use std::fmt;
 
 use crate::backend::TextureFormat;
-use crate::scene::{Light, LightingModel, Scene, ShadowFilter};
+use crate::scene::{
+    GbufferSettings, Light, LightingModel, NormalEncoding, PositionStorage, Scene, ShadowFilter,
+};
 
 /// Lights handled by one lighting draw (the size of the uniform array in `lighting.wgsl`).
 pub const MAX_LIGHTS_PER_DRAW: usize = 16;
@@ -106,6 +108,8 @@ pub struct RenderPlan {
     pub passes: Vec<PassSpec>,
     /// Lighting model to mask channel assignment.
     pub mask_channels: Vec<MaskChannel>,
+    /// Each lighting pass's draws and their shader variants, in pass order.
+    pub lighting: Vec<LightingPass>,
 }
 
 /// Names of the G-buffer targets, in attachment order.
@@ -121,6 +125,10 @@ pub const GBUFFER_TARGETS: [&str; 5] = [
 pub const DEPTH: &str = "depth";
 /// Name of the HDR light buffer.
 pub const LIGHT: &str = "light";
+/// Name of the lighting passes' routing depth: each lighting pass clears it, marks its model's
+/// pixels (from the mask) at depth 0, and draws its lights with an equal-depth test, so that the
+/// depth test skips other pixels before any shading.
+pub const ROUTE: &str = "route";
 /// Name of the tone-mapped output.
 pub const FINAL: &str = "final";
 
@@ -204,6 +212,16 @@ impl RenderPlan {
                 width: scene.quality.width,
                 height: scene.quality.height,
                 contents: channels.join(", "),
+            });
+        }
+        if !models.is_empty() {
+            targets.push(TargetSpec {
+                name: ROUTE.to_owned(),
+                format: TextureFormat::Depth32Float,
+                width: scene.quality.width,
+                height: scene.quality.height,
+                contents: "lighting routing: 0 where the last lighting pass's model shades, else 1"
+                    .to_owned(),
             });
         }
         targets.push(TargetSpec {
@@ -354,7 +372,8 @@ impl RenderPlan {
                 ),
             });
         }
-        for channel in &mask_channels {
+        let lighting = lighting_passes(scene, &models, casters > 0);
+        for (channel, pass) in mask_channels.iter().zip(&lighting) {
             let mut reads = gbuffer.clone();
             reads.push(mask_target_name(channel.target));
             if channel.model != LightingModel::Unlit {
@@ -364,14 +383,14 @@ impl RenderPlan {
                 name: format!("lighting_{}", channel.model.name().replace('-', "_")),
                 kind: PassKind::Lighting(channel.model),
                 reads,
-                writes: vec![LIGHT.to_owned()],
+                writes: vec![ROUTE.to_owned(), LIGHT.to_owned()],
                 detail: if channel.model == LightingModel::Unlit {
-                    "1 draw, no lights".to_owned()
+                    "1 draw, no lights, routed by depth test".to_owned()
                 } else {
                     format!(
-                        "{} light(s) in {} draw(s), additive",
+                        "{} light(s) in {} draw(s), additive, routed by depth test",
                         scene.lights.len(),
-                        batches_with_shadows(scene, casters > 0)
+                        pass.draws.len()
                     )
                 },
             });
@@ -424,6 +443,7 @@ impl RenderPlan {
             targets,
             passes,
             mask_channels,
+            lighting,
         }
     }
 
@@ -436,18 +456,6 @@ impl RenderPlan {
     pub fn target_names(&self) -> Vec<&str> {
         self.targets.iter().map(|t| t.name.as_str()).collect()
     }
-}
-
-/// Lighting draws per model: each shadowed light gets its own draw (its shadow map bound), the
-/// other lights go 16 to a draw; at least one draw (ambient).
-pub fn batches_with_shadows(scene: &Scene, any_casters: bool) -> usize {
-    let shadowed = scene
-        .lights
-        .iter()
-        .filter(|l| any_casters && l.casts_shadows())
-        .count();
-    let plain = scene.lights.len() - shadowed;
-    (shadowed + plain.div_ceil(MAX_LIGHTS_PER_DRAW)).max(1)
 }
 
 fn format_name(format: TextureFormat) -> &'static str {
@@ -478,6 +486,11 @@ impl fmt::Display for RenderPlan {
         writeln!(f, "passes:")?;
         for (i, p) in self.passes.iter().enumerate() {
             writeln!(f, "  {}. {:<21} {}", i + 1, p.name, p.detail)?;
+            if let PassKind::Lighting(model) = p.kind {
+                for (d, draw) in self.lighting_draws(model).iter().enumerate() {
+                    writeln!(f, "       draw {}: {}", d + 1, draw.variant)?;
+                }
+            }
             if !p.reads.is_empty() {
                 writeln!(f, "       reads  {}", p.reads.join(", "))?;
             }
@@ -486,5 +499,299 @@ impl fmt::Display for RenderPlan {
             }
         }
         Ok(())
+    }
+}
+
+/// A shadowed light's kind, as a lighting draw's specialisation sees it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ShadowKind {
+    /// A directional light's orthographic map.
+    Directional,
+    /// A point light's six-face atlas.
+    Point,
+}
+
+/// The shader variant of one lighting draw: the values of `lighting.wgsl`'s `override`
+/// constants, chosen from the scene so that a draw compiles only the code it uses. Two draws
+/// with equal variants share a pipeline; backends cache pipelines by these constants.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct LightingVariant {
+    /// Lights shaded by the draw (`LIGHT_COUNT`, at most [`MAX_LIGHTS_PER_DRAW`]).
+    pub lights: u32,
+    /// Whether any of them is directional (`DIRECTIONAL_LIGHTS`).
+    pub directional: bool,
+    /// Whether any of them is a point light (`POINT_LIGHTS`).
+    pub point: bool,
+    /// The shadowed light in slot 0, its kind and filter (`SHADOW_KIND`, `SHADOW_FILTER`).
+    pub shadow: Option<(ShadowKind, ShadowFilter)>,
+    /// Image-based lighting in this draw (`IBL`).
+    pub ibl: bool,
+    /// Some surface of the model has clearcoat (`CLEARCOAT`; the shader still branches per
+    /// pixel when true).
+    pub clearcoat: bool,
+    /// Some surface of the model is anisotropic (`ANISOTROPY`; per pixel when true).
+    pub anisotropy: bool,
+    /// G-buffer position storage and normal encoding (`POSITION_MODE`, `NORMAL_MODE`).
+    pub gbuffer: GbufferSettings,
+    /// The cost breakdown's input floor: reads the inputs, no shading (`INPUT_FLOOR`).
+    pub input_floor: bool,
+}
+
+impl LightingVariant {
+    /// The pipeline-overridable constants of `lighting.wgsl`, by name, for this variant.
+    pub fn constants(&self) -> Vec<(String, f64)> {
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        let (kind, filter) = match self.shadow {
+            None => (0.0, 0.0),
+            Some((kind, filter)) => (
+                match kind {
+                    ShadowKind::Directional => 1.0,
+                    ShadowKind::Point => 2.0,
+                },
+                f64::from(shadow_filter_code(filter)),
+            ),
+        };
+        let position = match self.gbuffer.position {
+            PositionStorage::CameraRelative => 0.0,
+            PositionStorage::World => 1.0,
+            PositionStorage::Depth => 2.0,
+        };
+        let normal = match self.gbuffer.normal {
+            NormalEncoding::Fp16 => 0.0,
+            NormalEncoding::Octahedral => 1.0,
+        };
+        [
+            ("SHADOW_KIND", kind),
+            ("SHADOW_FILTER", filter),
+            ("LIGHT_COUNT", f64::from(self.lights)),
+            ("DIRECTIONAL_LIGHTS", flag(self.directional)),
+            ("POINT_LIGHTS", flag(self.point)),
+            ("IBL", flag(self.ibl)),
+            ("CLEARCOAT", flag(self.clearcoat)),
+            ("ANISOTROPY", flag(self.anisotropy)),
+            ("POSITION_MODE", position),
+            ("NORMAL_MODE", normal),
+            ("INPUT_FLOOR", flag(self.input_floor)),
+        ]
+        .into_iter()
+        .map(|(name, value)| (name.to_owned(), value))
+        .collect()
+    }
+}
+
+impl fmt::Display for LightingVariant {
+    /// e.g. `1 directional, shadow directional pcf3, clearcoat, gbuffer camera-relative/fp16`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let types = match (self.directional, self.point) {
+            (true, true) => " directional+point",
+            (true, false) => " directional",
+            (false, true) => " point",
+            (false, false) => "",
+        };
+        write!(f, "{}{types} light(s)", self.lights)?;
+        if let Some((kind, filter)) = self.shadow {
+            let kind = match kind {
+                ShadowKind::Directional => "directional",
+                ShadowKind::Point => "point",
+            };
+            write!(f, ", shadow {kind} {}", filter.name())?;
+        }
+        for (on, name) in [
+            (self.ibl, "ibl"),
+            (self.clearcoat, "clearcoat"),
+            (self.anisotropy, "anisotropy"),
+            (self.input_floor, "input floor"),
+        ] {
+            if on {
+                write!(f, ", {name}")?;
+            }
+        }
+        write!(f, ", gbuffer {}", self.gbuffer.name())
+    }
+}
+
+/// `SHADOW_FILTER`'s code for a filter (also `ShadowUniforms.map.x`).
+pub fn shadow_filter_code(filter: ShadowFilter) -> u32 {
+    match filter {
+        ShadowFilter::Hard => 0,
+        ShadowFilter::Pcf3 => 1,
+        ShadowFilter::Soft => 2,
+        ShadowFilter::SoftFull => 3,
+        ShadowFilter::SoftReference => 4,
+        ShadowFilter::Vsm => 5,
+        ShadowFilter::Vogel => 6,
+    }
+}
+
+/// One full-screen draw of a lighting pass: the scene lights it shades and its variant.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightingDraw {
+    /// Indices into the scene's lights, in uniform-slot order.
+    pub lights: Vec<usize>,
+    /// The shadowed light (then the only one, in slot 0), if any.
+    pub shadowed: Option<usize>,
+    /// Whether this is the pass's first draw (ambient, IBL and unlit albedo are added once).
+    pub first: bool,
+    /// Its shader variant.
+    pub variant: LightingVariant,
+}
+
+/// One lighting pass: a model and its draws.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightingPass {
+    /// The lighting model.
+    pub model: LightingModel,
+    /// Its draws, in order.
+    pub draws: Vec<LightingDraw>,
+}
+
+/// A part of the lighting passes' work that the bench's cost breakdown takes away, to time the
+/// pass without it (`harness bench --breakdown`). Images rendered with one are not the scene's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightingFeature {
+    /// Every draw's shading: the draws only read their inputs (the input floor).
+    Shading,
+    /// Image-based lighting.
+    Ibl,
+    /// Shadow lookups (the lights stay, unshadowed).
+    Shadows,
+    /// Clearcoat lobes.
+    Clearcoat,
+    /// One light (by scene index), with its shadow lookup.
+    Light(usize),
+}
+
+/// The draws of each lighting model: unshadowed lights 16 to a draw, then one draw per shadowed
+/// light (with its maps bound); at least one draw (ambient). Unlit gets one draw and no lights.
+fn lighting_passes(
+    scene: &Scene,
+    models: &[LightingModel],
+    any_casters: bool,
+) -> Vec<LightingPass> {
+    let shadowed: Vec<usize> = (0..scene.lights.len())
+        .filter(|&i| any_casters && scene.lights[i].casts_shadows())
+        .collect();
+    let plain: Vec<usize> = (0..scene.lights.len())
+        .filter(|i| !shadowed.contains(i))
+        .collect();
+    let mut batches: Vec<(Vec<usize>, Option<usize>)> = plain
+        .chunks(MAX_LIGHTS_PER_DRAW)
+        .map(|c| (c.to_vec(), None))
+        .collect();
+    batches.extend(shadowed.iter().map(|&i| (vec![i], Some(i))));
+    if batches.is_empty() {
+        batches.push((vec![], None));
+    }
+    let ibl = scene
+        .environment
+        .as_ref()
+        .is_some_and(|e| e.intensity * scene.quality.exposure > 0.0);
+    models
+        .iter()
+        .map(|&model| {
+            let materials = || {
+                scene
+                    .objects
+                    .iter()
+                    .filter(move |o| o.lighting == model)
+                    .map(|o| &o.material)
+            };
+            let pbr = model == LightingModel::Pbr;
+            let base = LightingVariant {
+                lights: 0,
+                directional: false,
+                point: false,
+                shadow: None,
+                ibl: false,
+                clearcoat: pbr
+                    && materials().any(|m| m.clearcoat != 0.0 || m.clearcoat_map.is_some()),
+                anisotropy: pbr && materials().any(|m| m.anisotropy != 0.0),
+                gbuffer: scene.quality.gbuffer,
+                input_floor: false,
+            };
+            let draws = if model == LightingModel::Unlit {
+                vec![LightingDraw {
+                    lights: vec![],
+                    shadowed: None,
+                    first: true,
+                    variant: base,
+                }]
+            } else {
+                batches
+                    .iter()
+                    .enumerate()
+                    .map(|(index, (lights, shadowed))| {
+                        let mut draw = LightingDraw {
+                            lights: lights.clone(),
+                            shadowed: *shadowed,
+                            first: index == 0,
+                            variant: LightingVariant {
+                                ibl: ibl && index == 0,
+                                ..base
+                            },
+                        };
+                        draw.specialise(scene);
+                        draw
+                    })
+                    .collect()
+            };
+            LightingPass { model, draws }
+        })
+        .collect()
+}
+
+impl LightingDraw {
+    /// Sets the light-dependent part of the variant from `lights` and `shadowed`.
+    fn specialise(&mut self, scene: &Scene) {
+        let light = |i: usize| &scene.lights[i];
+        self.variant.lights = self.lights.len() as u32;
+        self.variant.directional = self
+            .lights
+            .iter()
+            .any(|&i| matches!(light(i), Light::Directional { .. }));
+        self.variant.point = self
+            .lights
+            .iter()
+            .any(|&i| matches!(light(i), Light::Point { .. }));
+        self.variant.shadow = self.shadowed.and_then(|i| match light(i) {
+            Light::Directional { shadow, .. } => {
+                shadow.map(|s| (ShadowKind::Directional, s.filter))
+            }
+            Light::Point { shadow, .. } => shadow.map(|s| (ShadowKind::Point, s.filter)),
+        });
+    }
+}
+
+impl RenderPlan {
+    /// The draws of `model`'s lighting pass (empty if the plan has none).
+    pub fn lighting_draws(&self, model: LightingModel) -> &[LightingDraw] {
+        self.lighting
+            .iter()
+            .find(|p| p.model == model)
+            .map_or(&[], |p| &p.draws[..])
+    }
+
+    /// Takes `feature` out of every lighting pass (for the bench's cost breakdown): the frame
+    /// then times the passes without it. A light taken out leaves its draw, with no light.
+    pub fn remove_lighting_feature(&mut self, feature: LightingFeature, scene: &Scene) {
+        for pass in &mut self.lighting {
+            for draw in &mut pass.draws {
+                match feature {
+                    LightingFeature::Shading => draw.variant.input_floor = true,
+                    LightingFeature::Ibl => draw.variant.ibl = false,
+                    LightingFeature::Shadows => draw.shadowed = None,
+                    LightingFeature::Clearcoat => draw.variant.clearcoat = false,
+                    LightingFeature::Light(light) => {
+                        draw.lights.retain(|&i| i != light);
+                        if draw.shadowed == Some(light) {
+                            draw.shadowed = None;
+                        }
+                    }
+                }
+                if pass.model != LightingModel::Unlit {
+                    draw.specialise(scene);
+                }
+            }
+        }
     }
 }

@@ -247,7 +247,7 @@ pub struct Object {
 }
 
 /// How a shadow map is filtered.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ShadowFilter {
     /// One depth comparison (hard shadows).

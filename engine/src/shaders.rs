@@ -3,7 +3,9 @@
 //! wgpu consumes WGSL directly. The GL backend gets GLSL 4.50 core from naga, with explicit
 //! `layout(binding = n)`: WGSL `@group(0) @binding(n)` becomes UBO binding `n` for uniform
 //! buffers and texture unit `n` for textures; a sampler is bound (with `glBindSampler`) to the
-//! unit of the texture it is used with, found from naga's reflection info.
+//! unit of the texture it is used with, found from naga's reflection info. Pipeline-overridable
+//! constants (WGSL `override`) are resolved by naga before the GLSL writer, as wgpu does for its
+//! backends, so the GL driver compiles the specialised code only.
 
 use naga::back::glsl;
 use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
@@ -136,23 +138,34 @@ pub struct GlslStage {
     pub sampler_units: Vec<(u32, Option<u32>)>,
 }
 
-/// Translates one entry point to GLSL 4.50 core with explicit bindings.
+/// Translates one entry point to GLSL 4.50 core with explicit bindings, with the module's
+/// `override` constants set from `constants` (by name; the rest keep their defaults).
 pub fn to_glsl(
     module: &ValidatedModule,
     stage: naga::ShaderStage,
     entry: &str,
+    constants: &[(String, f64)],
 ) -> Result<GlslStage, ShaderError> {
     let err = |message: String| ShaderError::Translate {
         name: module.name.clone(),
         entry: entry.to_owned(),
         message,
     };
+    let mut values = naga::back::PipelineConstants::default();
+    values.extend(constants.iter().cloned());
+    let (ir, info) = naga::back::pipeline_constants::process_overrides(
+        &module.module,
+        &module.info,
+        Some((stage, entry)),
+        &values,
+    )
+    .map_err(|e| err(format!("override constants: {e}")))?;
     let options = glsl::Options {
         version: glsl::Version::Desktop(450),
         // No y-flip or depth remap here: the GL backend sets glClipControl(UPPER_LEFT,
         // ZERO_TO_ONE), which gives wgpu's conventions in fixed function.
         writer_flags: glsl::WriterFlags::empty(),
-        binding_map: identity_binding_map(&module.module),
+        binding_map: identity_binding_map(&ir),
         zero_initialize_workgroup_memory: true,
     };
     let pipeline_options = glsl::PipelineOptions {
@@ -163,8 +176,8 @@ pub fn to_glsl(
     let mut source = String::new();
     let mut writer = glsl::Writer::new(
         &mut source,
-        &module.module,
-        &module.info,
+        &ir,
+        &info,
         &options,
         &pipeline_options,
         naga::proc::BoundsCheckPolicies::default(),
@@ -172,10 +185,7 @@ pub fn to_glsl(
     .map_err(|e| err(e.to_string()))?;
     let reflection = writer.write().map_err(|e| err(e.to_string()))?;
     let binding_of = |var: naga::Handle<naga::GlobalVariable>| {
-        module.module.global_variables[var]
-            .binding
-            .as_ref()
-            .map(|b| b.binding)
+        ir.global_variables[var].binding.as_ref().map(|b| b.binding)
     };
     let mut sampler_units = Vec::new();
     for mapping in reflection.texture_mapping.values() {
@@ -215,7 +225,8 @@ mod tests {
                 source.name
             );
             for ep in &module.module.entry_points {
-                let glsl = to_glsl(&module, ep.stage, &ep.name).unwrap_or_else(|e| panic!("{e}"));
+                let glsl =
+                    to_glsl(&module, ep.stage, &ep.name, &[]).unwrap_or_else(|e| panic!("{e}"));
                 assert!(
                     glsl.source.starts_with("#version 450 core"),
                     "{}::{} did not produce GLSL 450 core",

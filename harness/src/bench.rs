@@ -8,6 +8,12 @@
 //! depth, timed the same way in the same run. The ratio pass / floor is what compares across
 //! machines; the milliseconds do not.
 //!
+//! A lighting pass has a second, more honest floor: its *input floor*, the same pass (same
+//! routing, same draws) with every draw's shading replaced by reading its inputs (the G-buffer
+//! targets, and depth where positions come from it) and writing their sum. Pass / input floor is
+//! the cost of shading alone. `harness bench --breakdown` goes further and times each lighting
+//! pass with one part of its work taken away at a time ([`breakdown`]).
+//!
 //! `harness bench` prints this per scene and backend, and the criterion benchmarks in `benches/`
 //! use the same [`Floors`] and [`pass_time`].
 
@@ -19,8 +25,9 @@ use engine::backend::{
     DepthAttachment, DepthState, Draw, Handle, LoadOp, Pipeline, PipelineDesc, RenderPass,
     ResourceScope, ShaderDesc, Subresource, Texture, TextureDesc, Topology,
 };
+use engine::plan::{LightingFeature, PassKind};
 use engine::plan::{PassSpec, RenderPlan};
-use engine::renderer::{self, Readback};
+use engine::renderer::{self, Faults, Readback};
 use engine::scene::Scene;
 use engine::shaders;
 
@@ -58,6 +65,10 @@ pub struct PassBench {
     pub floor_ms: Option<f64>,
     /// `median_ms / floor_ms`.
     pub ratio: Option<f64>,
+    /// Lighting passes: median GPU time of the pass reading its inputs and shading nothing, ms.
+    pub input_floor_ms: Option<f64>,
+    /// `median_ms / input_floor_ms`.
+    pub input_ratio: Option<f64>,
 }
 
 /// Timing of one scene on one backend.
@@ -310,6 +321,7 @@ impl Floors {
                             topology: Topology::TriangleList,
                             cull: CullMode::None,
                             geometry: None,
+                            constants: vec![],
                         },
                     )?;
                     pipelines.insert(key, p);
@@ -381,22 +393,27 @@ impl Floors {
 }
 
 /// Renders `scene` once to warm up, then `frames` times: each frame's pass timings and wall ms.
+/// With `without`, the lighting passes run without that part of their work.
 fn time_frames(
     backend: &mut dyn Backend,
     scene: &Scene,
     frames: usize,
+    without: Option<LightingFeature>,
 ) -> Result<(Vec<Vec<backend::PassTiming>>, Vec<f64>), BenchError> {
     let mut timings = Vec::with_capacity(frames);
     let mut wall = Vec::with_capacity(frames);
+    let faults = Faults {
+        remove_lighting: without,
+        ..Faults::default()
+    };
     for i in 0..=frames {
         let start = Instant::now();
-        let frame = renderer::render(backend, scene, Readback::Only(&[])).map_err(|e| {
-            BenchError::Render {
+        let frame = renderer::render_with_faults(backend, scene, Readback::Only(&[]), &faults)
+            .map_err(|e| BenchError::Render {
                 scene: scene.name.clone(),
                 backend: backend.kind().name().to_owned(),
                 message: e.to_string(),
-            }
-        })?;
+            })?;
         if i > 0 {
             wall.push(start.elapsed().as_secs_f64() * 1e3);
             timings.push(frame.timings);
@@ -450,7 +467,22 @@ pub fn bench_scene(
     let mut backend = backend::create(kind).map_err(backend_error)?;
     let frames = frames.max(1);
     let plan = RenderPlan::new(scene);
-    let (timings, wall) = time_frames(backend.as_mut(), scene, frames)?;
+    let (timings, wall) = time_frames(backend.as_mut(), scene, frames, None)?;
+    let has_lighting = plan
+        .passes
+        .iter()
+        .any(|p| matches!(p.kind, PassKind::Lighting(_)));
+    let input_floor_timings = if has_lighting {
+        time_frames(
+            backend.as_mut(),
+            scene,
+            frames,
+            Some(LightingFeature::Shading),
+        )?
+        .0
+    } else {
+        Vec::new()
+    };
     let floors = Floors::new(backend.as_mut(), &plan).map_err(backend_error)?;
     let mut passes = Vec::with_capacity(plan.passes.len());
     let mut floor_result = Ok(());
@@ -469,11 +501,16 @@ pub fn bench_scene(
             floor_times.remove(0);
         }
         let floor_ms = median(floor_times);
+        let input_floor_ms = matches!(spec.kind, PassKind::Lighting(_))
+            .then(|| median_pass_ms(&plan, &input_floor_timings, &spec.name))
+            .flatten();
         passes.push(PassBench {
             pass: spec.name.clone(),
             median_ms,
             floor_ms,
             ratio: median_ms.zip(floor_ms).map(|(p, f)| p / f),
+            input_floor_ms,
+            input_ratio: median_ms.zip(input_floor_ms).map(|(p, f)| p / f),
         });
     }
     floors.destroy(backend.as_mut());
@@ -497,12 +534,194 @@ pub fn bench_scene(
     })
 }
 
+/// One row of a lighting pass's cost breakdown.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct BreakdownRow {
+    /// What the row costs (e.g. `light 0 (directional, shadow pcf3)`).
+    pub what: String,
+    /// Median GPU ms: the input floor's own time, or the pass's time minus its time without
+    /// this part.
+    pub ms: Option<f64>,
+    /// Whether the row is part of the sum (false: a part of another row, shown indented).
+    pub summed: bool,
+}
+
+/// Where a lighting pass's time goes: its input floor, then each part of its work as the time
+/// the pass loses when that part alone is taken away.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PassBreakdown {
+    /// Scene name.
+    pub scene: String,
+    /// Backend name.
+    pub backend: String,
+    /// Plan pass name.
+    pub pass: String,
+    /// The pass's median GPU ms as it is.
+    pub total_ms: Option<f64>,
+    /// The rows, input floor first.
+    pub rows: Vec<BreakdownRow>,
+    /// Sum of the summed rows, ms.
+    pub sum_ms: Option<f64>,
+    /// `sum_ms / total_ms`: near 1 when the parts add up (the costs are separable).
+    pub sum_to_total: Option<f64>,
+}
+
+/// Times every lighting pass of `scene` on `kind` as it is and with one part taken away at a
+/// time: the input floor (no shading), IBL, each light (with its shadow lookup), and, as parts
+/// of those, shadow lookups and clearcoat. Each variant is `frames` frames after a warm-up.
+pub fn breakdown(
+    scene: &Scene,
+    kind: BackendKind,
+    frames: usize,
+    progress: impl Fn(&str),
+) -> Result<Vec<PassBreakdown>, BenchError> {
+    let mut backend = backend::create(kind).map_err(|e| BenchError::Backend {
+        backend: kind.name().to_owned(),
+        message: e.to_string(),
+    })?;
+    let frames = frames.max(1);
+    let plan = RenderPlan::new(scene);
+    let draws = || plan.lighting.iter().flat_map(|pass| &pass.draws);
+    let mut removals: Vec<(String, LightingFeature, bool)> = vec![(
+        "G-buffer reads (input floor)".to_owned(),
+        LightingFeature::Shading,
+        true,
+    )];
+    if draws().any(|d| d.variant.ibl) {
+        removals.push(("IBL".to_owned(), LightingFeature::Ibl, true));
+    }
+    for (index, light) in scene.lights.iter().enumerate() {
+        let shadow = draws()
+            .find(|d| d.shadowed == Some(index))
+            .and_then(|d| d.variant.shadow)
+            .map_or(String::new(), |(_, filter)| {
+                format!(", shadow {}", filter.name())
+            });
+        let kind = match light {
+            engine::scene::Light::Directional { .. } => "directional",
+            engine::scene::Light::Point { .. } => "point",
+        };
+        removals.push((
+            format!("light {index} ({kind}{shadow})"),
+            LightingFeature::Light(index),
+            true,
+        ));
+    }
+    if draws().any(|d| d.variant.shadow.is_some()) {
+        removals.push((
+            "  of which shadow lookups".to_owned(),
+            LightingFeature::Shadows,
+            false,
+        ));
+    }
+    if draws().any(|d| d.variant.clearcoat) {
+        removals.push((
+            "  of which clearcoat".to_owned(),
+            LightingFeature::Clearcoat,
+            false,
+        ));
+    }
+    progress("as it is");
+    let (full, _) = time_frames(backend.as_mut(), scene, frames, None)?;
+    let mut without = Vec::new();
+    for (what, feature, _) in &removals {
+        progress(&format!(
+            "without {}",
+            what.trim_start_matches("  of which ")
+        ));
+        without.push(time_frames(backend.as_mut(), scene, frames, Some(*feature))?.0);
+    }
+    let mut result = Vec::new();
+    for spec in plan
+        .passes
+        .iter()
+        .filter(|p| matches!(p.kind, PassKind::Lighting(_)))
+    {
+        let PassKind::Lighting(model) = spec.kind else {
+            continue;
+        };
+        let pass_draws = plan.lighting_draws(model);
+        // Only the parts this pass has (the removals are timed once for every pass).
+        let applies = |feature: LightingFeature| match feature {
+            LightingFeature::Shading => true,
+            LightingFeature::Ibl => pass_draws.iter().any(|d| d.variant.ibl),
+            LightingFeature::Shadows => pass_draws.iter().any(|d| d.variant.shadow.is_some()),
+            LightingFeature::Clearcoat => pass_draws.iter().any(|d| d.variant.clearcoat),
+            LightingFeature::Light(light) => pass_draws.iter().any(|d| d.lights.contains(&light)),
+        };
+        let total_ms = median_pass_ms(&plan, &full, &spec.name);
+        let rows: Vec<BreakdownRow> = removals
+            .iter()
+            .zip(&without)
+            .filter(|((_, feature, _), _)| applies(*feature))
+            .map(|((what, feature, summed), timings)| {
+                let variant_ms = median_pass_ms(&plan, timings, &spec.name);
+                let ms = if *feature == LightingFeature::Shading {
+                    variant_ms
+                } else {
+                    total_ms.zip(variant_ms).map(|(t, v)| t - v)
+                };
+                BreakdownRow {
+                    what: what.clone(),
+                    ms,
+                    summed: *summed,
+                }
+            })
+            .collect();
+        let sum_ms = rows
+            .iter()
+            .filter(|r| r.summed)
+            .map(|r| r.ms)
+            .sum::<Option<f64>>();
+        result.push(PassBreakdown {
+            scene: scene.name.clone(),
+            backend: kind.name().to_owned(),
+            pass: spec.name.clone(),
+            total_ms,
+            rows,
+            sum_ms,
+            sum_to_total: sum_ms.zip(total_ms).map(|(s, t)| s / t),
+        });
+    }
+    Ok(result)
+}
+
+/// A pass breakdown as a table.
+pub fn breakdown_table(b: &PassBreakdown) -> String {
+    let ms = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.2}"));
+    let share = |v: Option<f64>| {
+        v.zip(b.total_ms)
+            .map_or(String::new(), |(v, t)| format!("{:.0}%", 100.0 * v / t))
+    };
+    let mut out = format!(
+        "{} {} on {} (GPU ms; each part: the pass minus the pass without it)\n",
+        b.scene, b.pass, b.backend
+    );
+    for row in &b.rows {
+        out.push_str(&format!(
+            "  {:<44} {:>8} {:>6}\n",
+            row.what,
+            ms(row.ms),
+            share(row.ms)
+        ));
+    }
+    out.push_str(&format!(
+        "  {:<44} {:>8} {:>6}\n  {:<44} {:>8}\n",
+        "sum of the parts",
+        ms(b.sum_ms),
+        share(b.sum_ms),
+        "pass as it is",
+        ms(b.total_ms)
+    ));
+    out
+}
+
 /// One scene's timings as a table.
 pub fn table(bench: &SceneBench) -> String {
     let ms = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.2}"));
     let ratio = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.1}x"));
     let mut out = format!(
-        "{} on {} ({}x{}, median of {} frames, GPU ms)\n{:<22} {:>9} {:>9} {:>8}\n",
+        "{} on {} ({}x{}, median of {} frames, GPU ms)\n{:<22} {:>9} {:>9} {:>8} {:>12} {:>8}\n",
         bench.scene,
         bench.backend,
         bench.width,
@@ -511,15 +730,24 @@ pub fn table(bench: &SceneBench) -> String {
         "pass",
         "time",
         "floor",
+        "ratio",
+        "input floor",
         "ratio"
     );
     for p in &bench.passes {
+        let (input, input_ratio) = if p.input_floor_ms.is_some() {
+            (ms(p.input_floor_ms), ratio(p.input_ratio))
+        } else {
+            (String::new(), String::new())
+        };
         out.push_str(&format!(
-            "{:<22} {:>9} {:>9} {:>8}\n",
+            "{:<22} {:>9} {:>9} {:>8} {:>12} {:>8}\n",
             p.pass,
             ms(p.median_ms),
             ms(p.floor_ms),
-            ratio(p.ratio)
+            ratio(p.ratio),
+            input,
+            input_ratio
         ));
     }
     out.push_str(&format!(
@@ -643,7 +871,7 @@ pub fn series(
     for (value, scene, pass) in settings {
         progress(&format!("{name} {value}"));
         let plan = RenderPlan::new(&scene);
-        let (timings, _) = time_frames(backend.as_mut(), &scene, frames.max(1))?;
+        let (timings, _) = time_frames(backend.as_mut(), &scene, frames.max(1), None)?;
         points.push(SeriesPoint {
             series: name.to_owned(),
             value,

@@ -162,6 +162,11 @@ enum Command {
         /// or all (repeatable).
         #[arg(long = "series")]
         series: Vec<String>,
+        /// Instead of the pass table, where each lighting pass's time goes: its input floor
+        /// (reading the G-buffer, no shading), then the time it loses without IBL, without each
+        /// light, and (parts of those) without shadow lookups and clearcoat.
+        #[arg(long, conflicts_with = "series")]
+        breakdown: bool,
         /// Where to keep the results (bench.json, bench_series.json) for the check report.
         #[arg(long, default_value_os_t = default_out_dir())]
         out: PathBuf,
@@ -256,10 +261,13 @@ fn main() -> ExitCode {
             backends,
             frames,
             series,
+            breakdown,
             out,
             json,
         } => {
-            if series.is_empty() {
+            if breakdown {
+                bench_breakdown(&scenes, &backends, frames, json)
+            } else if series.is_empty() {
                 bench(&scenes, &backends, frames, &out, json)
             } else {
                 bench_series(&series, &backends, frames, &out, json)
@@ -1062,6 +1070,44 @@ fn bench_series(
     save_bench_json(out, harness::bench::SERIES_JSON, &text)?;
     if json {
         println!("{text}");
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `harness bench --breakdown`: each lighting pass's cost, part by part.
+fn bench_breakdown(
+    scenes: &[String],
+    backends: &[BackendKind],
+    frames: usize,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    let names: Vec<String> = if scenes.is_empty() {
+        engine::scene_file::canonical_scenes(&harness::scenes_dir())
+    } else {
+        scenes.to_vec()
+    };
+    let kinds: Vec<BackendKind> = if backends.is_empty() {
+        vec![BackendKind::Gl]
+    } else {
+        backends.to_vec()
+    };
+    let mut all = Vec::new();
+    for kind in kinds {
+        for name in &names {
+            let scene = harness::load_scene(name)?.scene;
+            let passes = harness::bench::breakdown(&scene, kind, frames, |what| {
+                eprintln!("  {} on {kind}: {what} ({frames} frames) ...", scene.name);
+            })?;
+            if !json {
+                for pass in &passes {
+                    println!("{}", harness::bench::breakdown_table(pass));
+                }
+            }
+            all.extend(passes);
+        }
+    }
+    if json {
+        println!("{}", serde_json::to_string_pretty(&all)?);
     }
     Ok(ExitCode::SUCCESS)
 }

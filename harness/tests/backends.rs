@@ -154,6 +154,7 @@ fn probe_pipeline(
             topology: Topology::TriangleList,
             cull: CullMode::Back,
             geometry: None,
+            constants: vec![],
         })
         .unwrap()
 }

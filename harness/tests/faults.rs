@@ -114,6 +114,9 @@ impl Backend for Faulty {
     fn live_resources(&self) -> usize {
         self.inner.live_resources()
     }
+    fn pipelines_compiled(&self) -> u64 {
+        self.inner.pipelines_compiled()
+    }
 }
 
 fn chess() -> engine::scene::Scene {

@@ -120,6 +120,7 @@ fn recreating_a_pipeline_keeps_memory_flat() {
                     topology: Topology::TriangleList,
                     cull: CullMode::None,
                     geometry: None,
+                    constants: vec![],
                 })
                 .unwrap();
             backend.destroy_pipeline(pipeline).unwrap();

@@ -273,3 +273,48 @@ fn gizmos_are_optional_and_only_touch_the_final_image() {
         assert!(changed > 50, "{kind}: gizmos changed only {changed} pixels");
     }
 }
+
+/// Specialisation: scenes with different features get different lighting pipelines (their
+/// variants differ, and rendering the second compiles new pipelines), and rendering a scene
+/// again compiles nothing new (every backend caches pipelines by shader, state and constants).
+#[test]
+fn lighting_variants_follow_the_scene_and_are_compiled_once() {
+    let chess = harness::load_scene("chess").unwrap().scene;
+    let ibl = harness::load_scene("ibl").unwrap().scene;
+    let variants = |scene: &Scene| {
+        let plan = engine::plan::RenderPlan::new(scene);
+        plan.lighting
+            .iter()
+            .flat_map(|pass| pass.draws.iter().map(|d| d.variant))
+            .collect::<Vec<_>>()
+    };
+    let (chess_variants, ibl_variants) = (variants(&chess), variants(&ibl));
+    // chess: a shadowed directional sun and a point light, clearcoat, no anisotropy; ibl: no
+    // lights, IBL, clearcoat and anisotropy.
+    assert!(chess_variants
+        .iter()
+        .any(|v| v.shadow.is_some() && v.lights == 1));
+    assert!(chess_variants.iter().all(|v| v.clearcoat && !v.anisotropy));
+    assert!(ibl_variants
+        .iter()
+        .all(|v| v.ibl && v.anisotropy && v.lights == 0));
+    assert!(chess_variants.iter().all(|v| !ibl_variants.contains(v)));
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        let before = backend.pipelines_compiled();
+        renderer::render(backend.as_mut(), &chess, Readback::Only(&[])).unwrap();
+        let after_chess = backend.pipelines_compiled();
+        assert!(after_chess > before, "{kind}: nothing compiled");
+        renderer::render(backend.as_mut(), &chess, Readback::Only(&[])).unwrap();
+        assert_eq!(
+            backend.pipelines_compiled(),
+            after_chess,
+            "{kind}: rendering chess again compiled pipelines"
+        );
+        renderer::render(backend.as_mut(), &ibl, Readback::Only(&[])).unwrap();
+        assert!(
+            backend.pipelines_compiled() > after_chess,
+            "{kind}: ibl's lighting variants came from chess's pipelines"
+        );
+    }
+}

@@ -538,6 +538,9 @@ pub struct PipelineDesc {
     /// [`Features::geometry_shaders`] is true accept one (the others return
     /// [`BackendError::Unsupported`](super::BackendError::Unsupported)).
     pub geometry: Option<GeometryStage>,
+    /// Values of the shader's pipeline-overridable constants (WGSL `override`), by name; every
+    /// stage sees the same list. Pipelines that differ only here are different pipelines.
+    pub constants: Vec<(String, f64)>,
 }
 
 /// A geometry stage. WGSL has none, so it is GLSL 4.50 core, for the GL backend only; it reads

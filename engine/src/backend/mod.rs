@@ -248,6 +248,10 @@ pub trait Backend {
 
     /// Number of live resources of all kinds (for leak checks).
     fn live_resources(&self) -> usize;
+
+    /// Pipelines compiled so far: a pipeline asked for again with the same shader and
+    /// descriptor (constants included) comes from the backend's cache and is not counted.
+    fn pipelines_compiled(&self) -> u64;
 }
 
 impl<'a> dyn Backend + 'a {

@@ -98,6 +98,7 @@ pub(super) fn pass(
             topology: Topology::LineList,
             cull: CullMode::None,
             geometry: None,
+            constants: vec![],
         },
     )?;
     let uniform = scope.buffer(

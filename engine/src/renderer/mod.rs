@@ -22,8 +22,8 @@ use glam::{DMat4, DVec3, Mat3, Mat4};
 use crate::backend::*;
 use crate::image::Image;
 use crate::mesh::{MeshData, Vertex};
-use crate::plan::{self, MaskChannel, PassKind, RenderPlan, MAX_LIGHTS_PER_DRAW};
-use crate::scene::{Light, LightingModel, Scene, ToneMap, Transform};
+use crate::plan::{self, LightingFeature, MaskChannel, PassKind, RenderPlan};
+use crate::scene::{Light, Scene, ToneMap, Transform};
 use crate::shaders;
 
 pub use uniforms::{ambient_radiance, light_uniforms};
@@ -108,8 +108,9 @@ impl Frame {
     }
 }
 
-/// Deliberate faults, for the harness's mutation self-test (proof that the golden tolerances
-/// catch a broken pass). All off by default; [`render`] never sets them.
+/// Deliberate departures from the scene: faults for the harness's mutation self-test (proof that
+/// the golden tolerances catch a broken pass), and lighting work taken away for the bench's cost
+/// breakdown. All off by default; [`render`] never sets them.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Faults {
     /// The geometry pass writes albedo with red and blue swapped.
@@ -117,6 +118,9 @@ pub struct Faults {
     /// The tone-mapping pass scales the light buffer by this before its curve (a fault in the
     /// last pass only: the light buffer stays as it was).
     pub tonemap_input_scale: Option<f32>,
+    /// The lighting passes run without this part of their work (see
+    /// [`RenderPlan::remove_lighting_feature`]).
+    pub remove_lighting: Option<LightingFeature>,
 }
 
 /// Renders `scene` and reads back the requested outputs. Everything created is destroyed before
@@ -137,7 +141,10 @@ pub fn render_with_faults(
     faults: &Faults,
 ) -> Result<Frame, RenderError> {
     validate(scene)?;
-    let plan = RenderPlan::new(scene);
+    let mut plan = RenderPlan::new(scene);
+    if let Some(feature) = faults.remove_lighting {
+        plan.remove_lighting_feature(feature, scene);
+    }
     let wanted: Vec<String> = match readback {
         Readback::All => plan
             .target_names()
@@ -397,11 +404,10 @@ struct GpuMesh {
 
 type Outputs = (BTreeMap<String, Image>, Vec<PassTiming>);
 
-/// One lighting draw: up to 16 unshadowed lights, or one shadowed light with its maps.
+/// The resources of one lighting draw ([`plan::LightingDraw`]): its lights' uniforms, and the
+/// maps of its shadowed light (placeholders when it has none).
 struct LightDraw {
     lights: Vec<uniforms::LightData>,
-    /// The shadowed light's index in the scene, if this draw has one.
-    shadow_light: Option<usize>,
     shadow_map: Handle<Texture>,
     /// The VSM moments (a placeholder unless the light's filter is `vsm`).
     moments: Handle<Texture>,
@@ -469,6 +475,7 @@ fn fullscreen_pipeline(
         topology: Topology::TriangleList,
         cull: CullMode::None,
         geometry: None,
+        constants: vec![],
     }
 }
 
@@ -671,6 +678,7 @@ fn record_and_submit(
             topology: Topology::TriangleList,
             cull: CullMode::Back,
             geometry: None,
+            constants: vec![],
         },
     )?;
     let mask_pipeline = scope.pipeline(
@@ -704,6 +712,7 @@ fn record_and_submit(
             topology: Topology::TriangleList,
             cull: CullMode::Back,
             geometry: None,
+            constants: vec![],
         },
     )?;
     let mut geometry_draws = Vec::new();
@@ -1001,15 +1010,8 @@ fn record_and_submit(
         BufferUsage::Storage,
         bytemuck::cast_slice(&shadows::shadow_uniforms(None)),
     )?;
-    let unshadowed = |lights: Vec<uniforms::LightData>| LightDraw {
-        lights,
-        shadow_light: None,
-        shadow_map: no_shadow_map,
-        moments: no_moments,
-        shadow_uniform: no_shadow_uniform,
-    };
-    // Lighting draws: unshadowed lights 16 to a draw, then one draw per shadowed light.
-    let mut shadowed_draws = Vec::new();
+    // Each shadowed light's maps and shadow uniforms, by scene light index.
+    let mut shadow_bindings = HashMap::new();
     for view in &views {
         let uniform = scope.buffer(
             backend,
@@ -1018,55 +1020,103 @@ fn record_and_submit(
             bytemuck::cast_slice(&shadows::shadow_uniforms(Some(view))),
         )?;
         let moments = plan::shadow_moments_target_name(view.light);
-        shadowed_draws.push(LightDraw {
-            lights: vec![lights[view.light]],
-            shadow_light: Some(view.light),
-            shadow_map: targets[&plan::shadow_target_name(view.light)],
-            moments: targets.get(&moments).copied().unwrap_or(no_moments),
-            shadow_uniform: uniform,
-        });
+        shadow_bindings.insert(
+            view.light,
+            (
+                targets[&plan::shadow_target_name(view.light)],
+                targets.get(&moments).copied().unwrap_or(no_moments),
+                uniform,
+            ),
+        );
     }
-    let plain: Vec<uniforms::LightData> = lights
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| !views.iter().any(|v| v.light == *i))
-        .map(|(_, l)| *l)
-        .collect();
-    let mut light_draws: Vec<LightDraw> = plain
-        .chunks(MAX_LIGHTS_PER_DRAW)
-        .map(|c| unshadowed(c.to_vec()))
-        .collect();
-    light_draws.extend(shadowed_draws);
-    if light_draws.is_empty() {
-        light_draws.push(unshadowed(vec![]));
-    }
-    for channel in &plan.mask_channels {
-        let model = channel.model;
-        let pipeline = scope.pipeline(
-            backend,
-            &fullscreen_pipeline(
-                &format!("lighting {model}"),
+    // The resources of one of the plan's lighting draws.
+    let light_draw = |draw: &plan::LightingDraw| {
+        let (shadow_map, moments, shadow_uniform) = draw
+            .shadowed
+            .and_then(|light| shadow_bindings.get(&light).copied())
+            .unwrap_or((no_shadow_map, no_moments, no_shadow_uniform));
+        LightDraw {
+            lights: draw.lights.iter().map(|&i| lights[i]).collect(),
+            shadow_map,
+            moments,
+            shadow_uniform,
+        }
+    };
+    // One pipeline per (entry point, variant, routed or not), created on first use.
+    let mut lighting_pipelines: HashMap<String, Handle<Pipeline>> = HashMap::new();
+    let mut lighting_pipeline = |scope: &mut ResourceScope,
+                                 backend: &mut dyn Backend,
+                                 entry: &str,
+                                 variant: &plan::LightingVariant,
+                                 routed: bool|
+     -> Result<Handle<Pipeline>, RenderError> {
+        let key = format!("{entry} {variant:?} {routed}");
+        if let Some(&pipeline) = lighting_pipelines.get(&key) {
+            return Ok(pipeline);
+        }
+        let blend = routed.then_some(BlendState::ADDITIVE);
+        let desc = PipelineDesc {
+            depth: routed.then_some(DepthState {
+                format: TextureFormat::Depth32Float,
+                write: false,
+                compare: CompareFunction::Equal,
+            }),
+            constants: variant.constants(),
+            ..fullscreen_pipeline(
+                &format!("lighting {entry} ({variant})"),
                 lighting_shader,
-                model.entry_point(),
+                entry,
                 lighting_bindings.clone(),
                 TextureFormat::Rgba16Float,
-                Some(BlendState::ADDITIVE),
-            ),
-        )?;
-        let unlit_draw = [unshadowed(vec![])];
-        let batches = if model == LightingModel::Unlit {
-            &unlit_draw[..]
-        } else {
-            &light_draws[..]
+                blend,
+            )
         };
+        let pipeline = scope.pipeline(backend, &desc)?;
+        lighting_pipelines.insert(key, pipeline);
+        Ok(pipeline)
+    };
+    // Routing: marks the pass's model's pixels at depth 0 in the cleared routing target; it
+    // adds zero to the light buffer (a pass's pipelines must all match its attachments).
+    let route_pipeline = if plan.lighting.is_empty() {
+        None
+    } else {
+        Some(scope.pipeline(
+            backend,
+            &PipelineDesc {
+                depth: Some(DepthState {
+                    format: TextureFormat::Depth32Float,
+                    write: true,
+                    compare: CompareFunction::Always,
+                }),
+                ..fullscreen_pipeline(
+                    "lighting route",
+                    lighting_shader,
+                    "fs_route",
+                    vec![
+                        BindingLayout {
+                            binding: 0,
+                            kind: BindingKind::StorageBuffer,
+                        },
+                        texture_layout(6),
+                    ],
+                    TextureFormat::Rgba16Float,
+                    Some(BlendState::ADDITIVE),
+                )
+            },
+        )?)
+    };
+    for (channel, pass) in plan.mask_channels.iter().zip(&plan.lighting) {
+        let model = channel.model;
+        let mask = mask_targets[channel.target];
         let mut draws = Vec::new();
-        for (index, draw) in batches.iter().enumerate() {
+        for (index, draw) in pass.draws.iter().enumerate() {
+            let resources = light_draw(draw);
             let data = uniforms::lighting_uniforms(
                 scene,
                 &camera,
                 *channel,
-                &draw.lights,
-                index == 0,
+                &resources.lights,
+                draw.first,
                 ibl_textures.max_lod,
             );
             let uniform = scope.buffer(
@@ -1075,7 +1125,20 @@ fn record_and_submit(
                 BufferUsage::Storage,
                 bytemuck::cast_slice(&data),
             )?;
-            let bindings = lighting_bind_group(uniform, mask_targets[channel.target], draw);
+            if index == 0 {
+                if let Some(route) = route_pipeline {
+                    draws.push(fullscreen_draw(
+                        route,
+                        vec![
+                            binding(0, BindingResource::Buffer(uniform)),
+                            binding(6, BindingResource::Texture(mask)),
+                        ],
+                    ));
+                }
+            }
+            let pipeline =
+                lighting_pipeline(scope, backend, model.entry_point(), &draw.variant, true)?;
+            let bindings = lighting_bind_group(uniform, mask, &resources);
             draws.push(fullscreen_draw(pipeline, bindings));
         }
         let load = if light_cleared {
@@ -1091,7 +1154,11 @@ fn record_and_submit(
                 .find(|p| p.kind == PassKind::Lighting(model))
                 .map_or_else(|| format!("lighting_{model}"), |p| p.name.clone()),
             color_attachments: vec![attachment(light_buffer, load)],
-            depth_attachment: None,
+            depth_attachment: Some(DepthAttachment {
+                texture: target(plan::ROUTE),
+                subresource: Subresource::default(),
+                load: LoadOp::Clear(1.0),
+            }),
             viewports: vec![],
             draws,
         });
@@ -1108,36 +1175,26 @@ fn record_and_submit(
     }
 
     // Debug: each shadowed light's shadow term, through the lighting shader's own lookup.
-    if scene.quality.debug_shadow_terms && !views.is_empty() {
-        let pipeline = scope.pipeline(
-            backend,
-            &fullscreen_pipeline(
-                "shadow term",
-                lighting_shader,
-                "fs_shadow_term",
-                lighting_bindings.clone(),
-                TextureFormat::Rgba16Float,
-                None,
-            ),
-        )?;
+    if scene.quality.debug_shadow_terms {
         for view in &views {
             let name = plan::shadow_term_target_name(view.light);
-            let Some(draw) = light_draws
-                .iter()
-                .find(|d| d.shadow_light == Some(view.light))
-            else {
+            let mut draws = plan.lighting.iter().flat_map(|pass| &pass.draws);
+            let Some(draw) = draws.find(|d| d.shadowed == Some(view.light)) else {
                 continue;
             };
+            let pipeline =
+                lighting_pipeline(scope, backend, "fs_shadow_term", &draw.variant, false)?;
+            let resources = light_draw(draw);
             let channel = plan.mask_channels[0];
             let data =
-                uniforms::lighting_uniforms(scene, &camera, channel, &draw.lights, false, 0.0);
+                uniforms::lighting_uniforms(scene, &camera, channel, &resources.lights, false, 0.0);
             let uniform = scope.buffer(
                 backend,
                 &format!("{name} uniforms"),
                 BufferUsage::Storage,
                 bytemuck::cast_slice(&data),
             )?;
-            let bindings = lighting_bind_group(uniform, mask_targets[0], draw);
+            let bindings = lighting_bind_group(uniform, mask_targets[0], &resources);
             passes.push(RenderPass {
                 name: name.clone(),
                 color_attachments: vec![attachment(target(&name), LoadOp::Clear([0.0; 4]))],

@@ -215,15 +215,7 @@ pub fn shadow_uniforms(view: Option<&ShadowView>) -> Vec<f32> {
         (view.size, view.size)
     };
     data.extend_from_slice(&[
-        match s.filter {
-            ShadowFilter::Hard => 0.0,
-            ShadowFilter::Pcf3 => 1.0,
-            ShadowFilter::Soft => 2.0,
-            ShadowFilter::SoftFull => 3.0,
-            ShadowFilter::SoftReference => 4.0,
-            ShadowFilter::Vsm => 5.0,
-            ShadowFilter::Vogel => 6.0,
-        },
+        crate::plan::shadow_filter_code(s.filter) as f32,
         1.0 / w as f32,
         1.0 / h as f32,
         view.texel_world as f32,
@@ -341,6 +333,7 @@ pub(super) fn record(
         topology: Topology::TriangleList,
         cull: CullMode::None,
         geometry: None,
+        constants: vec![],
     };
     let depth_pipeline = scope.pipeline(backend, &caster_pipeline(false))?;
     let layered_pipeline = if scene.quality.point_shadows == PointShadowPass::GeometryShader

@@ -14,7 +14,10 @@ mod context;
 mod conv;
 pub(crate) mod wgpu_interop;
 
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
 use std::marker::PhantomData;
+use std::rc::Rc;
 use std::sync::{Arc, Mutex};
 
 use glow::HasContext;
@@ -36,7 +39,22 @@ struct GlBuffer {
     size: u64,
 }
 
+/// A validated module and the hash of its name and source (the caches' key).
+struct GlShader {
+    module: Rc<ValidatedModule>,
+    key: u64,
+}
+
+/// A linked program, shared by every pipeline made from the same stages and constants.
+#[derive(Clone)]
+struct LinkedProgram {
+    program: glow::Program,
+    /// (texture unit = texture binding, binding of the sampler used with it).
+    sampler_units: Vec<(u32, Option<u32>)>,
+}
+
 struct GlPipeline {
+    /// Owned by the program cache, deleted when the backend is dropped.
     program: glow::Program,
     vao: glow::VertexArray,
     desc: PipelineDesc,
@@ -55,8 +73,15 @@ pub struct GlBackend {
     textures: Pool<GlTexture>,
     buffers: Pool<GlBuffer>,
     samplers: Pool<glow::Sampler>,
-    shaders: Pool<ValidatedModule>,
+    shaders: Pool<GlShader>,
     pipelines: Pool<GlPipeline>,
+    /// Validated modules and linked programs by source, stages and constants, kept for the
+    /// backend's life as a driver's shader cache would be: renders ask for the same pipelines
+    /// every frame, and llvmpipe takes tens of milliseconds to compile a lighting variant.
+    module_cache: HashMap<u64, Rc<ValidatedModule>>,
+    program_cache: HashMap<String, LinkedProgram>,
+    /// Programs linked (cache misses), for [`Backend::pipelines_compiled`].
+    pipelines_compiled: u64,
     _not_send: PhantomData<*const ()>,
 }
 
@@ -145,6 +170,9 @@ impl GlBackend {
             samplers: Pool::new("sampler"),
             shaders: Pool::new("shader"),
             pipelines: Pool::new("pipeline"),
+            module_cache: HashMap::new(),
+            program_cache: HashMap::new(),
+            pipelines_compiled: 0,
             _not_send: PhantomData,
         })
     }
@@ -170,6 +198,97 @@ impl GlBackend {
         } else {
             Err(driver_error(what, messages.join("; ")))
         }
+    }
+
+    /// Translates, compiles and links a pipeline's stages with its constants.
+    fn link(&self, desc: &PipelineDesc) -> Result<LinkedProgram> {
+        let module = &self.shaders.get(desc.shader)?.module;
+        let translate = |stage, entry: &str| {
+            shaders::to_glsl(module, stage, entry, &desc.constants).map_err(|e| {
+                BackendError::Shader {
+                    backend: BackendKind::Gl.name(),
+                    name: format!("{}::{entry}", module.name),
+                    message: e.to_string(),
+                }
+            })
+        };
+        let mut stages = vec![(
+            glow::VERTEX_SHADER,
+            desc.vertex_entry.as_str(),
+            translate(naga::ShaderStage::Vertex, &desc.vertex_entry)?,
+        )];
+        if let Some(entry) = &desc.fragment_entry {
+            stages.push((
+                glow::FRAGMENT_SHADER,
+                entry,
+                translate(naga::ShaderStage::Fragment, entry)?,
+            ));
+        }
+        let mut sampler_units: Vec<(u32, Option<u32>)> = stages
+            .iter()
+            .flat_map(|(_, _, s)| s.sampler_units.clone())
+            .collect();
+        sampler_units.sort();
+        sampler_units.dedup();
+        let mut sources: Vec<(u32, String, &str)> = stages
+            .iter()
+            .map(|(stage, entry, glsl)| {
+                (
+                    *stage,
+                    format!("{}::{entry}", module.name),
+                    glsl.source.as_str(),
+                )
+            })
+            .collect();
+        if let Some(geometry) = &desc.geometry {
+            sources.push((
+                glow::GEOMETRY_SHADER,
+                geometry.name.clone(),
+                geometry.glsl.as_str(),
+            ));
+        }
+        let mut compiled = Vec::new();
+        for (stage, name, source) in &sources {
+            match self.compile(*stage, name, source) {
+                Ok(shader) => compiled.push(shader),
+                Err(e) => {
+                    // SAFETY: see module docs; these shaders were created above.
+                    unsafe { compiled.into_iter().for_each(|s| self.gl.delete_shader(s)) };
+                    return Err(e);
+                }
+            }
+        }
+        let gl = &self.gl;
+        // SAFETY: see module docs; the shaders were compiled above and are deleted once linked.
+        let program = unsafe {
+            let program = gl
+                .create_program()
+                .map_err(|e| driver_error(&desc.label, e))?;
+            for &shader in &compiled {
+                gl.attach_shader(program, shader);
+            }
+            gl.link_program(program);
+            for shader in compiled {
+                gl.detach_shader(program, shader);
+                gl.delete_shader(shader);
+            }
+            if !gl.get_program_link_status(program) {
+                let log = gl.get_program_info_log(program);
+                gl.delete_program(program);
+                return Err(BackendError::Shader {
+                    backend: BackendKind::Gl.name(),
+                    name: format!("{} ({})", module.name, desc.label),
+                    message: format!("GLSL link failed: {log}"),
+                });
+            }
+            gl.object_label(glow::PROGRAM, program.0.get(), Some(&desc.label));
+            program
+        };
+        self.check_errors(&format!("pipeline `{}`", desc.label))?;
+        Ok(LinkedProgram {
+            program,
+            sampler_units,
+        })
     }
 
     fn compile(&self, stage: u32, name: &str, source: &str) -> Result<glow::Shader> {
@@ -705,13 +824,26 @@ impl Backend for GlBackend {
     }
 
     fn create_shader(&mut self, desc: &ShaderDesc) -> Result<Handle<Shader>> {
-        let module =
-            shaders::validate(&desc.name, &desc.wgsl).map_err(|e| BackendError::Shader {
-                backend: BackendKind::Gl.name(),
-                name: desc.name.clone(),
-                message: e.to_string(),
-            })?;
-        Ok(self.shaders.insert(module))
+        let key = {
+            let mut hasher = std::collections::hash_map::DefaultHasher::new();
+            (&desc.name, &desc.wgsl).hash(&mut hasher);
+            hasher.finish()
+        };
+        let module = match self.module_cache.get(&key) {
+            Some(module) => module.clone(),
+            None => {
+                let module = Rc::new(shaders::validate(&desc.name, &desc.wgsl).map_err(|e| {
+                    BackendError::Shader {
+                        backend: BackendKind::Gl.name(),
+                        name: desc.name.clone(),
+                        message: e.to_string(),
+                    }
+                })?);
+                self.module_cache.insert(key, module.clone());
+                module
+            }
+        };
+        Ok(self.shaders.insert(GlShader { module, key }))
     }
 
     fn destroy_shader(&mut self, shader: Handle<Shader>) -> Result<()> {
@@ -720,84 +852,27 @@ impl Backend for GlBackend {
 
     fn create_pipeline(&mut self, desc: &PipelineDesc) -> Result<Handle<Pipeline>> {
         self.context.make_current()?;
-        let module = self.shaders.get(desc.shader)?;
-        let translate = |stage, entry: &str| {
-            shaders::to_glsl(module, stage, entry).map_err(|e| BackendError::Shader {
-                backend: BackendKind::Gl.name(),
-                name: format!("{}::{entry}", module.name),
-                message: e.to_string(),
-            })
+        let shader = self.shaders.get(desc.shader)?;
+        let cache_key = format!(
+            "{:x}|{}|{:?}|{:?}|{:?}",
+            shader.key,
+            desc.vertex_entry,
+            desc.fragment_entry,
+            desc.geometry.as_ref().map(|g| (&g.name, &g.glsl)),
+            desc.constants
+        );
+        let linked = match self.program_cache.get(&cache_key) {
+            Some(linked) => linked.clone(),
+            None => {
+                let linked = self.link(desc)?;
+                self.program_cache.insert(cache_key, linked.clone());
+                self.pipelines_compiled += 1;
+                linked
+            }
         };
-        let mut stages = vec![(
-            glow::VERTEX_SHADER,
-            desc.vertex_entry.as_str(),
-            translate(naga::ShaderStage::Vertex, &desc.vertex_entry)?,
-        )];
-        if let Some(entry) = &desc.fragment_entry {
-            stages.push((
-                glow::FRAGMENT_SHADER,
-                entry,
-                translate(naga::ShaderStage::Fragment, entry)?,
-            ));
-        }
-        let mut sampler_units: Vec<(u32, Option<u32>)> = stages
-            .iter()
-            .flat_map(|(_, _, s)| s.sampler_units.clone())
-            .collect();
-        sampler_units.sort();
-        sampler_units.dedup();
-        let mut sources: Vec<(u32, String, &str)> = stages
-            .iter()
-            .map(|(stage, entry, glsl)| {
-                (
-                    *stage,
-                    format!("{}::{entry}", module.name),
-                    glsl.source.as_str(),
-                )
-            })
-            .collect();
-        if let Some(geometry) = &desc.geometry {
-            sources.push((
-                glow::GEOMETRY_SHADER,
-                geometry.name.clone(),
-                geometry.glsl.as_str(),
-            ));
-        }
-        let mut compiled = Vec::new();
-        for (stage, name, source) in &sources {
-            match self.compile(*stage, name, source) {
-                Ok(shader) => compiled.push(shader),
-                Err(e) => {
-                    // SAFETY: see module docs; these shaders were created above.
-                    unsafe { compiled.into_iter().for_each(|s| self.gl.delete_shader(s)) };
-                    return Err(e);
-                }
-            }
-        }
         let gl = &self.gl;
-        // SAFETY: see module docs; the shaders were compiled above and are deleted once linked.
-        let (program, vao) = unsafe {
-            let program = gl
-                .create_program()
-                .map_err(|e| driver_error(&desc.label, e))?;
-            for &shader in &compiled {
-                gl.attach_shader(program, shader);
-            }
-            gl.link_program(program);
-            for shader in compiled {
-                gl.detach_shader(program, shader);
-                gl.delete_shader(shader);
-            }
-            if !gl.get_program_link_status(program) {
-                let log = gl.get_program_info_log(program);
-                gl.delete_program(program);
-                return Err(BackendError::Shader {
-                    backend: BackendKind::Gl.name(),
-                    name: format!("{} ({})", module.name, desc.label),
-                    message: format!("GLSL link failed: {log}"),
-                });
-            }
-            gl.object_label(glow::PROGRAM, program.0.get(), Some(&desc.label));
+        // SAFETY: see module docs; the VAO is created here and owned by the pipeline.
+        let vao = unsafe {
             let vao = gl
                 .create_vertex_array()
                 .map_err(|e| driver_error(&desc.label, e))?;
@@ -816,28 +891,25 @@ impl Backend for GlBackend {
                 }
             }
             gl.bind_vertex_array(None);
-            (program, vao)
+            vao
         };
         self.check_errors(&format!("pipeline `{}`", desc.label))?;
         Ok(self.pipelines.insert(GlPipeline {
-            program,
+            program: linked.program,
             vao,
             desc: desc.clone(),
-            sampler_units,
+            sampler_units: linked.sampler_units,
         }))
     }
 
     fn destroy_pipeline(&mut self, pipeline: Handle<Pipeline>) -> Result<()> {
         self.context.make_current()?;
         let p = self.pipelines.remove(pipeline)?;
-        // SAFETY: see module docs; removed from the pool, never used again.
-        unsafe {
-            self.gl.delete_program(p.program);
-            self.gl.delete_vertex_array(p.vao);
-        }
+        // SAFETY: see module docs; removed from the pool, never used again (its program stays
+        // in the program cache).
+        unsafe { self.gl.delete_vertex_array(p.vao) };
         Ok(())
     }
-
     fn submit(&mut self, passes: &[RenderPass]) -> Result<Vec<PassTiming>> {
         self.context.make_current()?;
         let gl = &self.gl;
@@ -973,6 +1045,10 @@ impl Backend for GlBackend {
             + self.shaders.len()
             + self.pipelines.len()
     }
+
+    fn pipelines_compiled(&self) -> u64 {
+        self.pipelines_compiled
+    }
 }
 
 impl Drop for GlBackend {
@@ -991,10 +1067,12 @@ impl Drop for GlBackend {
             self.textures.drain().for_each(|t| gl.delete_texture(t.raw));
             self.buffers.drain().for_each(|b| gl.delete_buffer(b.raw));
             self.samplers.drain().for_each(|s| gl.delete_sampler(s));
-            self.pipelines.drain().for_each(|p| {
-                gl.delete_program(p.program);
-                gl.delete_vertex_array(p.vao);
-            });
+            self.pipelines
+                .drain()
+                .for_each(|p| gl.delete_vertex_array(p.vao));
+            self.program_cache
+                .drain()
+                .for_each(|(_, linked)| gl.delete_program(linked.program));
             gl.finish();
         }
     }

@@ -68,6 +68,8 @@ pub struct WgpuBackend {
     /// distinct pipelines instead of the number of frames.
     module_cache: HashMap<u64, wgpu::ShaderModule>,
     pipeline_cache: HashMap<String, PipelineResource>,
+    /// Pipelines compiled (cache misses), for [`Backend::pipelines_compiled`].
+    pipelines_compiled: u64,
     depth_copy: Option<DepthCopy>,
 }
 
@@ -168,6 +170,7 @@ impl WgpuBackend {
             pipelines: Pool::new("pipeline"),
             module_cache: HashMap::new(),
             pipeline_cache: HashMap::new(),
+            pipelines_compiled: 0,
             depth_copy: None,
         })
     }
@@ -606,7 +609,7 @@ impl Backend for WgpuBackend {
         }
         let shader = self.shaders.get(desc.shader)?;
         let cache_key = format!(
-            "{:x}|{}|{}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
+            "{:x}|{}|{}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
             shader.key,
             desc.label,
             desc.vertex_entry,
@@ -616,7 +619,8 @@ impl Backend for WgpuBackend {
             desc.color_targets,
             desc.depth,
             desc.topology,
-            desc.cull
+            desc.cull,
+            desc.constants
         );
         if let Some(cached) = self.pipeline_cache.get(&cache_key) {
             let cached = cached.clone();
@@ -624,6 +628,15 @@ impl Backend for WgpuBackend {
         }
         let module = &shader.module;
         let context = format!("pipeline `{}`", desc.label);
+        let constants: Vec<(&str, f64)> = desc
+            .constants
+            .iter()
+            .map(|(name, value)| (name.as_str(), *value))
+            .collect();
+        let compilation_options = wgpu::PipelineCompilationOptions {
+            constants: &constants,
+            ..Default::default()
+        };
         let entries: Vec<wgpu::BindGroupLayoutEntry> = desc
             .bindings
             .iter()
@@ -694,7 +707,7 @@ impl Backend for WgpuBackend {
                     vertex: wgpu::VertexState {
                         module,
                         entry_point: Some(&desc.vertex_entry),
-                        compilation_options: Default::default(),
+                        compilation_options: compilation_options.clone(),
                         buffers: &vertex_buffers,
                     },
                     primitive: wgpu::PrimitiveState {
@@ -720,7 +733,7 @@ impl Backend for WgpuBackend {
                         .map(|entry| wgpu::FragmentState {
                             module,
                             entry_point: Some(entry),
-                            compilation_options: Default::default(),
+                            compilation_options: compilation_options.clone(),
                             targets: &targets,
                         }),
                     multiview_mask: None,
@@ -735,6 +748,7 @@ impl Backend for WgpuBackend {
             label: desc.label.clone(),
         };
         self.pipeline_cache.insert(cache_key, resource.clone());
+        self.pipelines_compiled += 1;
         Ok(self.pipelines.insert(resource))
     }
 
@@ -1012,5 +1026,9 @@ impl Backend for WgpuBackend {
             + self.samplers.len()
             + self.shaders.len()
             + self.pipelines.len()
+    }
+
+    fn pipelines_compiled(&self) -> u64 {
+        self.pipelines_compiled
     }
 }
