@@ -23,8 +23,12 @@
 // The draw's shadowed light (slot 0): 0 none, 1 directional, 2 point.
 override SHADOW_KIND: u32 = 0u;
 // Its filter: 0 hard, 1 3x3 PCF, 2 stratified soft, 3 stratified soft without early-out,
-// 4 converged soft reference (Vogel, 1024 samples), 5 variance shadow map, 6 Vogel disk.
+// 4 converged soft reference (Vogel, 1024 samples), 5 variance shadow map, 6 Vogel disk,
+// 7 one bilinear comparison, 8 four bilinear comparisons (3x3 tent); 7 and 8 are bound a
+// linear-filtering comparison sampler.
 override SHADOW_FILTER: u32 = 0u;
+// Samples of the Vogel-disk filters (6, and 4 at 1024), a constant for the same reason.
+override VOGEL_SAMPLES: u32 = 0u;
 // Lights in the draw (at most 16), and which types among them.
 override LIGHT_COUNT: u32 = 0u;
 override DIRECTIONAL_LIGHTS: bool = true;
@@ -78,9 +82,12 @@ struct LightingUniforms {
     lights: array<LightData, 16>,
 }
 
-// Read-only storage rather than uniform: Mesa 22.3's lavapipe would otherwise recompile this
-// shader for every draw, specialised on the values that steer its loops and branches.
-@group(0) @binding(0) var<storage, read> u: LightingUniforms;
+// A uniform buffer: llvmpipe and lavapipe load uniforms as scalars, where read-only storage
+// costs a bounds-checked load per pixel (measured: chess's lighting pass 46 ms with storage,
+// 13 ms with uniforms, on llvmpipe). Storage was used while the feature switches were uniform
+// values: lavapipe then recompiled the shader per draw, specialised on the values that steered
+// its branches; those are override constants now (see the top of this file).
+@group(0) @binding(0) var<uniform> u: LightingUniforms;
 @group(0) @binding(1) var gbuffer_position: texture_2d<f32>;
 @group(0) @binding(2) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(3) var gbuffer_tangent: texture_2d<f32>;
@@ -103,7 +110,8 @@ struct ShadowUniforms {
     // w = texel size in meters (directional) or per meter of distance (point).
     map: vec4<f32>,
     // x = soft radius (texels), y = reach of the filter in texels (scales the biases),
-    // z = samples of the Vogel-disk filters (1024 for the reference).
+    // z = samples of the Vogel-disk filters (1024 for the reference; the shader reads
+    // VOGEL_SAMPLES instead).
     soft: vec4<f32>,
     // VSM: x = minimum variance, y = light-bleeding reduction.
     vsm: vec4<f32>,
@@ -111,7 +119,7 @@ struct ShadowUniforms {
 
 @group(0) @binding(7) var shadow_map: texture_depth_2d;
 @group(0) @binding(8) var shadow_sampler: sampler_comparison;
-@group(0) @binding(9) var<storage, read> shadow: ShadowUniforms;
+@group(0) @binding(9) var<uniform> shadow: ShadowUniforms;
 // Stratified soft shadows: per-pixel jittered sample offsets (unit disk), 32x32 tile, 8 layers;
 // layer 2r + k holds two samples of ring r (ring 3 is the outer one) as (x, y, x, y).
 @group(0) @binding(10) var shadow_jitter: texture_2d_array<f32>;
@@ -217,7 +225,7 @@ fn shadow_soft(look: ShadowLookup, early_out: bool) -> f32 {
 // Soft filter on a golden-angle (Vogel) disk of soft.z samples, no jitter: the `vogel` filter,
 // and at 1024 samples the converged reference for sweeps.
 fn shadow_vogel(look: ShadowLookup) -> f32 {
-    let count = max(i32(shadow.soft.z), 1);
+    let count = max(i32(VOGEL_SAMPLES), 1);
     var sum = 0.0;
     for (var i = 0; i < count; i++) {
         let r = sqrt((f32(i) + 0.5) / f32(count));
@@ -254,8 +262,15 @@ fn shadow_lookup(look: ShadowLookup) -> f32 {
     if SHADOW_FILTER == 2u || SHADOW_FILTER == 3u {
         return shadow_soft(look, SHADOW_FILTER == 2u);
     }
-    if SHADOW_FILTER == 0u {
+    if SHADOW_FILTER == 0u || SHADOW_FILTER == 7u {
         return shadow_tap(look.uv, look.reference, look.bounds);
+    }
+    if SHADOW_FILTER == 8u {
+        let h = 0.5 * shadow.map.yz;
+        return 0.25 * (shadow_tap(look.uv + vec2<f32>(-h.x, -h.y), look.reference, look.bounds)
+            + shadow_tap(look.uv + vec2<f32>(h.x, -h.y), look.reference, look.bounds)
+            + shadow_tap(look.uv + vec2<f32>(-h.x, h.y), look.reference, look.bounds)
+            + shadow_tap(look.uv + vec2<f32>(h.x, h.y), look.reference, look.bounds));
     }
     var sum = 0.0;
     for (var y = -1; y <= 1; y++) {
@@ -318,8 +333,10 @@ fn shadow_visibility(s: Surface, l: vec3<f32>, light: LightData) -> f32 {
     return shadow_lookup(look);
 }
 
+// Invariant: the routing draw and the shading draws of a pass must produce the same depth (0)
+// for the equal-depth test.
 @vertex
-fn vs_fullscreen(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
+fn vs_fullscreen(@builtin(vertex_index) index: u32) -> @invariant @builtin(position) vec4<f32> {
     let corner = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u));
     return vec4<f32>(corner * 2.0 - 1.0, 0.0, 1.0);
 }
@@ -404,12 +421,7 @@ struct Incoming {
 
 fn incoming(light: LightData, s: Surface) -> Incoming {
     var result: Incoming;
-    // Only a draw with both types looks at the light's own type.
-    var directional = DIRECTIONAL_LIGHTS;
-    if DIRECTIONAL_LIGHTS && POINT_LIGHTS {
-        directional = light.position.w < 0.5;
-    }
-    if directional {
+    if DIRECTIONAL_LIGHTS && !POINT_LIGHTS {
         result.direction = light.position.xyz;
         result.radiance = light.color.rgb;
         return result;
@@ -421,6 +433,13 @@ fn incoming(light: LightData, s: Surface) -> Incoming {
     let ratio = min(distance / max(light.color.a, 1e-6), 1.0);
     let attenuation = max(0.0, 1.0 - pow(ratio, light.params.x));
     result.radiance = light.color.rgb * attenuation;
+    if DIRECTIONAL_LIGHTS {
+        // A draw with both types picks per light with a select, not a branch: lavapipe would
+        // compile a new shader for each draw to specialise a branch on uniform data.
+        let directional = light.position.w < 0.5;
+        result.direction = select(result.direction, light.position.xyz, directional);
+        result.radiance = select(result.radiance, light.color.rgb, directional);
+    }
     return result;
 }
 

@@ -487,6 +487,21 @@ impl fmt::Display for RenderPlan {
         for (i, p) in self.passes.iter().enumerate() {
             writeln!(f, "  {}. {:<21} {}", i + 1, p.name, p.detail)?;
             if let PassKind::Lighting(model) = p.kind {
+                if let Some(r) = self
+                    .lighting
+                    .iter()
+                    .find(|l| l.model == model)
+                    .and_then(|l| l.rect)
+                {
+                    writeln!(
+                        f,
+                        "       pixels {}..{} x {}..{} (its objects' screen bounds)",
+                        r.x,
+                        r.x + r.width,
+                        r.y,
+                        r.y + r.height
+                    )?;
+                }
                 for (d, draw) in self.lighting_draws(model).iter().enumerate() {
                     writeln!(f, "       draw {}: {}", d + 1, draw.variant)?;
                 }
@@ -524,6 +539,8 @@ pub struct LightingVariant {
     pub point: bool,
     /// The shadowed light in slot 0, its kind and filter (`SHADOW_KIND`, `SHADOW_FILTER`).
     pub shadow: Option<(ShadowKind, ShadowFilter)>,
+    /// Samples of the Vogel-disk filters (`VOGEL_SAMPLES`; 0 for the other filters).
+    pub vogel_samples: u32,
     /// Image-based lighting in this draw (`IBL`).
     pub ibl: bool,
     /// Some surface of the model has clearcoat (`CLEARCOAT`; the shader still branches per
@@ -563,6 +580,7 @@ impl LightingVariant {
         [
             ("SHADOW_KIND", kind),
             ("SHADOW_FILTER", filter),
+            ("VOGEL_SAMPLES", f64::from(self.vogel_samples)),
             ("LIGHT_COUNT", f64::from(self.lights)),
             ("DIRECTIONAL_LIGHTS", flag(self.directional)),
             ("POINT_LIGHTS", flag(self.point)),
@@ -595,6 +613,9 @@ impl fmt::Display for LightingVariant {
                 ShadowKind::Point => "point",
             };
             write!(f, ", shadow {kind} {}", filter.name())?;
+            if self.vogel_samples > 0 && filter == ShadowFilter::Vogel {
+                write!(f, " ({} samples)", self.vogel_samples)?;
+            }
         }
         for (on, name) in [
             (self.ibl, "ibl"),
@@ -620,6 +641,8 @@ pub fn shadow_filter_code(filter: ShadowFilter) -> u32 {
         ShadowFilter::SoftReference => 4,
         ShadowFilter::Vsm => 5,
         ShadowFilter::Vogel => 6,
+        ShadowFilter::Bilinear => 7,
+        ShadowFilter::Pcf3Bilinear => 8,
     }
 }
 
@@ -643,6 +666,75 @@ pub struct LightingPass {
     pub model: LightingModel,
     /// Its draws, in order.
     pub draws: Vec<LightingDraw>,
+    /// The pixels its draws cover: the screen rectangle around its objects' bounding boxes
+    /// (None: the whole image, when a box reaches behind the camera).
+    pub rect: Option<PixelRect>,
+}
+
+/// A rectangle of pixels: columns `x..x + width`, rows `y..y + height` (row 0 at the top).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelRect {
+    /// First column.
+    pub x: u32,
+    /// First row.
+    pub y: u32,
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+}
+
+/// The screen rectangle around the bounding boxes of `model`'s objects, widened by two pixels
+/// (rasterization rounding), clamped to the image; None when a box corner is not in front of
+/// the camera (its projection would not bound it).
+fn model_rect(scene: &Scene, model: LightingModel) -> Option<PixelRect> {
+    let (width, height) = (scene.quality.width, scene.quality.height);
+    let aspect = f64::from(width) / f64::from(height);
+    let view_projection = scene.camera.projection(aspect) * scene.camera.view_rotation();
+    let (mut lo, mut hi) = (glam::DVec2::splat(f64::MAX), glam::DVec2::splat(f64::MIN));
+    for object in scene.objects.iter().filter(|o| o.lighting == model) {
+        let m = view_projection * object.transform.relative_to(scene.camera.position);
+        let (min, max) = (object.mesh.bounds.min, object.mesh.bounds.max);
+        for corner in 0..8 {
+            let pick = |axis: usize| {
+                f64::from(if corner & (1 << axis) == 0 {
+                    min[axis]
+                } else {
+                    max[axis]
+                })
+            };
+            let clip = m * glam::DVec4::new(pick(0), pick(1), pick(2), 1.0);
+            // NaN compares false: treated like a corner behind the camera.
+            if clip.w.is_nan() || clip.w <= 1e-9 {
+                return None;
+            }
+            let pixel = glam::DVec2::new(
+                (clip.x / clip.w * 0.5 + 0.5) * f64::from(width),
+                (0.5 - clip.y / clip.w * 0.5) * f64::from(height),
+            );
+            lo = lo.min(pixel);
+            hi = hi.max(pixel);
+        }
+    }
+    if lo.x > hi.x || lo.y > hi.y {
+        return None; // no objects of this model
+    }
+    let clamp = |v: f64, size: u32| v.clamp(0.0, f64::from(size)) as u32;
+    let (x0, y0) = (
+        clamp(lo.x.floor() - 2.0, width),
+        clamp(lo.y.floor() - 2.0, height),
+    );
+    let (x1, y1) = (
+        clamp(hi.x.ceil() + 2.0, width),
+        clamp(hi.y.ceil() + 2.0, height),
+    );
+    // An object entirely off screen keeps one pixel (a viewport cannot be empty).
+    Some(PixelRect {
+        x: x0.min(width - 1),
+        y: y0.min(height - 1),
+        width: (x1.max(x0 + 1) - x0).min(width - x0.min(width - 1)),
+        height: (y1.max(y0 + 1) - y0).min(height - y0.min(height - 1)),
+    })
 }
 
 /// A part of the lighting passes' work that the bench's cost breakdown takes away, to time the
@@ -702,6 +794,7 @@ fn lighting_passes(
                 directional: false,
                 point: false,
                 shadow: None,
+                vogel_samples: 0,
                 ibl: false,
                 clearcoat: pbr
                     && materials().any(|m| m.clearcoat != 0.0 || m.clearcoat_map.is_some()),
@@ -735,7 +828,11 @@ fn lighting_passes(
                     })
                     .collect()
             };
-            LightingPass { model, draws }
+            LightingPass {
+                model,
+                draws,
+                rect: model_rect(scene, model),
+            }
         })
         .collect()
 }
@@ -753,12 +850,16 @@ impl LightingDraw {
             .lights
             .iter()
             .any(|&i| matches!(light(i), Light::Point { .. }));
-        self.variant.shadow = self.shadowed.and_then(|i| match light(i) {
-            Light::Directional { shadow, .. } => {
-                shadow.map(|s| (ShadowKind::Directional, s.filter))
-            }
-            Light::Point { shadow, .. } => shadow.map(|s| (ShadowKind::Point, s.filter)),
+        let settings = self.shadowed.and_then(|i| match light(i) {
+            Light::Directional { shadow, .. } => shadow.map(|s| (ShadowKind::Directional, s)),
+            Light::Point { shadow, .. } => shadow.map(|s| (ShadowKind::Point, s)),
         });
+        self.variant.shadow = settings.map(|(kind, s)| (kind, s.filter));
+        self.variant.vogel_samples = match settings.map(|(_, s)| (s.filter, s.soft_samples)) {
+            Some((ShadowFilter::Vogel, samples)) => samples,
+            Some((ShadowFilter::SoftReference, _)) => 1024,
+            _ => 0,
+        };
     }
 }
 

@@ -271,6 +271,13 @@ pub enum ShadowFilter {
     /// depth squared, blurred by a separable Gaussian, sampled bilinearly, and turned into a
     /// visibility by Chebyshev's bound with a minimum variance and light-bleeding reduction.
     Vsm,
+    /// One comparison through a linear-filtering comparison sampler: the hardware's 2x2
+    /// percentage-closer filter, bilinearly weighted (one fetch).
+    Bilinear,
+    /// Four linear-filtered comparisons half a texel off the centre diagonally: a 3x3 tent
+    /// (weights 1 2 1 by 1 2 1) that slides smoothly with the receiver (four fetches instead of
+    /// `pcf3`'s nine).
+    Pcf3Bilinear,
 }
 
 impl ShadowFilter {
@@ -284,7 +291,27 @@ impl ShadowFilter {
             ShadowFilter::SoftReference => "soft-reference",
             ShadowFilter::Vogel => "vogel",
             ShadowFilter::Vsm => "vsm",
+            ShadowFilter::Bilinear => "bilinear",
+            ShadowFilter::Pcf3Bilinear => "pcf3-bilinear",
         }
+    }
+
+    /// Shadow-map fetches per shaded pixel (the stratified soft filter's early-out makes 4 of
+    /// its 16 the common case; `vogel_samples` is the `vogel` filter's count).
+    pub fn fetches(self, vogel_samples: u32) -> u32 {
+        match self {
+            ShadowFilter::Hard | ShadowFilter::Bilinear | ShadowFilter::Vsm => 1,
+            ShadowFilter::Pcf3 => 9,
+            ShadowFilter::Pcf3Bilinear => 4,
+            ShadowFilter::Soft | ShadowFilter::SoftFull => 16,
+            ShadowFilter::SoftReference => 1024,
+            ShadowFilter::Vogel => vogel_samples,
+        }
+    }
+
+    /// Whether the filter reads the map through a linear-filtering comparison sampler.
+    pub fn linear_comparison(self) -> bool {
+        matches!(self, ShadowFilter::Bilinear | ShadowFilter::Pcf3Bilinear)
     }
 }
 
@@ -324,7 +351,8 @@ impl ShadowSettings {
     pub fn reach(&self) -> f32 {
         match self.filter {
             ShadowFilter::Hard => 1.0,
-            ShadowFilter::Pcf3 => 2.0,
+            ShadowFilter::Pcf3 | ShadowFilter::Pcf3Bilinear => 2.0,
+            ShadowFilter::Bilinear => 1.5,
             ShadowFilter::Soft
             | ShadowFilter::SoftFull
             | ShadowFilter::SoftReference

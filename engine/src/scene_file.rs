@@ -225,7 +225,8 @@ pub struct ShadowSpec {
     pub slope_bias: Option<f32>,
     /// Normal offset in shadow-map texels.
     pub normal_offset: Option<f32>,
-    /// `hard`, `pcf3` (default), `soft`, `soft-full`, `soft-reference`, `vogel` or `vsm`.
+    /// `hard`, `pcf3` (default), `bilinear`, `pcf3-bilinear`, `soft`, `soft-full`,
+    /// `soft-reference`, `vogel` or `vsm`.
     pub filter: Option<ShadowFilter>,
     /// Sample-disk radius of the soft filters, in texels (default 2.5).
     pub soft_radius: Option<f32>,

@@ -402,24 +402,34 @@ fn time_frames(
 ) -> Result<(Vec<Vec<backend::PassTiming>>, Vec<f64>), BenchError> {
     let mut timings = Vec::with_capacity(frames);
     let mut wall = Vec::with_capacity(frames);
+    for i in 0..=frames {
+        let (frame, ms) = time_frame(backend, scene, without)?;
+        if i > 0 {
+            wall.push(ms);
+            timings.push(frame);
+        }
+    }
+    Ok((timings, wall))
+}
+
+/// Renders `scene` once (nothing read back): its pass timings and wall ms.
+fn time_frame(
+    backend: &mut dyn Backend,
+    scene: &Scene,
+    without: Option<LightingFeature>,
+) -> Result<(Vec<backend::PassTiming>, f64), BenchError> {
     let faults = Faults {
         remove_lighting: without,
         ..Faults::default()
     };
-    for i in 0..=frames {
-        let start = Instant::now();
-        let frame = renderer::render_with_faults(backend, scene, Readback::Only(&[]), &faults)
-            .map_err(|e| BenchError::Render {
-                scene: scene.name.clone(),
-                backend: backend.kind().name().to_owned(),
-                message: e.to_string(),
-            })?;
-        if i > 0 {
-            wall.push(start.elapsed().as_secs_f64() * 1e3);
-            timings.push(frame.timings);
-        }
-    }
-    Ok((timings, wall))
+    let start = Instant::now();
+    let frame = renderer::render_with_faults(backend, scene, Readback::Only(&[]), &faults)
+        .map_err(|e| BenchError::Render {
+            scene: scene.name.clone(),
+            backend: backend.kind().name().to_owned(),
+            message: e.to_string(),
+        })?;
+    Ok((frame.timings, start.elapsed().as_secs_f64() * 1e3))
 }
 
 /// Median GPU ms of plan pass `name` over frames (None if the plan has no such pass or the
@@ -621,16 +631,26 @@ pub fn breakdown(
             false,
         ));
     }
-    progress("as it is");
-    let (full, _) = time_frames(backend.as_mut(), scene, frames, None)?;
-    let mut without = Vec::new();
-    for (what, feature, _) in &removals {
+    // Frames are interleaved (one of each variant in turn, after one warm-up frame of each),
+    // so that a drift of the machine's speed during the run falls on every variant alike.
+    let variants: Vec<Option<LightingFeature>> = std::iter::once(None)
+        .chain(removals.iter().map(|(_, feature, _)| Some(*feature)))
+        .collect();
+    let mut timings: Vec<Vec<Vec<backend::PassTiming>>> = vec![Vec::new(); variants.len()];
+    for round in 0..=frames {
         progress(&format!(
-            "without {}",
-            what.trim_start_matches("  of which ")
+            "round {round} of {frames}: {} variants",
+            variants.len()
         ));
-        without.push(time_frames(backend.as_mut(), scene, frames, Some(*feature))?.0);
+        for (variant, timed) in variants.iter().zip(&mut timings) {
+            let (frame, _) = time_frame(backend.as_mut(), scene, *variant)?;
+            if round > 0 {
+                timed.push(frame);
+            }
+        }
     }
+    let full = timings.remove(0);
+    let without = timings;
     let mut result = Vec::new();
     for spec in plan
         .passes

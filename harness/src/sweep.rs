@@ -28,6 +28,9 @@ pub struct SweepRow {
     pub filter: String,
     /// Shadow map size (per face).
     pub map_size: u32,
+    /// Shadow-map fetches per shaded pixel (the soft filter's early-out usually needs 4 of
+    /// its 16).
+    pub fetches: u32,
     /// Median GPU time of the shadow-map pass(es), ms.
     pub shadow_ms: Option<f64>,
     /// Median GPU time of the lighting passes, ms.
@@ -159,6 +162,8 @@ pub fn shadow_sweep(
         for (filter, samples) in [
             (ShadowFilter::Hard, None),
             (ShadowFilter::Pcf3, None),
+            (ShadowFilter::Bilinear, None),
+            (ShadowFilter::Pcf3Bilinear, None),
             (ShadowFilter::Soft, None),
             (ShadowFilter::SoftFull, None),
             (ShadowFilter::Vogel, Some(16)),
@@ -198,6 +203,7 @@ pub fn shadow_sweep(
             rows.push(SweepRow {
                 filter: label,
                 map_size,
+                fetches: filter.fetches(samples.unwrap_or(64)),
                 shadow_ms: pass_ms(&frames, "shadow_"),
                 lighting_ms: pass_ms(&frames, "lighting_"),
                 misclassified: visibility.fraction,
@@ -257,9 +263,10 @@ pub fn stats(mut errors: Vec<f64>) -> (f64, f64, f64) {
 /// The sweep as a table.
 pub fn table(rows: &[SweepRow]) -> String {
     let mut out = format!(
-        "{:<10} {:>6} {:>11} {:>13} {:>14} {:>24}  {}\n",
+        "{:<13} {:>6} {:>7} {:>11} {:>13} {:>14} {:>24}  {}\n",
         "filter",
         "map",
+        "fetches",
         "shadow ms",
         "lighting ms",
         "misclassified",
@@ -269,9 +276,10 @@ pub fn table(rows: &[SweepRow]) -> String {
     let ms = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.2}"));
     for r in rows {
         out.push_str(&format!(
-            "{:<10} {:>6} {:>11} {:>13} {:>13.3}% {:>24}  {}{}\n",
+            "{:<13} {:>6} {:>7} {:>11} {:>13} {:>13.3}% {:>24}  {}{}\n",
             r.filter,
             r.map_size,
+            r.fetches,
             ms(r.shadow_ms),
             ms(r.lighting_ms),
             r.misclassified * 100.0,
@@ -292,14 +300,15 @@ pub fn table(rows: &[SweepRow]) -> String {
 /// is stable: the insta snapshot of the canonical scenes' sweep.
 pub fn stable_table(rows: &[SweepRow]) -> String {
     let mut out = format!(
-        "{:<10} {:>6} {:>14} {:>12}\n",
-        "filter", "map", "misclassified", "vs soft ref"
+        "{:<13} {:>6} {:>7} {:>14} {:>12}\n",
+        "filter", "map", "fetches", "misclassified", "vs soft ref"
     );
     for r in rows {
         out.push_str(&format!(
-            "{:<10} {:>6} {:>13.1}% {:>12}{}\n",
+            "{:<13} {:>6} {:>7} {:>13.1}% {:>12}{}\n",
             r.filter,
             r.map_size,
+            r.fetches,
             r.misclassified * 100.0,
             r.error_vs_soft_reference
                 .map_or("-".to_owned(), |e| format!("{e:.3}")),

@@ -88,6 +88,8 @@ fn open_plane_has_no_shadow_acne() {
         for filter in [
             ShadowFilter::Hard,
             ShadowFilter::Pcf3,
+            ShadowFilter::Bilinear,
+            ShadowFilter::Pcf3Bilinear,
             ShadowFilter::Soft,
             ShadowFilter::Vsm,
         ] {

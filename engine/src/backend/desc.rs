@@ -376,10 +376,11 @@ pub enum SamplerBindingKind {
 pub enum BindingKind {
     /// `var<uniform>`.
     UniformBuffer,
-    /// `var<storage, read>`: read-only storage. Used for the lighting pass's parameters: Mesa
-    /// 22.3's lavapipe inlines uniform-buffer values that steer loops and branches, compiling a
-    /// new shader for every draw that binds a new uniform buffer and never freeing the old one
-    /// (~3.7 MiB per frame); it does not look into storage buffers.
+    /// `var<storage, read>`: read-only storage, for parameters a driver must not specialise
+    /// shaders on. Mesa 22.3's lavapipe inlines uniform-buffer values that steer loops and
+    /// branches, compiling a new shader for every draw that binds a new uniform buffer and never
+    /// freeing the old one (~3.7 MiB per frame); it does not look into storage buffers. Costlier
+    /// to read than uniforms on llvmpipe and lavapipe (a bounds-checked load per pixel).
     StorageBuffer,
     /// A sampled texture.
     Texture {

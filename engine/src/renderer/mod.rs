@@ -412,6 +412,8 @@ struct LightDraw {
     /// The VSM moments (a placeholder unless the light's filter is `vsm`).
     moments: Handle<Texture>,
     shadow_uniform: Handle<Buffer>,
+    /// Nearest or linear-filtering comparison, by the light's filter.
+    shadow_sampler: Handle<Sampler>,
 }
 
 fn binding(binding: u32, resource: BindingResource) -> Binding {
@@ -884,11 +886,11 @@ fn record_and_submit(
     }
 
     let lighting_shader = shader(scope, backend, shaders::LIGHTING)?;
-    // The lighting pass reads its parameters from read-only storage buffers, not uniform
-    // buffers: see `BindingKind::StorageBuffer` (lavapipe's per-draw shader recompiles).
+    // Parameters in uniform buffers; nothing in them steers a branch or loop (see the top of
+    // lighting.wgsl), so lavapipe has nothing to specialise per draw.
     let mut lighting_bindings = vec![BindingLayout {
         binding: 0,
-        kind: BindingKind::StorageBuffer,
+        kind: BindingKind::UniformBuffer,
     }];
     lighting_bindings.extend((1..=6).map(texture_layout));
     lighting_bindings.extend([
@@ -905,7 +907,7 @@ fn record_and_submit(
         },
         BindingLayout {
             binding: 9,
-            kind: BindingKind::StorageBuffer,
+            kind: BindingKind::UniformBuffer,
         },
         BindingLayout {
             binding: 10,
@@ -964,6 +966,14 @@ fn record_and_submit(
             ..SamplerDesc::nearest("shadow compare")
         },
     )?;
+    let linear_shadow_sampler = scope.sampler(
+        backend,
+        &SamplerDesc {
+            compare: Some(CompareFunction::LessEqual),
+            mipmap_filter: FilterMode::Nearest,
+            ..SamplerDesc::linear("shadow compare linear", AddressMode::ClampToEdge)
+        },
+    )?;
     let moments_sampler = scope.sampler(
         backend,
         &SamplerDesc {
@@ -983,7 +993,7 @@ fn record_and_submit(
         bindings.extend([
             binding(6, BindingResource::Texture(mask)),
             binding(7, BindingResource::Texture(draw.shadow_map)),
-            binding(8, BindingResource::Sampler(shadow_sampler)),
+            binding(8, BindingResource::Sampler(draw.shadow_sampler)),
             binding(9, BindingResource::Buffer(draw.shadow_uniform)),
             binding(10, BindingResource::Texture(jitter)),
             binding(11, BindingResource::Texture(draw.moments)),
@@ -1007,7 +1017,7 @@ fn record_and_submit(
     let no_shadow_uniform = scope.buffer(
         backend,
         "no shadow uniforms",
-        BufferUsage::Storage,
+        BufferUsage::Uniform,
         bytemuck::cast_slice(&shadows::shadow_uniforms(None)),
     )?;
     // Each shadowed light's maps and shadow uniforms, by scene light index.
@@ -1016,30 +1026,37 @@ fn record_and_submit(
         let uniform = scope.buffer(
             backend,
             &format!("shadow uniforms light {}", view.light),
-            BufferUsage::Storage,
+            BufferUsage::Uniform,
             bytemuck::cast_slice(&shadows::shadow_uniforms(Some(view))),
         )?;
         let moments = plan::shadow_moments_target_name(view.light);
+        let sampler = if view.settings.filter.linear_comparison() {
+            linear_shadow_sampler
+        } else {
+            shadow_sampler
+        };
         shadow_bindings.insert(
             view.light,
             (
                 targets[&plan::shadow_target_name(view.light)],
                 targets.get(&moments).copied().unwrap_or(no_moments),
                 uniform,
+                sampler,
             ),
         );
     }
     // The resources of one of the plan's lighting draws.
     let light_draw = |draw: &plan::LightingDraw| {
-        let (shadow_map, moments, shadow_uniform) = draw
+        let (shadow_map, moments, shadow_uniform, shadow_sampler) = draw
             .shadowed
             .and_then(|light| shadow_bindings.get(&light).copied())
-            .unwrap_or((no_shadow_map, no_moments, no_shadow_uniform));
+            .unwrap_or((no_shadow_map, no_moments, no_shadow_uniform, shadow_sampler));
         LightDraw {
             lights: draw.lights.iter().map(|&i| lights[i]).collect(),
             shadow_map,
             moments,
             shadow_uniform,
+            shadow_sampler,
         }
     };
     // One pipeline per (entry point, variant, routed or not), created on first use.
@@ -1095,7 +1112,7 @@ fn record_and_submit(
                     vec![
                         BindingLayout {
                             binding: 0,
-                            kind: BindingKind::StorageBuffer,
+                            kind: BindingKind::UniformBuffer,
                         },
                         texture_layout(6),
                     ],
@@ -1122,7 +1139,7 @@ fn record_and_submit(
             let uniform = scope.buffer(
                 backend,
                 &format!("lighting {model} batch {index}"),
-                BufferUsage::Storage,
+                BufferUsage::Uniform,
                 bytemuck::cast_slice(&data),
             )?;
             if index == 0 {
@@ -1159,7 +1176,20 @@ fn record_and_submit(
                 subresource: Subresource::default(),
                 load: LoadOp::Clear(1.0),
             }),
-            viewports: vec![],
+            // Only the pixels around the model's objects are rasterized (frag.xy stays in
+            // image coordinates, so the shaders read the right texels).
+            viewports: pass
+                .rect
+                .map(|r| Viewport {
+                    x: r.x as f32,
+                    y: r.y as f32,
+                    width: r.width as f32,
+                    height: r.height as f32,
+                    min_depth: 0.0,
+                    max_depth: 1.0,
+                })
+                .into_iter()
+                .collect(),
             draws,
         });
     }
@@ -1191,7 +1221,7 @@ fn record_and_submit(
             let uniform = scope.buffer(
                 backend,
                 &format!("{name} uniforms"),
-                BufferUsage::Storage,
+                BufferUsage::Uniform,
                 bytemuck::cast_slice(&data),
             )?;
             let bindings = lighting_bind_group(uniform, mask_targets[0], &resources);
