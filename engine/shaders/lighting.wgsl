@@ -45,6 +45,10 @@ override POSITION_MODE: u32 = 0u;
 override NORMAL_MODE: u32 = 0u;
 // Cost breakdown (harness bench --breakdown): read the inputs and write their sum, no shading.
 override INPUT_FLOOR: bool = false;
+// Cost breakdown: every variant with a part taken away still reads all the inputs (as the whole
+// pass does), adding them times a uniform zero, so that taking a light away does not also take
+// away the reads of the G-buffer targets only it needed, which the input floor already counts.
+override KEEP_INPUTS: bool = false;
 
 const PI: f32 = 3.14159265358979;
 const MAX_LIGHTS: u32 = 16u;
@@ -65,7 +69,8 @@ struct LightData {
 struct LightingUniforms {
     // One-hot selector of this model's channel in the bound mask target.
     mask_select: vec4<f32>,
-    // rgb = uniform ambient radiance * exposure (zero after the first batch).
+    // rgb = uniform ambient radiance * exposure (zero after the first batch); w = 0, a zero
+    // the compiler cannot see (KEEP_INPUTS).
     ambient: vec4<f32>,
     // x = number of lights in this batch (LIGHT_COUNT in the shader); y = 1 to emit unlit
     // albedo (first batch only).
@@ -661,6 +666,9 @@ fn shade(model: u32, pixel: vec2<i32>) -> vec4<f32> {
         let light = incoming(u.lights[i], s);
         radiance += brdf_times_cosine(model, s, v, light.direction) * light.radiance
             * visibility(i, s, light.direction, u.lights[i]);
+    }
+    if KEEP_INPUTS {
+        radiance += input_floor(pixel).rgb * u.ambient.w;
     }
     return finish(radiance);
 }

@@ -552,6 +552,9 @@ pub struct LightingVariant {
     pub gbuffer: GbufferSettings,
     /// The cost breakdown's input floor: reads the inputs, no shading (`INPUT_FLOOR`).
     pub input_floor: bool,
+    /// The cost breakdown's other variants: read every input even where the work left needs
+    /// fewer (`KEEP_INPUTS`), so that each part's time excludes the reads the input floor counts.
+    pub keep_inputs: bool,
 }
 
 impl LightingVariant {
@@ -590,6 +593,7 @@ impl LightingVariant {
             ("POSITION_MODE", position),
             ("NORMAL_MODE", normal),
             ("INPUT_FLOOR", flag(self.input_floor)),
+            ("KEEP_INPUTS", flag(self.keep_inputs)),
         ]
         .into_iter()
         .map(|(name, value)| (name.to_owned(), value))
@@ -622,6 +626,7 @@ impl fmt::Display for LightingVariant {
             (self.clearcoat, "clearcoat"),
             (self.anisotropy, "anisotropy"),
             (self.input_floor, "input floor"),
+            (self.keep_inputs, "keep inputs"),
         ] {
             if on {
                 write!(f, ", {name}")?;
@@ -801,6 +806,7 @@ fn lighting_passes(
                 anisotropy: pbr && materials().any(|m| m.anisotropy != 0.0),
                 gbuffer: scene.quality.gbuffer,
                 input_floor: false,
+                keep_inputs: false,
             };
             let draws = if model == LightingModel::Unlit {
                 vec![LightingDraw {
@@ -889,6 +895,7 @@ impl RenderPlan {
                         }
                     }
                 }
+                draw.variant.keep_inputs = feature != LightingFeature::Shading;
                 if pass.model != LightingModel::Unlit {
                     draw.specialise(scene);
                 }

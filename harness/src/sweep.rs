@@ -496,9 +496,8 @@ pub fn ibl_sweep(
     for (name, settings) in ibl_settings() {
         progress(&format!("precompute {name}"));
         engine::ibl::dfg_table();
-        let start = std::time::Instant::now();
-        std::hint::black_box(engine::ibl::build(&environment.image, &settings));
-        let precompute_s = start.elapsed().as_secs_f64();
+        // Timed, and kept in memory for the render below.
+        let (_, precompute_s) = engine::ibl::build_timed(&environment.image, &settings);
         let mut variant = scene.clone();
         variant.quality.ibl = settings.clone();
         let mut frames = Vec::new();

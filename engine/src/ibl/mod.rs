@@ -161,6 +161,17 @@ pub fn build(image: &EnvironmentImage, settings: &IblSettings) -> IblMaps {
     }
 }
 
+/// [`build`], timed, and the result kept in this process's memory cache, so that the next
+/// [`prepare`] of the same image and settings (a render) reuses it: what a sweep that times the
+/// precompute and then renders needs, without building twice.
+pub fn build_timed(image: &Arc<EnvironmentImage>, settings: &IblSettings) -> (Arc<IblMaps>, f64) {
+    let start = Instant::now();
+    let maps = Arc::new(build(image, settings));
+    let seconds = start.elapsed().as_secs_f64();
+    cache::memory_put(cache::key_of_shared(image, settings), maps.clone());
+    (maps, seconds)
+}
+
 /// The DFG table, computed once per process (it depends on nothing).
 pub fn dfg_table() -> Arc<Vec<[f32; 2]>> {
     static TABLE: std::sync::OnceLock<Arc<Vec<[f32; 2]>>> = std::sync::OnceLock::new();
