@@ -756,6 +756,9 @@ pub enum LightingFeature {
     Clearcoat,
     /// One light (by scene index), with its shadow lookup.
     Light(usize),
+    /// Every light and IBL: what is left is reading the inputs and the per-pixel setup (view
+    /// vector, ambient, output).
+    Lighting,
 }
 
 /// The draws of each lighting model: unshadowed lights 16 to a draw, then one draw per shadowed
@@ -893,6 +896,11 @@ impl RenderPlan {
                         if draw.shadowed == Some(light) {
                             draw.shadowed = None;
                         }
+                    }
+                    LightingFeature::Lighting => {
+                        draw.lights.clear();
+                        draw.shadowed = None;
+                        draw.variant.ibl = false;
                     }
                 }
                 draw.variant.keep_inputs = feature != LightingFeature::Shading;

@@ -577,8 +577,9 @@ pub struct PassBreakdown {
 }
 
 /// Times every lighting pass of `scene` on `kind` as it is and with one part taken away at a
-/// time: the input floor (no shading), IBL, each light (with its shadow lookup), and, as parts
-/// of those, shadow lookups and clearcoat. Each variant is `frames` frames after a warm-up.
+/// time: the input floor (no shading), the per-pixel setup (the pass with no light and no IBL,
+/// less the input floor), IBL, each light (with its shadow lookup), and, as parts of those,
+/// shadow lookups and clearcoat. Each variant is `frames` frames after a warm-up.
 pub fn breakdown(
     scene: &Scene,
     kind: BackendKind,
@@ -592,11 +593,18 @@ pub fn breakdown(
     let frames = frames.max(1);
     let plan = RenderPlan::new(scene);
     let draws = || plan.lighting.iter().flat_map(|pass| &pass.draws);
-    let mut removals: Vec<(String, LightingFeature, bool)> = vec![(
-        "G-buffer reads (input floor)".to_owned(),
-        LightingFeature::Shading,
-        true,
-    )];
+    let mut removals: Vec<(String, LightingFeature, bool)> = vec![
+        (
+            "G-buffer reads (input floor)".to_owned(),
+            LightingFeature::Shading,
+            true,
+        ),
+        (
+            "per-pixel setup (view vector, ambient, output)".to_owned(),
+            LightingFeature::Lighting,
+            true,
+        ),
+    ];
     if draws().any(|d| d.variant.ibl) {
         removals.push(("IBL".to_owned(), LightingFeature::Ibl, true));
     }
@@ -663,23 +671,28 @@ pub fn breakdown(
         let pass_draws = plan.lighting_draws(model);
         // Only the parts this pass has (the removals are timed once for every pass).
         let applies = |feature: LightingFeature| match feature {
-            LightingFeature::Shading => true,
+            LightingFeature::Shading | LightingFeature::Lighting => true,
             LightingFeature::Ibl => pass_draws.iter().any(|d| d.variant.ibl),
             LightingFeature::Shadows => pass_draws.iter().any(|d| d.variant.shadow.is_some()),
             LightingFeature::Clearcoat => pass_draws.iter().any(|d| d.variant.clearcoat),
             LightingFeature::Light(light) => pass_draws.iter().any(|d| d.lights.contains(&light)),
         };
         let total_ms = median_pass_ms(&plan, &full, &spec.name);
+        let floor_ms = removals
+            .iter()
+            .position(|(_, feature, _)| *feature == LightingFeature::Shading)
+            .and_then(|i| median_pass_ms(&plan, &without[i], &spec.name));
         let rows: Vec<BreakdownRow> = removals
             .iter()
             .zip(&without)
             .filter(|((_, feature, _), _)| applies(*feature))
             .map(|((what, feature, summed), timings)| {
                 let variant_ms = median_pass_ms(&plan, timings, &spec.name);
-                let ms = if *feature == LightingFeature::Shading {
-                    variant_ms
-                } else {
-                    total_ms.zip(variant_ms).map(|(t, v)| t - v)
+                let ms = match feature {
+                    LightingFeature::Shading => variant_ms,
+                    // The variant with no lights and no IBL, less the input floor.
+                    LightingFeature::Lighting => variant_ms.zip(floor_ms).map(|(v, f)| v - f),
+                    _ => total_ms.zip(variant_ms).map(|(t, v)| t - v),
                 };
                 BreakdownRow {
                     what: what.clone(),

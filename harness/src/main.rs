@@ -163,8 +163,9 @@ enum Command {
         #[arg(long = "series")]
         series: Vec<String>,
         /// Instead of the pass table, where each lighting pass's time goes: its input floor
-        /// (reading the G-buffer, no shading), then the time it loses without IBL, without each
-        /// light, and (parts of those) without shadow lookups and clearcoat.
+        /// (reading the G-buffer, no shading), its per-pixel setup, then the time it loses
+        /// without IBL, without each light, and (parts of those) without shadow lookups and
+        /// clearcoat; against the pass as it is.
         #[arg(long, conflicts_with = "series")]
         breakdown: bool,
         /// Where to keep the results (bench.json, bench_series.json) for the check report.

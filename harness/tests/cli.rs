@@ -341,6 +341,61 @@ fn bench_json_gives_each_pass_its_time_and_ratio_to_the_floor() {
     assert!(dir.path().join("bench.json").is_file());
 }
 
+/// `harness bench --breakdown --json`: a row per part of each lighting pass (input floor,
+/// setup, each light, and the parts of those), their sum and the pass as it is. Times vary;
+/// only the shape and that every figure is a time are checked here.
+#[test]
+fn bench_breakdown_lists_the_parts_of_each_lighting_pass() {
+    let (code, stdout, stderr) = harness(&[
+        "bench",
+        "--breakdown",
+        "--scene",
+        "arrow",
+        "--backend",
+        "gl",
+        "--frames",
+        "1",
+        "--json",
+    ]);
+    if code != 0 && stderr.contains("unavailable") && std::env::var("REQUIRE_BACKENDS").is_err() {
+        eprintln!("skipping: gl unavailable: {stderr}");
+        return;
+    }
+    assert_eq!(code, 0, "{stderr}");
+    let passes: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let names: Vec<&str> = passes
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["pass"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["lighting_pbr", "lighting_blinn_phong"]);
+    for pass in passes.as_array().unwrap() {
+        let rows: Vec<&str> = pass["rows"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r["what"].as_str().unwrap())
+            .collect();
+        assert_eq!(
+            rows,
+            [
+                "G-buffer reads (input floor)",
+                "per-pixel setup (view vector, ambient, output)",
+                "light 0 (point, shadow pcf3)",
+                "  of which shadow lookups",
+            ]
+            .into_iter()
+            .chain((pass["pass"] == "lighting_pbr").then_some("  of which clearcoat"))
+            .collect::<Vec<_>>(),
+            "{pass}"
+        );
+        for key in ["total_ms", "sum_ms", "sum_to_total"] {
+            assert!(pass[key].as_f64().unwrap().is_finite(), "{key}: {pass}");
+        }
+    }
+}
+
 /// `harness noise` measures a source in child processes (`check --json` per scene and backend)
 /// and renders recorded on another host, and judges both against the limits; a golden that no
 /// longer matches makes it exit 1. Refuses unknown sources and a partial `--write`.
