@@ -973,11 +973,7 @@ fn bench(
     out: &std::path::Path,
     json: bool,
 ) -> anyhow::Result<ExitCode> {
-    let names: Vec<String> = if scenes.is_empty() {
-        engine::scene_file::canonical_scenes(&harness::scenes_dir())
-    } else {
-        scenes.to_vec()
-    };
+    let names = scenes_or_canonical(scenes);
     let loaded = names
         .iter()
         .map(|n| harness::load_scene(n).map(|l| l.scene))
@@ -1049,11 +1045,7 @@ fn bench_series(
     } else {
         names.to_vec()
     };
-    let kinds: Vec<BackendKind> = if backends.is_empty() {
-        vec![BackendKind::Gl]
-    } else {
-        backends.to_vec()
-    };
+    let kinds = backends_or_gl(backends);
     let mut all = Vec::new();
     for kind in kinds {
         for name in &names {
@@ -1075,6 +1067,24 @@ fn bench_series(
     Ok(ExitCode::SUCCESS)
 }
 
+/// The scenes asked for, or every canonical scene.
+fn scenes_or_canonical(scenes: &[String]) -> Vec<String> {
+    if scenes.is_empty() {
+        engine::scene_file::canonical_scenes(&harness::scenes_dir())
+    } else {
+        scenes.to_vec()
+    }
+}
+
+/// The backends asked for, or gl.
+fn backends_or_gl(backends: &[BackendKind]) -> Vec<BackendKind> {
+    if backends.is_empty() {
+        vec![BackendKind::Gl]
+    } else {
+        backends.to_vec()
+    }
+}
+
 /// `harness bench --breakdown`: each lighting pass's cost, part by part.
 fn bench_breakdown(
     scenes: &[String],
@@ -1082,16 +1092,8 @@ fn bench_breakdown(
     frames: usize,
     json: bool,
 ) -> anyhow::Result<ExitCode> {
-    let names: Vec<String> = if scenes.is_empty() {
-        engine::scene_file::canonical_scenes(&harness::scenes_dir())
-    } else {
-        scenes.to_vec()
-    };
-    let kinds: Vec<BackendKind> = if backends.is_empty() {
-        vec![BackendKind::Gl]
-    } else {
-        backends.to_vec()
-    };
+    let names = scenes_or_canonical(scenes);
+    let kinds = backends_or_gl(backends);
     let mut all = Vec::new();
     for kind in kinds {
         for name in &names {

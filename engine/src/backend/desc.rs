@@ -293,6 +293,16 @@ pub struct ShaderDesc {
     pub wgsl: String,
 }
 
+impl ShaderDesc {
+    /// A hash of the name and source: the key of the backends' module and pipeline caches.
+    pub fn cache_key(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut hasher = std::collections::hash_map::DefaultHasher::new();
+        (&self.name, &self.wgsl).hash(&mut hasher);
+        hasher.finish()
+    }
+}
+
 /// Vertex attribute formats.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum VertexFormat {

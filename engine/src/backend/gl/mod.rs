@@ -15,7 +15,6 @@ mod conv;
 pub(crate) mod wgpu_interop;
 
 use std::collections::HashMap;
-use std::hash::{Hash, Hasher};
 use std::marker::PhantomData;
 use std::rc::Rc;
 use std::sync::{Arc, Mutex};
@@ -824,11 +823,7 @@ impl Backend for GlBackend {
     }
 
     fn create_shader(&mut self, desc: &ShaderDesc) -> Result<Handle<Shader>> {
-        let key = {
-            let mut hasher = std::collections::hash_map::DefaultHasher::new();
-            (&desc.name, &desc.wgsl).hash(&mut hasher);
-            hasher.finish()
-        };
+        let key = desc.cache_key();
         let module = match self.module_cache.get(&key) {
             Some(module) => module.clone(),
             None => {

@@ -9,7 +9,6 @@ mod conv;
 use ::wgpu;
 use std::borrow::Cow;
 use std::collections::HashMap;
-use std::hash::{Hash, Hasher};
 use std::sync::Arc;
 
 use super::pool::Pool;
@@ -566,11 +565,7 @@ impl Backend for WgpuBackend {
     }
 
     fn create_shader(&mut self, desc: &ShaderDesc) -> Result<Handle<Shader>> {
-        let key = {
-            let mut hasher = std::collections::hash_map::DefaultHasher::new();
-            (&desc.name, &desc.wgsl).hash(&mut hasher);
-            hasher.finish()
-        };
+        let key = desc.cache_key();
         if let Some(module) = self.module_cache.get(&key) {
             let module = module.clone();
             return Ok(self.shaders.insert(ShaderResource { module, key }));
