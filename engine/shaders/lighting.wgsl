@@ -631,14 +631,25 @@ fn pbr_ibl(s: Surface, v: vec3<f32>) -> vec3<f32> {
     return (diffuse + specular) * (1.0 - clearcoat_fresnel) + clearcoat;
 }
 
-// The lighting pass's input floor: every input a pixel's shading reads (the five G-buffer targets,
-// and depth where positions come from it), summed into the output, and no shading.
-fn input_floor(pixel: vec2<i32>) -> vec4<f32> {
-    var sum = textureLoad(gbuffer_position, pixel, 0) + textureLoad(gbuffer_normal, pixel, 0)
-        + textureLoad(gbuffer_tangent, pixel, 0) + textureLoad(gbuffer_albedo, pixel, 0)
-        + textureLoad(gbuffer_material, pixel, 0);
-    if POSITION_MODE == 2u {
-        sum += textureLoad(scene_depth, pixel, 0);
+const MODEL_UNLIT: u32 = 4u;
+
+// The lighting pass's input floor: every input `model`'s shading reads, summed into the output,
+// and no shading. Unlit reads the albedo only; the others also position and normal (and depth
+// where positions come from it), PBR and Blinn-Phong the material target, and the tangent only
+// where a material is anisotropic (the only use of it).
+fn input_floor(model: u32, pixel: vec2<i32>) -> vec4<f32> {
+    var sum = textureLoad(gbuffer_albedo, pixel, 0);
+    if model != MODEL_UNLIT {
+        sum += textureLoad(gbuffer_position, pixel, 0) + textureLoad(gbuffer_normal, pixel, 0);
+        if POSITION_MODE == 2u {
+            sum += textureLoad(scene_depth, pixel, 0);
+        }
+    }
+    if model == MODEL_PBR || model == MODEL_BLINN_PHONG {
+        sum += textureLoad(gbuffer_material, pixel, 0);
+    }
+    if ANISOTROPY {
+        sum += textureLoad(gbuffer_tangent, pixel, 0);
     }
     return finish(sum.rgb * 1e-3 + vec3<f32>(sum.a * 1e-3));
 }
@@ -647,7 +658,7 @@ fn input_floor(pixel: vec2<i32>) -> vec4<f32> {
 // PBR scales it by (1 - metallic), the other models by the base color alone.
 fn shade(model: u32, pixel: vec2<i32>) -> vec4<f32> {
     if INPUT_FLOOR {
-        return input_floor(pixel);
+        return input_floor(model, pixel);
     }
     let s = load_surface(pixel);
     let v = safe_normalize(-s.position, s.normal);
@@ -668,7 +679,7 @@ fn shade(model: u32, pixel: vec2<i32>) -> vec4<f32> {
             * visibility(i, s, light.direction, u.lights[i]);
     }
     if KEEP_INPUTS {
-        radiance += input_floor(pixel).rgb * u.ambient.w;
+        radiance += input_floor(model, pixel).rgb * u.ambient.w;
     }
     return finish(radiance);
 }
@@ -718,7 +729,7 @@ fn fs_route(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
 fn fs_unlit(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let pixel = vec2<i32>(frag.xy);
     if INPUT_FLOOR {
-        return input_floor(pixel);
+        return input_floor(MODEL_UNLIT, pixel);
     }
     let s = load_surface(pixel);
     return finish(s.base_color * f32(u.counts.y));

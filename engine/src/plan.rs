@@ -759,6 +759,8 @@ pub enum LightingFeature {
     /// Every light and IBL: what is left is reading the inputs and the per-pixel setup (view
     /// vector, ambient, output).
     Lighting,
+    /// Every light, IBL kept.
+    Lights,
 }
 
 /// The draws of each lighting model: unshadowed lights 16 to a draw, then one draw per shadowed
@@ -901,6 +903,10 @@ impl RenderPlan {
                         draw.lights.clear();
                         draw.shadowed = None;
                         draw.variant.ibl = false;
+                    }
+                    LightingFeature::Lights => {
+                        draw.lights.clear();
+                        draw.shadowed = None;
                     }
                 }
                 draw.variant.keep_inputs = feature != LightingFeature::Shading;

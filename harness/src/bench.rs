@@ -9,8 +9,9 @@
 //! machines; the milliseconds do not.
 //!
 //! A lighting pass has a second, more honest floor: its *input floor*, the same pass (same
-//! routing, same draws) with every draw's shading replaced by reading its inputs (the G-buffer
-//! targets, and depth where positions come from it) and writing their sum. Pass / input floor is
+//! routing, same draws) with every draw's shading replaced by reading the inputs its model
+//! reads (the G-buffer targets it uses, and depth where positions come from it) and writing
+//! their sum. Pass / input floor is
 //! the cost of shading alone. `harness bench --breakdown` goes further and times each lighting
 //! pass with one part of its work taken away at a time ([`breakdown`]).
 //!
@@ -578,8 +579,9 @@ pub struct PassBreakdown {
 
 /// Times every lighting pass of `scene` on `kind` as it is and with one part taken away at a
 /// time: the input floor (no shading), the per-pixel setup (the pass with no light and no IBL,
-/// less the input floor), IBL, each light (with its shadow lookup), and, as parts of those,
-/// shadow lookups and clearcoat. Each variant is `frames` frames after a warm-up.
+/// less the input floor), IBL, what IBL and the lights share in a draw that shades both (IBL
+/// with no light, less IBL beside them), each light (with its shadow lookup), and, as parts of
+/// those, shadow lookups and clearcoat. Each variant is `frames` frames after a warm-up.
 pub fn breakdown(
     scene: &Scene,
     kind: BackendKind,
@@ -607,6 +609,12 @@ pub fn breakdown(
     ];
     if draws().any(|d| d.variant.ibl) {
         removals.push(("IBL".to_owned(), LightingFeature::Ibl, true));
+    }
+    // A draw shading IBL and lights together decodes the surface once for both: neither removal
+    // alone takes that away. Timed as what IBL costs with no light, less what it costs beside
+    // the lights.
+    if draws().any(|d| d.variant.ibl && d.variant.lights > 0) {
+        removals.push((SHARED_ROW.to_owned(), LightingFeature::Lights, true));
     }
     for (index, light) in scene.lights.iter().enumerate() {
         let shadow = draws()
@@ -673,15 +681,27 @@ pub fn breakdown(
         let applies = |feature: LightingFeature| match feature {
             LightingFeature::Shading | LightingFeature::Lighting => true,
             LightingFeature::Ibl => pass_draws.iter().any(|d| d.variant.ibl),
+            LightingFeature::Lights => pass_draws
+                .iter()
+                .any(|d| d.variant.ibl && d.variant.lights > 0),
             LightingFeature::Shadows => pass_draws.iter().any(|d| d.variant.shadow.is_some()),
             LightingFeature::Clearcoat => pass_draws.iter().any(|d| d.variant.clearcoat),
             LightingFeature::Light(light) => pass_draws.iter().any(|d| d.lights.contains(&light)),
         };
         let total_ms = median_pass_ms(&plan, &full, &spec.name);
-        let floor_ms = removals
-            .iter()
-            .position(|(_, feature, _)| *feature == LightingFeature::Shading)
-            .and_then(|i| median_pass_ms(&plan, &without[i], &spec.name));
+        let ms_without = |feature: LightingFeature| {
+            removals
+                .iter()
+                .position(|(_, f, _)| *f == feature)
+                .and_then(|i| median_pass_ms(&plan, &without[i], &spec.name))
+        };
+        let floor_ms = ms_without(LightingFeature::Shading);
+        // IBL's cost beside the lights (the pass minus the pass without IBL), and the pass with
+        // IBL and setup alone.
+        let ibl_ms = total_ms
+            .zip(ms_without(LightingFeature::Ibl))
+            .map(|(t, v)| t - v);
+        let no_lighting_ms = ms_without(LightingFeature::Lighting);
         let rows: Vec<BreakdownRow> = removals
             .iter()
             .zip(&without)
@@ -692,6 +712,11 @@ pub fn breakdown(
                     LightingFeature::Shading => variant_ms,
                     // The variant with no lights and no IBL, less the input floor.
                     LightingFeature::Lighting => variant_ms.zip(floor_ms).map(|(v, f)| v - f),
+                    // IBL with no light (less the pass with neither), less IBL beside the lights.
+                    LightingFeature::Lights => variant_ms
+                        .zip(no_lighting_ms)
+                        .zip(ibl_ms)
+                        .map(|((v, s), i)| v - s - i),
                     _ => total_ms.zip(variant_ms).map(|(t, v)| t - v),
                 };
                 BreakdownRow {
@@ -718,6 +743,9 @@ pub fn breakdown(
     }
     Ok(result)
 }
+
+/// The breakdown row of what IBL and the lights share in a draw that shades both.
+const SHARED_ROW: &str = "shared by IBL and the lights (surface, view)";
 
 /// A pass breakdown as a table.
 pub fn breakdown_table(b: &PassBreakdown) -> String {
