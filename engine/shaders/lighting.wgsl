@@ -72,14 +72,12 @@ struct LightingUniforms {
     // rgb = uniform ambient radiance * exposure (zero after the first batch); w = 0, a zero
     // the compiler cannot see (KEEP_INPUTS).
     ambient: vec4<f32>,
-    // x = number of lights in this batch (LIGHT_COUNT in the shader); y = 1 to emit unlit
-    // albedo (first batch only).
+    // y = 1 to emit unlit albedo (first batch only); x, z, w unused (the batch's light count is
+    // LIGHT_COUNT).
     counts: vec4<u32>,
     // IBL: x = environment intensity * exposure (0: none, or not the first batch), y = highest
     // specular lod (roughness 1), z, w = cos and sin of the environment's rotation about +Y.
     ibl: vec4<f32>,
-    // G-buffer storage, as POSITION_MODE and NORMAL_MODE.
-    gbuffer: vec4<f32>,
     // World position of the camera (f32), for world-space positions.
     camera_world: vec4<f32>,
     // Clip space to camera-relative world space, for positions from depth.
@@ -101,22 +99,19 @@ struct LightingUniforms {
 @group(0) @binding(6) var shader_mask: texture_2d<f32>;
 
 // The shadow map of the one shadowed light of this draw (draws with a shadowed light hold only
-// that light, in slot 0); a 1x1 placeholder with `params.x = 0` otherwise.
+// that light, in slot 0); a 1x1 placeholder otherwise. Its kind, filter and sample count are the
+// draw's SHADOW_KIND, SHADOW_FILTER and VOGEL_SAMPLES, not values here.
 struct ShadowUniforms {
     // Camera-relative world space to the light's clip space: [0] for a directional light, one
     // per cube face (+X, -X, +Y, -Y, +Z, -Z) for a point light.
     faces: array<mat4x4<f32>, 6>,
-    // x = kind (0 none, 1 directional, 2 point), y = constant bias (m), z = slope bias (texels),
-    // w = normal offset (texels).
+    // x unused, y = constant bias (m), z = slope bias (texels), w = normal offset (texels).
     params: vec4<f32>,
-    // x = filter (0 hard, 1 3x3 PCF, 2 stratified soft, 3 stratified soft without early-out,
-    // 4 converged soft reference, 5 variance shadow map, 6 Vogel disk of soft.z samples),
-    // y = 1 / map width, z = 1 / map height,
+    // x unused, y = 1 / map width, z = 1 / map height,
     // w = texel size in meters (directional) or per meter of distance (point).
     map: vec4<f32>,
-    // x = soft radius (texels), y = reach of the filter in texels (scales the biases),
-    // z = samples of the Vogel-disk filters (1024 for the reference; the shader reads
-    // VOGEL_SAMPLES instead).
+    // x = soft radius (texels), y = reach of the filter in texels (scales the biases), z, w
+    // unused.
     soft: vec4<f32>,
     // VSM: x = minimum variance, y = light-bleeding reduction.
     vsm: vec4<f32>,
@@ -227,7 +222,7 @@ fn shadow_soft(look: ShadowLookup, early_out: bool) -> f32 {
     return sum / 16.0;
 }
 
-// Soft filter on a golden-angle (Vogel) disk of soft.z samples, no jitter: the `vogel` filter,
+// Soft filter on a golden-angle (Vogel) disk of VOGEL_SAMPLES samples, no jitter: the `vogel` filter,
 // and at 1024 samples the converged reference for sweeps.
 fn shadow_vogel(look: ShadowLookup) -> f32 {
     let count = max(i32(VOGEL_SAMPLES), 1);

@@ -203,28 +203,16 @@ pub fn shadow_uniforms(view: Option<&ShadowView>) -> Vec<f32> {
         data.extend_from_slice(&m.to_cols_array());
     }
     let s = &view.settings;
-    data.extend_from_slice(&[
-        if view.point { 2.0 } else { 1.0 },
-        s.bias,
-        s.slope_bias,
-        s.normal_offset,
-    ]);
+    // The kind, the filter and the Vogel sample count are the lighting draw's override
+    // constants (plan::LightingVariant); their slots here stay 0.
+    data.extend_from_slice(&[0.0, s.bias, s.slope_bias, s.normal_offset]);
     let (w, h) = if view.point {
         (3 * view.size, 2 * view.size)
     } else {
         (view.size, view.size)
     };
-    data.extend_from_slice(&[
-        crate::plan::shadow_filter_code(s.filter) as f32,
-        1.0 / w as f32,
-        1.0 / h as f32,
-        view.texel_world as f32,
-    ]);
-    let samples = match s.filter {
-        ShadowFilter::SoftReference => 1024,
-        _ => s.soft_samples,
-    };
-    data.extend_from_slice(&[s.soft_radius, s.reach(), samples as f32, 0.0]);
+    data.extend_from_slice(&[0.0, 1.0 / w as f32, 1.0 / h as f32, view.texel_world as f32]);
+    data.extend_from_slice(&[s.soft_radius, s.reach(), 0.0, 0.0]);
     data.extend_from_slice(&[s.vsm_min_variance, s.vsm_bleeding_reduction, 0.0, 0.0]);
     data
 }

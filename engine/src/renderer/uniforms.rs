@@ -152,7 +152,8 @@ pub(super) fn lighting_uniforms(
     } else {
         [0.0; 4]
     };
-    let counts = [batch.len() as u32, u32::from(first_batch), 0, 0];
+    // The light count and the G-buffer modes are the draw's override constants.
+    let counts = [0, u32::from(first_batch), 0, 0];
     // IBL: x = intensity * exposure (first batch only), y = highest specular lod,
     // z, w = cos and sin of the rotation about +Y.
     let ibl = match (&scene.environment, first_batch) {
@@ -169,13 +170,6 @@ pub(super) fn lighting_uniforms(
     bytes.extend_from_slice(bytemuck::cast_slice(&ambient));
     bytes.extend_from_slice(bytemuck::cast_slice(&counts));
     bytes.extend_from_slice(bytemuck::cast_slice(&ibl));
-    let (position_mode, normal_mode) = gbuffer_modes(&scene.quality.gbuffer);
-    bytes.extend_from_slice(bytemuck::cast_slice(&[
-        position_mode,
-        normal_mode,
-        0.0,
-        0.0,
-    ]));
     let c = scene.camera.position.as_vec3();
     bytes.extend_from_slice(bytemuck::cast_slice(&[c.x, c.y, c.z, 0.0]));
     let inverse = camera.view_projection().inverse().as_mat4();
