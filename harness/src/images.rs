@@ -112,29 +112,51 @@ fn remove_stale_temporaries(path: &Path, file_name: &str) {
     }
 }
 
+/// How hard the PNG encoder works: goldens are kept in the repository and written once per
+/// bless, so they get the smallest files; outputs for looking at (renders, failure images,
+/// report previews) are written on every run, so they get the fast encoder (about 5x faster
+/// and about 1.5x larger at 512x512).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PngCompression {
+    /// Best compression with adaptive filtering.
+    Smallest,
+    /// The encoder's fast mode.
+    Fast,
+}
+
 /// PNG bytes of an 8-bit RGBA image.
-pub fn encode_png(image: &Image, path: &Path) -> Result<Vec<u8>, ImageFileError> {
+pub fn encode_png(
+    image: &Image,
+    path: &Path,
+    compression: PngCompression,
+) -> Result<Vec<u8>, ImageFileError> {
     use image::ImageEncoder;
     let data = image.as_u8().ok_or_else(|| ImageFileError::Unsupported {
         path: path.to_owned(),
         message: format!("{:?} is a float image; write it as .exr", image.format),
     })?;
     let mut out = Vec::new();
-    image::codecs::png::PngEncoder::new_with_quality(
-        &mut out,
-        image::codecs::png::CompressionType::Best,
-        image::codecs::png::FilterType::Adaptive,
-    )
-    .write_image(
-        data,
-        image.width,
-        image.height,
-        image::ExtendedColorType::Rgba8,
-    )
-    .map_err(|e| ImageFileError::Png {
-        path: path.to_owned(),
-        message: e.to_string(),
-    })?;
+    let (level, filter) = match compression {
+        PngCompression::Smallest => (
+            image::codecs::png::CompressionType::Best,
+            image::codecs::png::FilterType::Adaptive,
+        ),
+        PngCompression::Fast => (
+            image::codecs::png::CompressionType::Fast,
+            image::codecs::png::FilterType::Adaptive,
+        ),
+    };
+    image::codecs::png::PngEncoder::new_with_quality(&mut out, level, filter)
+        .write_image(
+            data,
+            image.width,
+            image.height,
+            image::ExtendedColorType::Rgba8,
+        )
+        .map_err(|e| ImageFileError::Png {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?;
     Ok(out)
 }
 
@@ -165,14 +187,18 @@ pub fn display_u8(image: &Image) -> Image {
 
 /// Writes an image: `.png` needs 8 bits (float images are converted with [`display_u8`]),
 /// `.exr` stores float RGBA as fp16 (depth and R32F as f32) with ZIP compression.
-pub fn write_image(image: &Image, path: &Path) -> Result<(), ImageFileError> {
+pub fn write_image(
+    image: &Image,
+    path: &Path,
+    compression: PngCompression,
+) -> Result<(), ImageFileError> {
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
     match extension.as_str() {
-        "png" => write_atomically(path, &encode_png(&display_u8(image), path)?),
+        "png" => write_atomically(path, &encode_png(&display_u8(image), path, compression)?),
         "exr" => write_atomically(path, &encode_exr(image, path)?),
         _ => Err(ImageFileError::Unsupported {
             path: path.to_owned(),
@@ -321,7 +347,7 @@ mod tests {
             ),
         };
         let path = dir.join("rgba.exr");
-        write_image(&rgba, &path).unwrap();
+        write_image(&rgba, &path, PngCompression::Fast).unwrap();
         let back = read_exr(&path).unwrap();
         assert_eq!(back.data, rgba.data);
         let depth = Image {
@@ -331,7 +357,7 @@ mod tests {
             data: ImageData::F32(vec![0.1234567, 1.0, 0.5, 0.999_999_9]),
         };
         let path = dir.join("depth.exr");
-        write_image(&depth, &path).unwrap();
+        write_image(&depth, &path, PngCompression::Fast).unwrap();
         assert_eq!(read_exr(&path).unwrap().data, depth.data);
         let _ = std::fs::remove_dir_all(&dir);
     }
@@ -346,7 +372,7 @@ mod tests {
             data: ImageData::U8(vec![1, 2, 3, 255, 250, 128, 0, 255]),
         };
         let path = dir.join("a.png");
-        write_image(&image, &path).unwrap();
+        write_image(&image, &path, PngCompression::Fast).unwrap();
         assert_eq!(read_png(&path).unwrap().data, image.data);
         let _ = std::fs::remove_dir_all(&dir);
     }

@@ -564,7 +564,7 @@ fn render(
             Some(dir) => dir.join(format!("{name}.{extension}")),
             None => default_dir.join(format!("{name}.{extension}")),
         };
-        harness::images::write_image(image, &path)?;
+        harness::images::write_image(image, &path, harness::images::PngCompression::Fast)?;
         println!("{name:<17} -> {}", path.display());
     }
     for timing in &frame.timings {

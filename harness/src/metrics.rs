@@ -21,6 +21,8 @@
 //!
 //! Non-finite values are counted separately and always fail (see [`crate::tolerance`]).
 
+use std::borrow::Cow;
+
 use engine::{Image, ImageData};
 
 /// Which channels a metric compares.
@@ -83,9 +85,11 @@ pub enum MetricError {
 }
 
 /// Both images as f32 values (8-bit scaled to 0..1) with their channel count.
-pub struct Pair {
-    actual: Vec<f32>,
-    golden: Vec<f32>,
+pub struct Pair<'a> {
+    actual: Cow<'a, [f32]>,
+    golden: Cow<'a, [f32]>,
+    /// Same values bit for bit, all finite: every error is exactly 0.
+    identical: bool,
     width: usize,
     height: usize,
     channels: usize,
@@ -102,16 +106,29 @@ fn shape(image: &Image) -> String {
     )
 }
 
-fn values(image: &Image) -> Vec<f32> {
+/// An image's values in metric units: float images borrowed, 8-bit ones scaled to 0..1.
+fn values(image: &Image) -> Cow<'_, [f32]> {
     match &image.data {
-        ImageData::U8(d) => d.iter().map(|&v| f32::from(v) / 255.0).collect(),
-        ImageData::F32(d) => d.clone(),
+        ImageData::U8(d) => Cow::Owned(d.iter().map(|&v| f32::from(v) / 255.0).collect()),
+        ImageData::F32(d) => Cow::Borrowed(d),
     }
 }
 
-impl Pair {
+/// Whether two images hold the same values bit for bit (float images compared by bit pattern,
+/// so a NaN matches only the same NaN).
+fn bitwise_equal(actual: &Image, golden: &Image) -> bool {
+    match (&actual.data, &golden.data) {
+        (ImageData::U8(a), ImageData::U8(g)) => a == g,
+        (ImageData::F32(a), ImageData::F32(g)) => {
+            a.len() == g.len() && a.iter().zip(g).all(|(a, g)| a.to_bits() == g.to_bits())
+        }
+        _ => false,
+    }
+}
+
+impl<'a> Pair<'a> {
     /// Prepares two images for comparison.
-    pub fn new(actual: &Image, golden: &Image) -> Result<Self, MetricError> {
+    pub fn new(actual: &'a Image, golden: &'a Image) -> Result<Self, MetricError> {
         let same = actual.width == golden.width
             && actual.height == golden.height
             && actual.channels() == golden.channels()
@@ -122,9 +139,13 @@ impl Pair {
                 golden: shape(golden),
             });
         }
+        let actual_values = values(actual);
+        let identical =
+            bitwise_equal(actual, golden) && actual_values.iter().all(|v| v.is_finite());
         Ok(Self {
-            actual: values(actual),
+            actual: actual_values,
             golden: values(golden),
+            identical,
             width: actual.width as usize,
             height: actual.height as usize,
             channels: actual.channels(),
@@ -135,6 +156,12 @@ impl Pair {
     /// Number of pixels.
     pub fn pixels(&self) -> usize {
         self.width * self.height
+    }
+
+    /// Whether the images are equal bit for bit with only finite values, so that every metric
+    /// is exactly zero (PSNR infinite) and need not be computed.
+    pub fn identical(&self) -> bool {
+        self.identical
     }
 
     /// Non-finite values in the actual image.
@@ -148,6 +175,20 @@ impl Pair {
     pub fn pixel_errors(&self, shift: u32, floor: Option<f64>, channels: Channels) -> Vec<f64> {
         let c = self.channels;
         let used = channels.count(c);
+        if shift == 0 {
+            return self
+                .actual
+                .chunks_exact(c)
+                .zip(self.golden.chunks_exact(c))
+                .map(|(a, g)| {
+                    a[..used]
+                        .iter()
+                        .zip(&g[..used])
+                        .map(|(&a, &g)| value_error(a, g, floor))
+                        .fold(0.0f64, f64::max)
+                })
+                .collect();
+        }
         let r = shift as isize;
         let mut out = Vec::with_capacity(self.pixels());
         for y in 0..self.height {
@@ -189,7 +230,7 @@ impl Pair {
     /// Largest absolute difference per channel (no shift).
     pub fn max_abs_per_channel(&self) -> Vec<f64> {
         let mut max = vec![0.0f64; self.channels];
-        for (i, (a, g)) in self.actual.iter().zip(&self.golden).enumerate() {
+        for (i, (a, g)) in self.actual.iter().zip(self.golden.iter()).enumerate() {
             let d = f64::from((a - g).abs());
             let slot = &mut max[i % self.channels];
             *slot = if d.is_nan() {
@@ -217,11 +258,26 @@ impl Pair {
         floor: Option<f64>,
         channels: Channels,
     ) -> f64 {
-        let over = self
-            .pixel_errors(shift, floor, channels)
-            .into_iter()
-            .filter(|&e| e > threshold)
-            .count();
+        let over = if shift == 0 {
+            // The common case, counted without a per-pixel error list.
+            let c = self.channels;
+            let used = channels.count(c);
+            self.actual
+                .chunks_exact(c)
+                .zip(self.golden.chunks_exact(c))
+                .filter(|(a, g)| {
+                    a[..used]
+                        .iter()
+                        .zip(&g[..used])
+                        .any(|(&a, &g)| value_error(a, g, floor) > threshold)
+                })
+                .count()
+        } else {
+            self.pixel_errors(shift, floor, channels)
+                .into_iter()
+                .filter(|&e| e > threshold)
+                .count()
+        };
         over as f64 / self.pixels().max(1) as f64
     }
 
@@ -230,7 +286,7 @@ impl Pair {
         let sum: f64 = self
             .actual
             .iter()
-            .zip(&self.golden)
+            .zip(self.golden.iter())
             .map(|(a, g)| f64::from(a - g).powi(2))
             .sum();
         (sum / self.actual.len().max(1) as f64).sqrt()
@@ -303,9 +359,14 @@ pub fn percentile_of_sorted(sorted: &[f64], percentile: f64) -> f64 {
     sorted[rank - 1]
 }
 
+/// Mean of a FLIP error map.
+pub fn flip_mean(map: &[f32]) -> f64 {
+    map.iter().map(|&v| f64::from(v)).sum::<f64>() / map.len().max(1) as f64
+}
+
 /// Mean and percentile of a FLIP error map.
 pub fn flip_stats(map: &[f32], percentile: f64) -> (f64, f64) {
-    let mean = map.iter().map(|&v| f64::from(v)).sum::<f64>() / map.len().max(1) as f64;
+    let mean = flip_mean(map);
     let mut sorted: Vec<f64> = map.iter().map(|&v| f64::from(v)).collect();
     sorted.sort_by(f64::total_cmp);
     (mean, percentile_of_sorted(&sorted, percentile))
@@ -356,6 +417,24 @@ mod tests {
         assert!(pair.psnr().is_infinite());
         let map = Pair::flip_map(&a, &a).unwrap();
         assert_eq!(flip_stats(&map, 0.99), (0.0, 0.0));
+        assert!(pair.identical());
+    }
+
+    #[test]
+    fn identical_means_bit_for_bit_and_finite() {
+        let golden = f32_image(4, 4, |x, y| [x as f32, y as f32, 0.5, 1.0]);
+        assert!(Pair::new(&golden, &golden).unwrap().identical());
+        let one_off = f32_image(4, 4, |x, y| {
+            let z = if (x, y) == (3, 3) { 0.5000001 } else { 0.5 };
+            [x as f32, y as f32, z, 1.0]
+        });
+        assert!(!Pair::new(&one_off, &golden).unwrap().identical());
+        // -0.0 equals 0.0 in value but not in bits: not called identical (the metrics say 0).
+        let zero = f32_image(1, 1, |_, _| [0.0; 4]);
+        let negative_zero = f32_image(1, 1, |_, _| [-0.0; 4]);
+        assert!(!Pair::new(&negative_zero, &zero).unwrap().identical());
+        let nan = f32_image(1, 1, |_, _| [f32::NAN; 4]);
+        assert!(!Pair::new(&nan, &nan).unwrap().identical());
     }
 
     #[test]

@@ -88,7 +88,12 @@ fn downscale(image: &Image) -> Image {
 }
 
 fn data_uri(image: &Image) -> String {
-    let png = images::encode_png(image, std::path::Path::new("preview.png")).unwrap_or_default();
+    let png = images::encode_png(
+        image,
+        std::path::Path::new("preview.png"),
+        images::PngCompression::Fast,
+    )
+    .unwrap_or_default();
     format!(
         "data:image/png;base64,{}",
         base64::engine::general_purpose::STANDARD.encode(png)

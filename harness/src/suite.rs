@@ -13,7 +13,7 @@ use engine::scene_file::LoadedScene;
 use engine::Image;
 
 use crate::golden::{self, GoldenStore, Outcome};
-use crate::images;
+use crate::images::{self, PngCompression};
 use crate::metrics::Channels;
 use crate::noise::{NoiseError, NoiseModel};
 use crate::tolerance::{Metric, Rule, RuleError};
@@ -405,12 +405,12 @@ pub fn write_artifacts(
         "exr"
     };
     let actual_path = dir.join(format!("{pass}_actual.{extension}"));
-    if images::write_image(actual, &actual_path).is_ok() {
+    if images::write_image(actual, &actual_path, PngCompression::Fast).is_ok() {
         artifacts.actual = Some(actual_path);
     }
     if let Some(golden) = golden {
         let golden_path = dir.join(format!("{pass}_golden.png"));
-        if images::write_image(golden, &golden_path).is_ok() {
+        if images::write_image(golden, &golden_path, PngCompression::Fast).is_ok() {
             artifacts.golden = Some(golden_path);
         }
         let scale = if golden::is_eight_bit(actual) {
@@ -420,7 +420,7 @@ pub fn write_artifacts(
         };
         if let Some(diff) = golden::diff_heatmap(actual, golden, scale) {
             let diff_path = dir.join(format!("{pass}_diff.png"));
-            if images::write_image(&diff, &diff_path).is_ok() {
+            if images::write_image(&diff, &diff_path, PngCompression::Fast).is_ok() {
                 artifacts.diff = Some(diff_path);
             }
         }

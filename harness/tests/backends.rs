@@ -297,7 +297,7 @@ fn readback_orientation_is_top_row_first_on_every_backend() {
 }
 
 fn harness_backends_json(envs: &[(&str, &str)]) -> Vec<serde_json::Value> {
-    let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_harness"));
+    let mut command = common::harness_command();
     command.args(["backends", "--json"]);
     for (k, v) in envs {
         command.env(k, v);

@@ -13,7 +13,7 @@ fn fixture(name: &str) -> PathBuf {
 }
 
 fn harness(args: &[&str]) -> (i32, String, String) {
-    let output = Command::new(env!("CARGO_BIN_EXE_harness"))
+    let output = common::harness_command()
         .args(args)
         .output()
         .expect("run harness");
@@ -185,7 +185,7 @@ fn bless_rewrites_only_the_named_golden() {
     let golden = root.path().join("golden");
     let before = snapshot(&golden);
     std::thread::sleep(std::time::Duration::from_millis(20));
-    let output = Command::new(env!("CARGO_BIN_EXE_harness"))
+    let output = common::harness_command()
         .args(["bless", "--scene", "chess", "--pass", "final"])
         .env("HARNESS_ROOT", root.path())
         .output()
@@ -218,7 +218,7 @@ fn bless_rewrites_only_the_named_golden() {
     );
 
     // Without --scene or --all, bless refuses.
-    let output = Command::new(env!("CARGO_BIN_EXE_harness"))
+    let output = common::harness_command()
         .arg("bless")
         .env("HARNESS_ROOT", root.path())
         .output()
@@ -250,7 +250,7 @@ fn check_reports_failures_with_images_and_the_bless_command() {
     darken(&root.path().join("golden/arrow/final.png"), 3);
     std::fs::remove_file(root.path().join("golden/arrow/light.exr")).unwrap();
     let out = root.path().join("out");
-    let output = Command::new(env!("CARGO_BIN_EXE_harness"))
+    let output = common::harness_command()
         .args(["check", "--scene", "arrow", "--out", out.to_str().unwrap()])
         .env("HARNESS_ROOT", root.path())
         .output()
@@ -448,7 +448,7 @@ fn noise_measures_sources_and_fails_when_a_golden_moved() {
     // A golden darkened by 2/255 is no noise: the drivers source fails against it.
     let root = common::temp_workspace();
     darken(&root.path().join("golden/ibl/final.png"), 2);
-    let output = Command::new(env!("CARGO_BIN_EXE_harness"))
+    let output = common::harness_command()
         .args(["noise", "--source", "drivers", "--scene", "ibl"])
         .env("HARNESS_ROOT", root.path())
         .output()
@@ -486,7 +486,7 @@ fn check_notes_a_driver_other_than_the_blessing_one() {
         .join("\n");
     std::fs::write(&record, moved).unwrap();
     let out = root.path().join("out");
-    let output = Command::new(env!("CARGO_BIN_EXE_harness"))
+    let output = common::harness_command()
         .args(["check", "--scene", "arrow", "--backend", "gl", "--out"])
         .arg(&out)
         .env("HARNESS_ROOT", root.path())

@@ -120,6 +120,7 @@ impl Backend for Faulty {
 }
 
 fn chess() -> engine::scene::Scene {
+    harness::use_ibl_cache();
     harness::load_scene("chess").unwrap().scene
 }
 
@@ -171,6 +172,7 @@ fn a_backend_lost_mid_run_fails_its_scene_and_the_run_goes_on() {
     let Some(&kind) = common::available_backends().first() else {
         return;
     };
+    harness::use_ibl_cache();
     let cases = harness::suite::canonical_cases().unwrap();
     let store = harness::golden::GoldenStore::workspace();
     let created = AtomicUsize::new(0);
@@ -213,7 +215,7 @@ fn a_backend_lost_mid_run_fails_its_scene_and_the_run_goes_on() {
 }
 
 fn harness_bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_harness"))
+    common::harness_command()
 }
 
 fn temporaries(dir: &Path) -> Vec<PathBuf> {
@@ -233,7 +235,11 @@ fn with_full_disk(args: &[&str], root: Option<&Path>) -> std::process::Output {
         .arg("-c")
         .arg("trap '' XFSZ; ulimit -f 4; exec \"$0\" \"$@\"")
         .arg(env!("CARGO_BIN_EXE_harness"))
-        .args(args);
+        .args(args)
+        .env(
+            "HARNESS_IBL_CACHE",
+            harness::ibl_cache_dir().unwrap_or_default(),
+        );
     if let Some(root) = root {
         command.env("HARNESS_ROOT", root);
     }

@@ -10,6 +10,7 @@ use harness::hard_cases;
 /// Every hard case holds its invariants on every available backend.
 #[test]
 fn every_hard_case_holds_on_every_backend() {
+    harness::use_ibl_cache();
     let mut failures = Vec::new();
     for kind in common::available_backends() {
         let rows = hard_cases::run(kind, |_| {}).unwrap_or_else(|e| panic!("{kind}: {e}"));

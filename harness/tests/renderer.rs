@@ -279,6 +279,7 @@ fn gizmos_are_optional_and_only_touch_the_final_image() {
 /// again compiles nothing new (every backend caches pipelines by shader, state and constants).
 #[test]
 fn lighting_variants_follow_the_scene_and_are_compiled_once() {
+    harness::use_ibl_cache();
     let chess = harness::load_scene("chess").unwrap().scene;
     let ibl = harness::load_scene("ibl").unwrap().scene;
     let variants = |scene: &Scene| {

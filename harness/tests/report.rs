@@ -5,6 +5,8 @@
 //! Needs Chromium (`apt-get install -y chromium`; CI installs it). Without it the test says so
 //! on stderr and passes, unless REQUIRE_CHROMIUM=1.
 
+mod common;
+
 use std::path::Path;
 use std::process::Command;
 
@@ -34,7 +36,7 @@ fn report_screenshot_shows_the_images() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let output = Command::new(env!("CARGO_BIN_EXE_harness"))
+    let output = common::harness_command()
         .args([
             "check",
             "--scene",

@@ -55,3 +55,16 @@ pub fn temp_workspace() -> tempfile::TempDir {
     copy_tree(&workspace.join("golden"), &root.path().join("golden"));
     root
 }
+
+/// The `harness` binary as a command that shares this workspace's IBL cache, also when the test
+/// points HARNESS_ROOT at a temporary copy (the maps depend only on the environment image and
+/// the IBL settings; the cache itself is tested in engine/tests/ibl.rs). Without it, every run
+/// in a temporary workspace would precompute the maps again.
+pub fn harness_command() -> std::process::Command {
+    let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_harness"));
+    command.env(
+        "HARNESS_IBL_CACHE",
+        harness::ibl_cache_dir().unwrap_or_default(),
+    );
+    command
+}
