@@ -25,7 +25,10 @@ pub struct TextureImage {
     pub width: u32,
     /// Height of mip 0.
     pub height: u32,
-    /// RGBA8 texels per mip level, level 0 first.
+    /// How the texels are stored: RGBA8 (sRGB-encoded where `srgb`), or linear RGBA16F from a
+    /// 16-bit file.
+    pub format: crate::assets::TexelFormat,
+    /// Texels per mip level in `format`, level 0 first.
     pub mips: Vec<Vec<u8>>,
 }
 

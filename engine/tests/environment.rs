@@ -1,4 +1,4 @@
-//! EXR environment loading.
+//! Environment loading: EXR and Radiance `.hdr`.
 
 mod common;
 
@@ -142,4 +142,42 @@ fn canonical_environments_pass_the_dwa_block_check() {
         let env = load_environment(&path).unwrap_or_else(|e| panic!("{e}"));
         assert!(env.width > 0, "{name}");
     }
+}
+
+/// A Radiance `.hdr` environment (RGBE, written by hand: R = (x + 1) / 2, G = y + 1, B = 1/4 on
+/// 8x4) loads like an EXR one, alpha 1.
+#[test]
+fn radiance_hdr_environment_loads() {
+    let env = load_environment(&fixture("sky.hdr")).unwrap();
+    assert_eq!((env.width, env.height), (8, 4));
+    for y in 0..4 {
+        for x in 0..8 {
+            let texel = env.texels[y * 8 + x];
+            let expected = [(x as f32 + 1.0) * 0.5, y as f32 + 1.0, 0.25, 1.0];
+            for (got, want) in texel.iter().zip(expected) {
+                // RGBE keeps 8 bits of mantissa relative to the texel's largest channel.
+                assert!(
+                    (got - want).abs() <= want.max(y as f32 + 1.0) / 128.0,
+                    "({x}, {y}): {texel:?}"
+                );
+            }
+        }
+    }
+    assert!((env.max_radiance - 4.0).abs() < 0.05);
+}
+
+/// A truncated `.hdr` and a file that is neither EXR nor Radiance are errors naming the file.
+#[test]
+fn truncated_hdr_and_unknown_environment_formats_are_errors() {
+    let e = load_environment(&fixture("truncated.hdr"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("truncated.hdr"), "{e}");
+    let e = load_environment(&fixture("textures/gradient.bmp"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("gradient.bmp") && e.contains("not an OpenEXR or Radiance"),
+        "{e}"
+    );
 }

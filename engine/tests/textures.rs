@@ -3,7 +3,7 @@
 mod common;
 
 use common::fixture;
-use engine::assets::{generate_mips, load_texture, ColorSpace};
+use engine::assets::{generate_mips, generate_mips_f32, load_texture, ColorSpace, TexelFormat};
 
 /// R = 16x + 64y, G = 255 - R, B = 7, A = 255 except (3,3) = 0.
 fn ramp() -> Vec<u8> {
@@ -62,8 +62,11 @@ fn srgb_uniform_images_are_stable() {
     }
 }
 
+/// An odd size is box filtered over the whole area: no row or column is dropped. (Before, the
+/// 2x2 box dropped the last column and row: level 1 of this 5x3 texture was [25, 50] and
+/// [125, 50], as if x = 4 and y = 2 did not exist.)
 #[test]
-fn odd_sizes_clamp_and_reach_1x1() {
+fn odd_sizes_are_box_filtered_over_every_texel_and_reach_1x1() {
     let tex = load_texture(&fixture("textures/odd5x3.png"), ColorSpace::Linear).unwrap();
     let sizes: Vec<_> = (0..tex.mips.len()).map(|l| tex.mip_size(l)).collect();
     assert_eq!(sizes, [(5, 3), (2, 1), (1, 1)]);
@@ -71,8 +74,12 @@ fn odd_sizes_clamp_and_reach_1x1() {
         let (w, h) = tex.mip_size(level);
         assert_eq!(data.len(), (w * h * 4) as usize);
     }
-    // Level 1 texel (0,0) averages x 0..1, y 0..1: R = (0+50+0+50)/4, G = (0+0+100+100)/4.
-    assert_eq!(&tex.mips[1][..4], &[25, 50, 0, 255]);
+    // 5 -> 2 columns: texel 0 covers x in [0, 2.5): weights 0.4, 0.4, 0.2 on R = 0, 50, 100;
+    // texel 1 covers [2.5, 5): 0.2, 0.4, 0.4 on R = 100, 150, 200. 3 -> 1 rows: a third each
+    // of G = 0, 100, 200.
+    assert_eq!(tex.mips[1], [40, 100, 0, 255, 160, 100, 0, 255]);
+    // 2x1 -> 1x1: the mean of the two.
+    assert_eq!(tex.mips[2], [100, 100, 0, 255]);
     // A 1-texel-wide column: x is clamped, y is box filtered.
     let col = generate_mips(1, 2, &[10, 0, 0, 255, 20, 0, 0, 255], ColorSpace::Linear);
     assert_eq!(col[1], vec![15, 0, 0, 255]);
@@ -97,4 +104,75 @@ fn texture_errors_name_the_file() {
         e.to_string().contains("absent.png: cannot read file"),
         "{e}"
     );
+}
+
+/// An odd size in sRGB averages in linear light, like the even sizes: 3x1 of 0, 255, 0 gives
+/// the sRGB encoding of one third.
+#[test]
+fn odd_srgb_sizes_average_in_linear_light() {
+    let row = [0, 0, 0, 255, 255, 255, 255, 255, 0, 0, 0, 255];
+    let mips = generate_mips(3, 1, &row, ColorSpace::Srgb);
+    let third = engine::assets::linear_to_srgb_u8(1.0 / 3.0);
+    assert_eq!(mips[1], [third, third, third, 255]);
+    let floats = generate_mips_f32(3, 1, vec![[0.0; 4], [1.0; 4], [0.0; 4]]);
+    assert!((floats[1][0][0] - 1.0 / 3.0).abs() < 1e-7);
+}
+
+/// JPEG, TGA and BMP fixtures (written by another encoder, Pillow) decode to the gradient they
+/// hold: R = 32x, G = 64y, B = 100 on 8x4 (JPEG within its loss).
+#[test]
+fn jpeg_tga_and_bmp_textures_load() {
+    for (file, tolerance) in [
+        ("textures/gradient.jpg", 12),
+        ("textures/gradient.tga", 0),
+        ("textures/gradient.bmp", 0),
+    ] {
+        let tex = load_texture(&fixture(file), ColorSpace::Linear)
+            .unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert_eq!((tex.width, tex.height, tex.bits()), (8, 4, 8), "{file}");
+        assert_eq!(tex.format, TexelFormat::Rgba8, "{file}");
+        assert_eq!(tex.mips.len(), 4, "{file}");
+        for y in 0..4u32 {
+            for x in 0..8u32 {
+                let at = ((y * 8 + x) * 4) as usize;
+                let texel = &tex.mips[0][at..at + 4];
+                let expected = [32 * x, 64 * y, 100, 255];
+                for (got, want) in texel.iter().zip(expected) {
+                    assert!(
+                        (i64::from(*got) - i64::from(want)).abs() <= tolerance,
+                        "{file} ({x}, {y}): {texel:?} against {expected:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// A 16-bit PNG keeps more than 8 bits: its values 32768, 32800, 32832 and 32896 (all 128 in
+/// 8 bits) stay four different values, each within half an f16 step of value / 65535.
+#[test]
+fn sixteen_bit_png_keeps_its_precision() {
+    let tex = load_texture(&fixture("textures/fine16.png"), ColorSpace::Linear).unwrap();
+    assert_eq!((tex.width, tex.height, tex.bits()), (4, 1, 16));
+    assert_eq!(tex.format, TexelFormat::Rgba16Float);
+    let reds: Vec<f32> = tex.mips[0]
+        .chunks_exact(8)
+        .map(|texel| half::f16::from_le_bytes([texel[0], texel[1]]).to_f32())
+        .collect();
+    for (red, value) in reds.iter().zip([32768.0f32, 32800.0, 32832.0, 32896.0]) {
+        // f16 has a step of 2^-11 between 0.5 and 1.
+        assert!(
+            (red - value / 65535.0).abs() <= 2f32.powi(-12),
+            "{red} for {value}"
+        );
+    }
+    let mut distinct = reds.clone();
+    distinct.dedup();
+    assert_eq!(distinct.len(), 4, "{reds:?}");
+    // Alpha (none in the file) is 1; the mip chain goes down to 1x1.
+    assert_eq!(
+        half::f16::from_le_bytes([tex.mips[0][6], tex.mips[0][7]]).to_f32(),
+        1.0
+    );
+    assert_eq!(tex.mips.len(), 3);
 }

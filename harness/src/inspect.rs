@@ -19,7 +19,7 @@ pub enum InspectError {
     #[error(transparent)]
     Scene(#[from] scene_file::SceneFileError),
     /// The extension is not one `inspect` knows.
-    #[error("{0}: don't know how to inspect this (expected .obj, .mtl, .toml, .exr or .png)")]
+    #[error("{0}: don't know how to inspect this (expected .obj, .mtl, .toml, an environment (.exr, .hdr) or a texture (.png, .jpg, .tga, .bmp))")]
     UnknownKind(String),
 }
 
@@ -74,16 +74,22 @@ pub fn inspect(path: &Path) -> Result<Value, InspectError> {
                 json!({ "kind": "mtl", "path": path.display().to_string(), "materials": materials, "textures": textures, "warnings": warnings }),
             )
         }
-        "png" => {
+        "png" | "jpg" | "jpeg" | "tga" | "bmp" => {
             let texture = assets::load_texture(path, ColorSpace::Srgb)?;
-            Ok(
-                json!({ "kind": "png", "texture": texture_json(&path.display().to_string(), texture.width, texture.height, texture.mips.len(), ColorSpace::Srgb) }),
-            )
+            let mut described = texture_json(
+                &path.display().to_string(),
+                texture.width,
+                texture.height,
+                texture.mips.len(),
+                ColorSpace::Srgb,
+            );
+            described["bits"] = json!(texture.bits());
+            Ok(json!({ "kind": "texture", "texture": described }))
         }
-        "exr" => {
+        "exr" | "hdr" => {
             let environment = assets::load_environment(path)?;
             let summary = serde_json::to_value(environment.summary()).unwrap_or(Value::Null);
-            Ok(json!({ "kind": "exr", "environment": summary }))
+            Ok(json!({ "kind": "environment", "environment": summary }))
         }
         "toml" => {
             let loaded = scene_file::load(path)?;
@@ -176,6 +182,7 @@ pub fn inspect(path: &Path) -> Result<Value, InspectError> {
                 "environment": environment,
                 "textures": textures,
                 "textures_decoded": loaded.textures_decoded,
+                "warnings": loaded.warnings,
                 "plan": RenderPlan::new(scene).to_string(),
             }))
         }
@@ -235,10 +242,11 @@ pub fn to_text(value: &Value) -> String {
                 line(
                     &mut out,
                     format!(
-                        "  texture {} {}x{} {} mips {}",
+                        "  texture {} {}x{} {}-bit {} mips {}",
                         t["path"].as_str().unwrap_or(""),
                         t["width"],
                         t["height"],
+                        t["bits"],
                         t["mips"],
                         t["color_space"].as_str().unwrap_or("")
                     ),
@@ -286,6 +294,9 @@ pub fn to_text(value: &Value) -> String {
                     value["textures_decoded"]
                 ),
             );
+            for w in value["warnings"].as_array().into_iter().flatten() {
+                line(&mut out, format!("  note: {}", w.as_str().unwrap_or("")));
+            }
             out.push_str(value["plan"].as_str().unwrap_or(""));
         }
         _ => {

@@ -205,6 +205,7 @@ fn normal_and_parameter_maps_reach_the_gbuffer() {
             srgb,
             width: 2,
             height: 2,
+            format: engine::assets::TexelFormat::Rgba8,
             mips: vec![rgba.repeat(4), rgba.to_vec()],
         })
     };

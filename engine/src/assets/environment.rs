@@ -1,9 +1,11 @@
-//! Equirectangular environment maps from OpenEXR files (via the `exr` crate).
+//! Equirectangular environment maps from OpenEXR files (via the `exr` crate) and Radiance
+//! `.hdr` (RGBE) files (via the `image` crate), the two formats HDRI sites ship. The format is
+//! told by the file's first bytes, not its name.
 //!
-//! The first layer with `R`, `G` and `B` channels is read at its largest
+//! EXR: the first layer with `R`, `G` and `B` channels is read at its largest
 //! resolution level; `A` is optional (defaults to 1). Samples of any type
-//! (f16, f32, u32) are converted to f32. Texels are RGBA, linear, top row
-//! first. "Radiance" here is the **maximum of the R, G and B channels** of a
+//! (f16, f32, u32) are converted to f32. Radiance: RGB, alpha 1. Texels are RGBA, linear, top
+//! row first. "Radiance" here is the **maximum of the R, G and B channels** of a
 //! texel (not luminance).
 
 use std::io::Cursor;
@@ -20,7 +22,7 @@ pub const MAX_ENVIRONMENT_TEXELS: usize = 1 << 26;
 /// A decoded equirectangular environment map.
 #[derive(Clone, Debug)]
 pub struct Environment {
-    /// The EXR file.
+    /// The environment file (EXR or Radiance .hdr).
     pub path: PathBuf,
     /// Width in texels.
     pub width: u32,
@@ -120,16 +122,67 @@ fn check_dwa_blocks(path: &Path, bytes: &[u8]) -> Result<(), AssetError> {
     Ok(())
 }
 
-/// Loads an EXR environment map; rejects missing/corrupt files, zero or
-/// oversized images and any non-finite texel (naming the first bad pixel).
+/// The first bytes of an OpenEXR file.
+const EXR_MAGIC: &[u8] = &[0x76, 0x2f, 0x31, 0x01];
+
+/// Loads an EXR or Radiance `.hdr` environment map; rejects missing/corrupt files, other
+/// formats, zero or oversized images and any non-finite texel (naming the first bad pixel).
 pub fn load_environment(path: &Path) -> Result<Environment, AssetError> {
     let bytes = std::fs::read(path).map_err(|e| AssetError::io(path, e))?;
+    let (w, h, texels) = if bytes.starts_with(EXR_MAGIC) {
+        decode_exr(path, &bytes)?
+    } else if bytes.starts_with(b"#?") {
+        decode_radiance(path, &bytes)?
+    } else {
+        return Err(AssetError::invalid_image(
+            path,
+            "not an OpenEXR or Radiance .hdr file (environments must be one of the two)",
+        ));
+    };
+    validated(path, w, h, texels)
+}
+
+/// Checks an environment's size against [`MAX_ENVIRONMENT_TEXELS`] before decoding.
+fn check_size(path: &Path, w: usize, h: usize) -> Result<(), AssetError> {
+    if w == 0 || h == 0 {
+        return Err(AssetError::invalid_image(
+            path,
+            format!("image has zero size ({w}x{h})"),
+        ));
+    }
+    if w.checked_mul(h).is_none_or(|a| a > MAX_ENVIRONMENT_TEXELS) {
+        return Err(AssetError::invalid_image(
+            path,
+            format!("image too large ({w}x{h}, limit {MAX_ENVIRONMENT_TEXELS} texels)"),
+        ));
+    }
+    Ok(())
+}
+
+/// Decodes a Radiance RGBE file (its header is read and its size checked first).
+fn decode_radiance(path: &Path, bytes: &[u8]) -> Result<(usize, usize, Vec<[f32; 4]>), AssetError> {
+    use image::ImageDecoder as _;
+    let decode_err = |source| AssetError::ImageDecode {
+        path: path.to_path_buf(),
+        source,
+    };
+    let decoder = image::codecs::hdr::HdrDecoder::new(Cursor::new(bytes)).map_err(decode_err)?;
+    let (w, h) = decoder.dimensions();
+    check_size(path, w as usize, h as usize)?;
+    let image = image::DynamicImage::from_decoder(decoder).map_err(decode_err)?;
+    let rgb = image.into_rgb32f();
+    let texels = rgb.pixels().map(|p| [p[0], p[1], p[2], 1.0]).collect();
+    Ok((w as usize, h as usize, texels))
+}
+
+/// Decodes an OpenEXR file.
+fn decode_exr(path: &Path, bytes: &[u8]) -> Result<(usize, usize, Vec<[f32; 4]>), AssetError> {
     let exr_err = |source| AssetError::Exr {
         path: path.to_path_buf(),
         source,
     };
     let meta =
-        exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes), false).map_err(exr_err)?;
+        exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(exr_err)?;
     let has = |h: &exr::meta::header::Header, n: &str| h.channels.list.iter().any(|c| c.name.eq(n));
     let rgb_layers: Vec<_> = meta
         .headers
@@ -143,24 +196,10 @@ pub fn load_environment(path: &Path) -> Result<Environment, AssetError> {
         ));
     }
     for h in &rgb_layers {
-        let (w, hgt) = (h.layer_size.width(), h.layer_size.height());
-        if w == 0 || hgt == 0 {
-            return Err(AssetError::invalid_image(
-                path,
-                format!("image has zero size ({w}x{hgt})"),
-            ));
-        }
-        if w.checked_mul(hgt)
-            .is_none_or(|a| a > MAX_ENVIRONMENT_TEXELS)
-        {
-            return Err(AssetError::invalid_image(
-                path,
-                format!("image too large ({w}x{hgt}, limit {MAX_ENVIRONMENT_TEXELS} texels)"),
-            ));
-        }
+        check_size(path, h.layer_size.width(), h.layer_size.height())?;
     }
 
-    check_dwa_blocks(path, &bytes)?;
+    check_dwa_blocks(path, bytes)?;
 
     let image = exr::prelude::read()
         .no_deep_data()
@@ -186,12 +225,24 @@ pub fn load_environment(path: &Path) -> Result<Environment, AssetError> {
         )
         .first_valid_layer()
         .all_attributes()
-        .from_buffered(Cursor::new(&bytes))
+        .from_buffered(Cursor::new(bytes))
         .map_err(exr_err)?;
 
     let layer = image.layer_data;
-    let (w, h) = (layer.size.width(), layer.size.height());
-    let texels = layer.channel_data.pixels.1;
+    Ok((
+        layer.size.width(),
+        layer.size.height(),
+        layer.channel_data.pixels.1,
+    ))
+}
+
+/// The decoded texels as an [`Environment`], after checking their count and values.
+fn validated(
+    path: &Path,
+    w: usize,
+    h: usize,
+    texels: Vec<[f32; 4]>,
+) -> Result<Environment, AssetError> {
     if w == 0 || h == 0 || w.checked_mul(h) != Some(texels.len()) {
         return Err(AssetError::invalid_image(
             path,

@@ -3,9 +3,9 @@
 //! - [`load_obj`]: Wavefront OBJ + MTL via `tobj`, with a line-accurate
 //!   pre-scan, generated normals/UVs where missing and validated MikkTSpace
 //!   tangents ([`Vertex`] is the 48-byte geometry-pass vertex).
-//! - [`TextureCache`] / [`load_texture`]: PNG textures as RGBA8 with a CPU mip
-//!   chain, decoded once per (file, colour space).
-//! - [`load_environment`]: equirectangular OpenEXR environment maps.
+//! - [`TextureCache`] / [`load_texture`]: PNG, JPEG, TGA and BMP textures (RGBA8, or RGBA16F
+//!   for 16-bit files) with a CPU mip chain, decoded once per (file, colour space).
+//! - [`load_environment`]: equirectangular OpenEXR or Radiance `.hdr` environment maps.
 //!
 //! Every failure is an [`AssetError`] naming the file (and line, where known);
 //! no input makes these loaders panic.
@@ -38,6 +38,6 @@ pub use mesh::{Aabb, MeshData, Vertex};
 pub use obj::{load_mtl, load_obj, MaterialData, MaterialMaps, Model};
 pub use summary::{EnvironmentSummary, MaterialSummary, MeshSummary, ModelSummary, TextureSummary};
 pub use texture::{
-    generate_mips, linear_to_srgb_u8, load_texture, srgb_to_linear, ColorSpace, TextureCache,
-    TextureData, TextureId,
+    generate_mips, generate_mips_f32, linear_to_srgb_u8, load_texture, srgb_to_linear, ColorSpace,
+    TexelFormat, TextureCache, TextureData, TextureId,
 };

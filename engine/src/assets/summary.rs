@@ -67,12 +67,14 @@ pub struct TextureSummary {
     pub mips: usize,
     /// Colour space.
     pub color_space: ColorSpace,
+    /// Bits per channel of the file (8, or 16 for a map kept as RGBA16F).
+    pub bits: u8,
 }
 
 /// Summary of an [`Environment`].
 #[derive(Clone, Debug, Serialize)]
 pub struct EnvironmentSummary {
-    /// The EXR file.
+    /// The environment file.
     pub path: String,
     /// Width in texels.
     pub width: u32,
@@ -145,6 +147,7 @@ impl Model {
                         height: t.height,
                         mips: t.mips.len(),
                         color_space: t.color_space,
+                        bits: t.bits(),
                     })
                 })
                 .collect(),

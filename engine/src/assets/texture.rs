@@ -1,13 +1,20 @@
-//! Texture loading: decode with `image`, convert to RGBA8, build a CPU mip
+//! Texture loading: decode with `image` (PNG, JPEG, TGA, BMP), build a CPU mip
 //! chain, and deduplicate decodes through [`TextureCache`].
+//!
+//! 8-bit files become RGBA8 textures. 16-bit files (16-bit PNG, the usual form of precise
+//! normal maps) are not truncated to 8 bits: they become RGBA16F textures, which keep 11
+//! significant bits (a step of at most 1/2048 of a value, against 1/255 for 8 bits) and which
+//! every backend can filter; an sRGB 16-bit map is decoded to linear before it is stored, so
+//! sampling returns linear values either way.
 //!
 //! Mip levels follow the GPU convention: level `k` is
 //! `max(1, width >> k) x max(1, height >> k)`, down to 1x1. Each texel of a
-//! level is the 2x2 box average of the level above; sample coordinates are
-//! clamped to the source edge (so a 1-texel-wide source repeats its column,
-//! and for an odd source size the last row/column is not sampled). sRGB
-//! textures average RGB in linear light and re-encode; alpha and `Linear`
-//! textures average the stored values with round-half-up integer math.
+//! level is the box-filtered average of the area of the level above that it
+//! covers: the 2x2 texels below it where a size is even, and three texels per
+//! axis, weighted by how much of each the texel covers, where a size is odd
+//! (so no row or column of an odd-sized texture is dropped). sRGB textures
+//! average RGB in linear light and re-encode; alpha and `Linear` textures
+//! average the stored values, rounding half up.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -31,7 +38,16 @@ pub enum ColorSpace {
 #[derive(Copy, Clone, PartialEq, Eq, Hash, Debug, Serialize)]
 pub struct TextureId(pub u32);
 
-/// A decoded RGBA8 texture with its full mip chain.
+/// How a decoded texture's texels are stored.
+#[derive(Copy, Clone, PartialEq, Eq, Hash, Debug, Serialize)]
+pub enum TexelFormat {
+    /// Four bytes per texel, in the texture's colour space.
+    Rgba8,
+    /// Four little-endian IEEE half floats per texel, linear (from 16-bit files).
+    Rgba16Float,
+}
+
+/// A decoded texture with its full mip chain.
 #[derive(Clone, Debug)]
 pub struct TextureData {
     /// Path the texture was loaded from (as given to the loader).
@@ -42,12 +58,22 @@ pub struct TextureData {
     pub width: u32,
     /// Height of mip level 0.
     pub height: u32,
-    /// RGBA8 texels, tightly packed, top row first; `mips[0]` is full size,
+    /// How each level's texels are stored.
+    pub format: TexelFormat,
+    /// Texels, tightly packed in `format`, top row first; `mips[0]` is full size,
     /// the last level is 1x1.
     pub mips: Vec<Vec<u8>>,
 }
 
 impl TextureData {
+    /// Bits per channel of the file the texture came from (8 or 16).
+    pub fn bits(&self) -> u8 {
+        match self.format {
+            TexelFormat::Rgba8 => 8,
+            TexelFormat::Rgba16Float => 16,
+        }
+    }
+
     /// Size of mip level `level` (`max(1, size >> level)` per axis).
     pub fn mip_size(&self, level: usize) -> (u32, u32) {
         let shift = u32::try_from(level).unwrap_or(u32::MAX);
@@ -58,29 +84,71 @@ impl TextureData {
     }
 }
 
-/// Decodes an image file into RGBA8 and builds its mip chain.
+/// Decodes an image file and builds its mip chain: RGBA8 for 8-bit files, RGBA16F for 16-bit
+/// ones (see the module docs).
 ///
-/// The format is detected from the file contents (this build supports PNG).
+/// The format is detected from the file contents: PNG, JPEG, TGA or BMP.
 pub fn load_texture(path: &Path, color_space: ColorSpace) -> Result<TextureData, AssetError> {
+    // The format from the contents where they tell it, else from the extension (TGA has no
+    // signature).
     let bytes = std::fs::read(path).map_err(|e| AssetError::io(path, e))?;
-    let image = image::load_from_memory(&bytes).map_err(|source| AssetError::ImageDecode {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let rgba = image.into_rgba8();
-    let (width, height) = rgba.dimensions();
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+    if let Ok(format) = image::ImageFormat::from_path(path) {
+        reader.set_format(format);
+    }
+    let image = reader
+        .with_guessed_format()
+        .map_err(|e| AssetError::io(path, e))?
+        .decode()
+        .map_err(|source| AssetError::ImageDecode {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    let (width, height) = (image.width(), image.height());
     if width == 0 || height == 0 {
         return Err(AssetError::invalid_image(
             path,
             format!("image has zero size ({width}x{height})"),
         ));
     }
-    let mips = generate_mips(width, height, &rgba.into_raw(), color_space);
+    let sixteen_bits = image.color().bytes_per_pixel() / image.color().channel_count() == 2;
+    let (format, mips) = if sixteen_bits {
+        let level0: Vec<[f32; 4]> = image
+            .into_rgba16()
+            .pixels()
+            .map(|p| {
+                let value = |c: usize| f64::from(p[c]) / 65535.0;
+                let color = |c: usize| match color_space {
+                    ColorSpace::Srgb => srgb_to_linear(value(c)),
+                    ColorSpace::Linear => value(c),
+                };
+                [color(0), color(1), color(2), value(3)].map(|v| v as f32)
+            })
+            .collect();
+        let mips = generate_mips_f32(width, height, level0)
+            .iter()
+            .map(|level| {
+                level
+                    .iter()
+                    .flatten()
+                    .flat_map(|&v| half::f16::from_f32(v).to_le_bytes())
+                    .collect()
+            })
+            .collect();
+        (TexelFormat::Rgba16Float, mips)
+    } else {
+        let rgba = image.into_rgba8();
+        (
+            TexelFormat::Rgba8,
+            generate_mips(width, height, &rgba.into_raw(), color_space),
+        )
+    };
     Ok(TextureData {
         path: path.to_path_buf(),
         color_space,
         width,
         height,
+        format,
         mips,
     })
 }
@@ -110,6 +178,65 @@ pub fn generate_mips(
     mips
 }
 
+/// Builds the full mip chain (level 0 included) of a linear float RGBA image with the same
+/// box filter as [`generate_mips`] (every channel averaged as stored, no rounding).
+pub fn generate_mips_f32(width: u32, height: u32, level0: Vec<[f32; 4]>) -> Vec<Vec<[f32; 4]>> {
+    let (mut w, mut h) = (width.max(1), height.max(1));
+    let mut first = level0;
+    first.resize(w as usize * h as usize, [0.0; 4]);
+    let mut mips = vec![first];
+    while w > 1 || h > 1 {
+        let Some(src) = mips.last() else { break };
+        let (dw, dh) = ((w / 2).max(1), (h / 2).max(1));
+        let (xs, ys) = (box_taps(w, dw), box_taps(h, dh));
+        let mut next = Vec::with_capacity(dw as usize * dh as usize);
+        for y_taps in &ys {
+            for x_taps in &xs {
+                let mut sum = [0.0f64; 4];
+                for &(sy, wy) in y_taps {
+                    for &(sx, wx) in x_taps {
+                        let texel = src
+                            .get(sy as usize * w as usize + sx as usize)
+                            .copied()
+                            .unwrap_or([0.0; 4]);
+                        for (total, v) in sum.iter_mut().zip(texel) {
+                            *total += wx * wy * f64::from(v);
+                        }
+                    }
+                }
+                next.push(sum.map(|v| v as f32));
+            }
+        }
+        mips.push(next);
+        w = dw;
+        h = dh;
+    }
+    mips
+}
+
+/// The source texels of one axis under each destination texel when `source` texels shrink to
+/// `destination` (a box filter): destination texel `i` covers `[i, i + 1) * source /
+/// destination`, and each source texel weighs the fraction of that span it covers. An even
+/// size gives two taps of 1/2; an odd size three taps (for 5 -> 2: 0.4, 0.4, 0.2 and 0.2, 0.4,
+/// 0.4); a size of 1 one tap of 1.
+fn box_taps(source: u32, destination: u32) -> Vec<Vec<(u32, f64)>> {
+    let (source, destination) = (u64::from(source.max(1)), u64::from(destination.max(1)));
+    (0..destination)
+        .map(|i| {
+            // In units of 1/destination source texels: the span is [lo, hi).
+            let (lo, hi) = (i * source, (i + 1) * source);
+            let first = lo / destination;
+            let last = (hi - 1) / destination;
+            (first..=last)
+                .filter_map(|j| {
+                    let covered = hi.min((j + 1) * destination) - lo.max(j * destination);
+                    (covered > 0).then(|| (j as u32, covered as f64 / source as f64))
+                })
+                .collect()
+        })
+        .collect()
+}
+
 fn texel_bytes(w: u32, h: u32) -> usize {
     (w as usize).saturating_mul(h as usize).saturating_mul(4)
 }
@@ -117,11 +244,17 @@ fn texel_bytes(w: u32, h: u32) -> usize {
 fn downsample(src: &[u8], sw: u32, sh: u32, cs: ColorSpace) -> (Vec<u8>, u32, u32) {
     let (dw, dh) = ((sw / 2).max(1), (sh / 2).max(1));
     let lut = srgb_to_linear_lut();
-    let mut dst = Vec::with_capacity(texel_bytes(dw, dh));
     let at = |x: u32, y: u32, c: usize| -> u8 {
         let i = (y as usize * sw as usize + x as usize) * 4 + c;
         src.get(i).copied().unwrap_or(0)
     };
+    let odd = |size: u32| size > 1 && size % 2 == 1;
+    if odd(sw) || odd(sh) {
+        return (downsample_weighted(sw, sh, dw, dh, cs, &at), dw, dh);
+    }
+    // Even sizes (or 1): the 2x2 texels below, edge-clamped where a size is 1. Kept apart from
+    // the weighted path so that these levels stay bit for bit what they have always been.
+    let mut dst = Vec::with_capacity(texel_bytes(dw, dh));
     for y in 0..dh {
         let (y0, y1) = ((2 * y).min(sh - 1), (2 * y + 1).min(sh - 1));
         for x in 0..dw {
@@ -143,6 +276,46 @@ fn downsample(src: &[u8], sw: u32, sh: u32, cs: ColorSpace) -> (Vec<u8>, u32, u3
         }
     }
     (dst, dw, dh)
+}
+
+/// One level down where a size is odd: each texel the [`box_taps`]-weighted mean of the texels
+/// it covers.
+fn downsample_weighted(
+    sw: u32,
+    sh: u32,
+    dw: u32,
+    dh: u32,
+    cs: ColorSpace,
+    at: &dyn Fn(u32, u32, usize) -> u8,
+) -> Vec<u8> {
+    let lut = srgb_to_linear_lut();
+    let (xs, ys) = (box_taps(sw, dw), box_taps(sh, dh));
+    let mut dst = Vec::with_capacity(texel_bytes(dw, dh));
+    for y_taps in &ys {
+        for x_taps in &xs {
+            for c in 0..4 {
+                let srgb = cs == ColorSpace::Srgb && c < 3;
+                let mut sum = 0.0f64;
+                for &(sy, wy) in y_taps {
+                    for &(sx, wx) in x_taps {
+                        let v = at(sx, sy, c);
+                        let v = if srgb {
+                            lut.get(v as usize).copied().unwrap_or(0.0)
+                        } else {
+                            f64::from(v)
+                        };
+                        sum += wx * wy * v;
+                    }
+                }
+                dst.push(if srgb {
+                    linear_to_srgb_u8(sum)
+                } else {
+                    (sum + 0.5).floor().clamp(0.0, 255.0) as u8
+                });
+            }
+        }
+    }
+    dst
 }
 
 /// Exact sRGB decode of every 8-bit value.
@@ -225,29 +398,40 @@ impl TextureCache {
         let id = u32::try_from(self.textures.len())
             .map(TextureId)
             .map_err(|_| AssetError::invalid_image(path, "texture cache is full"))?;
-        // Size from the header only, checked and reserved (RGBA8 with a full mip chain, 4/3 of
-        // level 0) before anything is decoded.
-        let (width, height) = image::ImageReader::open(path)
+        // Size and bit depth from the header only, checked and reserved (RGBA8 or RGBA16F with
+        // a full mip chain, 4/3 of level 0) before anything is decoded.
+        let decoder = image::ImageReader::open(path)
             .map_err(|e| AssetError::io(path, e))?
             .with_guessed_format()
             .map_err(|e| AssetError::io(path, e))?
-            .into_dimensions()
+            .into_decoder()
             .map_err(|source| AssetError::ImageDecode {
                 path: path.to_path_buf(),
                 source,
             })?;
+        let (width, height) = image::ImageDecoder::dimensions(&decoder);
+        let color = image::ImageDecoder::color_type(&decoder);
+        let texel_bytes = if color.bytes_per_pixel() / color.channel_count() == 2 {
+            8
+        } else {
+            4
+        };
+        drop(decoder);
         self.budget.check_image(path, width, height)?;
-        self.budget
-            .reserve(path, u64::from(width) * u64::from(height) * 4 * 4 / 3)?;
+        self.budget.reserve(
+            path,
+            u64::from(width) * u64::from(height) * texel_bytes * 4 / 3,
+        )?;
         self.decodes += 1;
         let texture = load_texture(path, color_space)?;
         log::info!(
-            "decoded texture {} ({}x{}, {} mips, {:?})",
+            "decoded texture {} ({}x{}, {} mips, {:?}, {:?})",
             path.display(),
             texture.width,
             texture.height,
             texture.mips.len(),
-            color_space
+            color_space,
+            texture.format
         );
         self.textures.push(texture);
         self.by_key.insert(key, id);

@@ -551,10 +551,10 @@ fn record_and_submit(
     // Material textures, plus a white texel bound wherever a material has no map.
     let mut textures = Vec::with_capacity(scene.textures.len());
     for image in &scene.textures {
-        let format = if image.srgb {
-            TextureFormat::Rgba8UnormSrgb
-        } else {
-            TextureFormat::Rgba8Unorm
+        let format = match (image.format, image.srgb) {
+            (crate::assets::TexelFormat::Rgba16Float, _) => TextureFormat::Rgba16Float,
+            (crate::assets::TexelFormat::Rgba8, true) => TextureFormat::Rgba8UnormSrgb,
+            (crate::assets::TexelFormat::Rgba8, false) => TextureFormat::Rgba8Unorm,
         };
         let handle = scope.texture(
             backend,
