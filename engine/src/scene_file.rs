@@ -329,6 +329,10 @@ pub struct LoadedScene {
     pub tolerances: toml::Table,
     /// Texture files decoded while loading (each at most once).
     pub textures_decoded: usize,
+    /// What the loaders noted about untidy but usable assets (text that is not UTF-8, a
+    /// missing material library, unknown material names, generated normals, ...), each
+    /// asset's once, each naming its file and line.
+    pub warnings: Vec<String>,
 }
 
 fn line_column(text: &str, offset: usize) -> (usize, usize) {
@@ -415,6 +419,8 @@ struct Resolver {
     texture_index: HashMap<TextureId, usize>,
     textures: Vec<Arc<TextureImage>>,
     models: HashMap<PathBuf, Arc<MeshParts>>,
+    /// Each loaded asset's warnings, once per asset.
+    warnings: Vec<String>,
 }
 
 /// The meshes of one OBJ file, each with its MTL material.
@@ -433,6 +439,7 @@ impl Resolver {
             texture_index: HashMap::new(),
             textures: Vec::new(),
             models: HashMap::new(),
+            warnings: Vec::new(),
         }
     }
 
@@ -483,6 +490,7 @@ impl Resolver {
             srgb: data.color_space == ColorSpace::Srgb,
             width: data.width,
             height: data.height,
+            format: data.format,
             mips: data.mips.clone(),
         }));
         self.texture_index.insert(id, index);
@@ -510,6 +518,7 @@ impl Resolver {
             }
             None => {
                 let model = assets::load_obj(&key, &mut self.cache).map_err(|e| self.asset(e))?;
+                self.warnings.extend(model.warnings);
                 let materials = model.materials;
                 model
                     .meshes
@@ -725,6 +734,7 @@ impl Resolver {
             description: file.description,
             tolerances: file.tolerances,
             textures_decoded: self.cache.decode_count(),
+            warnings: self.warnings,
         })
     }
 }

@@ -82,10 +82,79 @@ fn nan_and_inf_coordinates() {
     );
 }
 
+/// Bytes that are not UTF-8 (a Latin-1 name) are read lossily with one warning naming the
+/// file, the line and the byte; the model loads.
 #[test]
-fn non_utf8_bytes() {
-    let e = load_err("non_utf8.obj");
-    assert!(e.contains("non_utf8.obj:4: invalid UTF-8"), "{e}");
+fn non_utf8_bytes_load_with_a_warning() {
+    let model = load("non_utf8.obj").unwrap();
+    assert_eq!(model.meshes.len(), 1);
+    let warnings: Vec<_> = model
+        .warnings
+        .iter()
+        .filter(|w| w.contains("UTF-8"))
+        .collect();
+    assert_eq!(warnings.len(), 1, "{:?}", model.warnings);
+    assert!(
+        warnings[0].contains("non_utf8.obj:4: not UTF-8 at byte 6 (1 lines in all)"),
+        "{}",
+        warnings[0]
+    );
+    assert_eq!(model.meshes[0].name, "caf\u{fffd} \u{fffd}\u{fffd}");
+}
+
+/// A Latin-1 MTL loads with a warning of its own, and its material is found by the OBJ's
+/// equally Latin-1 `usemtl` (both names are decoded the same way).
+#[test]
+fn latin1_mtl_loads_with_a_warning_and_its_material_is_used() {
+    let model = load("latin1_mtl.obj").unwrap();
+    assert!(
+        model
+            .warnings
+            .iter()
+            .any(|w| w.contains("latin1.mtl:1: not UTF-8 at byte 11 (2 lines in all)")),
+        "{:?}",
+        model.warnings
+    );
+    assert_eq!(model.materials.len(), 1);
+    assert_eq!(model.meshes[0].material, Some(0));
+    assert_eq!(model.materials[0].diffuse, Some([0.8, 0.2, 0.1]));
+    assert!(!model
+        .warnings
+        .iter()
+        .any(|w| w.contains("names no material")));
+}
+
+/// A missing library, a nameless `usemtl` and a name no MTL defines: each warns once, naming
+/// the file and line, and their faces take the default material (no material index).
+#[test]
+fn untidy_material_references_warn_and_use_the_default_material() {
+    let model = load("untidy_materials.obj").unwrap();
+    let expect = [
+        "untidy_materials.obj:2: material library",
+        "does_not_exist.mtl` cannot be read",
+        "untidy_materials.obj:7: `usemtl` without a name; the faces after it use the default material",
+        "untidy_materials.obj:9: usemtl `nowhere` names no material in the loaded MTL files (2 uses)",
+    ];
+    for needle in expect {
+        assert!(
+            model.warnings.iter().any(|w| w.contains(needle)),
+            "no warning with `{needle}`: {:?}",
+            model.warnings
+        );
+    }
+    assert_eq!(
+        model
+            .warnings
+            .iter()
+            .filter(|w| w.contains("nowhere"))
+            .count(),
+        1,
+        "{:?}",
+        model.warnings
+    );
+    let triangles: usize = model.meshes.iter().map(|m| m.indices.len() / 3).sum();
+    assert_eq!(triangles, 3);
+    assert!(model.meshes.iter().all(|m| m.material.is_none()));
 }
 
 #[test]
@@ -105,14 +174,22 @@ fn gigantic_indices_fail_fast() {
     }
 }
 
+/// A library that is not there is a warning naming the OBJ's `mtllib` line and the file; the
+/// mesh loads with the default material.
 #[test]
-fn missing_mtl() {
-    let e = load_err("missing_mtl.obj");
+fn missing_mtl_loads_with_a_warning() {
+    let model = load("missing_mtl.obj").unwrap();
+    assert_eq!(model.meshes.len(), 1);
+    assert!(model.materials.is_empty());
     assert!(
-        e.contains("does_not_exist.mtl: material library referenced from"),
-        "{e}"
+        model
+            .warnings
+            .iter()
+            .any(|w| w.contains("missing_mtl.obj:1: material library")
+                && w.contains("does_not_exist.mtl` cannot be read")),
+        "{:?}",
+        model.warnings
     );
-    assert!(e.contains("missing_mtl.obj:1"), "{e}");
 }
 
 #[test]

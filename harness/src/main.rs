@@ -314,13 +314,25 @@ fn backends(json: bool) -> anyhow::Result<ExitCode> {
 }
 
 fn load_cases(scenes: &[String]) -> anyhow::Result<Vec<harness::suite::Case>> {
-    if scenes.is_empty() {
-        return Ok(harness::suite::canonical_cases()?);
+    let cases: Vec<harness::suite::Case> = if scenes.is_empty() {
+        harness::suite::canonical_cases()?
+    } else {
+        scenes
+            .iter()
+            .map(|s| harness::suite::Case::load(s))
+            .collect::<Result<_, _>>()?
+    };
+    for case in &cases {
+        print_load_warnings(&case.loaded);
     }
-    scenes
-        .iter()
-        .map(|s| harness::suite::Case::load(s).map_err(Into::into))
-        .collect()
+    Ok(cases)
+}
+
+/// A scene's asset warnings on stderr, once per asset (the loader collects each once).
+fn print_load_warnings(loaded: &engine::scene_file::LoadedScene) {
+    for warning in &loaded.warnings {
+        eprintln!("warning: {warning}");
+    }
 }
 
 fn check(
@@ -525,6 +537,7 @@ fn render(
     out: Option<PathBuf>,
 ) -> anyhow::Result<ExitCode> {
     let loaded = harness::load_scene(scene)?;
+    print_load_warnings(&loaded);
     let scene = &loaded.scene;
     let plan = engine::plan::RenderPlan::new(scene);
     let names: Vec<String> = if passes.is_empty() {

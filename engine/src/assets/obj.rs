@@ -145,21 +145,39 @@ pub fn load_obj(path: &Path, textures: &mut TextureCache) -> Result<Model, Asset
         source,
     })?;
 
+    for missing in &state.missing_mtls {
+        warn(&mut warnings, missing.clone());
+    }
     let mut materials = Vec::new();
     for lib in &state.libs {
         warnings.extend(lib.warnings.iter().cloned());
         materials.extend(resolve_materials(lib, textures)?);
     }
+    // One warning per unknown name, at its first use.
+    let mut unknown: Vec<(&str, usize, usize)> = Vec::new();
     for (name, line) in &scan.usemtls {
-        if !materials.iter().any(|m| &m.name == name) {
-            warn(
-                &mut warnings,
-                format!(
-                    "{}:{line}: usemtl `{name}` names no material in the loaded MTL files",
-                    path.display()
-                ),
-            );
+        if materials.iter().any(|m| &m.name == name) {
+            continue;
         }
+        match unknown.iter_mut().find(|(n, _, _)| n == name) {
+            Some((_, _, uses)) => *uses += 1,
+            None => unknown.push((name, *line, 1)),
+        }
+    }
+    for (name, line, uses) in unknown {
+        let more = if uses > 1 {
+            format!(" ({uses} uses)")
+        } else {
+            String::new()
+        };
+        warn(
+            &mut warnings,
+            format!(
+                "{}:{line}: usemtl `{name}` names no material in the loaded MTL files{more}; \
+                 its faces use the default material",
+                path.display()
+            ),
+        );
     }
 
     let mut meshes = Vec::new();
@@ -220,8 +238,10 @@ pub fn load_obj(path: &Path, textures: &mut TextureCache) -> Result<Model, Asset
     })
 }
 
+/// Records a warning. It is logged at debug level only: callers report the list they get back
+/// ([`Model::warnings`]), once per asset.
 fn warn(warnings: &mut Vec<String>, msg: String) {
-    log::warn!("{msg}");
+    log::debug!("{msg}");
     warnings.push(msg);
 }
 
@@ -229,6 +249,8 @@ fn warn(warnings: &mut Vec<String>, msg: String) {
 struct LoaderState {
     calls: usize,
     libs: Vec<ParsedMtl>,
+    /// Warnings for `mtllib` files that could not be read.
+    missing_mtls: Vec<String>,
     error: Option<AssetError>,
 }
 
@@ -262,13 +284,26 @@ fn load_mtllib(
         match parse_mtl_file(&file, obj, line) {
             Ok(lib) => {
                 for m in &lib.materials {
-                    map.insert(m.name.clone(), tobj_materials.len());
+                    if m.name != NO_MATERIAL {
+                        map.insert(m.name.clone(), tobj_materials.len());
+                    }
                     tobj_materials.push(tobj::Material {
                         name: m.name.clone(),
                         ..Default::default()
                     });
                 }
                 st.libs.push(lib);
+            }
+            // A library that is not there: its materials are missing, not the model. The
+            // `usemtl`s naming them are reported once the load is done.
+            Err(AssetError::MissingMtl { path, source, .. }) => {
+                let at = line.map_or(String::new(), |l| format!(":{l}"));
+                st.missing_mtls.push(format!(
+                    "{}{at}: material library `{}` cannot be read ({source}); its materials are \
+                     missing and their faces use the default material",
+                    obj.display(),
+                    path.display()
+                ));
             }
             Err(e) => {
                 st.error = Some(e);
@@ -339,6 +374,10 @@ struct Scan {
     warnings: Vec<String>,
 }
 
+/// The material name a nameless `usemtl` is given for `tobj`: no MTL material answers to it
+/// (see `load_mtllib`), so its faces take the default material.
+const NO_MATERIAL: &str = "\u{fffd}no material\u{fffd}";
+
 /// Statements that are valid OBJ but not supported (free-form geometry etc.).
 const SILENTLY_IGNORED: &[&str] = &[
     "s",
@@ -358,17 +397,20 @@ fn prescan(path: &Path, bytes: &[u8]) -> Result<Scan, AssetError> {
     };
     let (mut first_skipped, mut polygons, mut colors) = (None, 0usize, 0usize);
     let (mut unsupported, mut first_unsupported) = (0usize, None);
+    // Lines that are not UTF-8 (Latin-1 comments and names are common), and the first one
+    // with the byte where it stops being UTF-8.
+    let mut not_utf8: (usize, Option<(usize, usize)>) = (0, None);
+    // Statements skipped because they name nothing (`usemtl` or `mtllib` alone).
+    let mut unnamed: Vec<(String, usize)> = Vec::new();
     for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
         let lineno = i + 1;
         let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
-        let line = std::str::from_utf8(raw).map_err(|e| {
-            AssetError::parse(
-                path,
-                lineno,
-                format!("invalid UTF-8 at byte {}", e.valid_up_to() + 1),
-            )
-        })?;
-        let mut line = line.trim();
+        let decoded = String::from_utf8_lossy(raw);
+        if let Err(e) = std::str::from_utf8(raw) {
+            not_utf8.0 += 1;
+            not_utf8.1.get_or_insert((lineno, e.valid_up_to() + 1));
+        }
+        let mut line = decoded.trim();
         // Inline comments on element lines (names and file paths may contain '#').
         if matches!(
             line.split_whitespace().next(),
@@ -463,7 +505,13 @@ fn prescan(path: &Path, bytes: &[u8]) -> Result<Scan, AssetError> {
             "o" | "g" => push_line(&mut scan.normalized, &format!("{key} {rest}")),
             "usemtl" | "mtllib" => {
                 if rest.is_empty() {
-                    return Err(err(format!("`{key}` without a name")));
+                    unnamed.push((key.to_string(), lineno));
+                    if key == "usemtl" {
+                        // The faces after it take the default material, as after a name that
+                        // no MTL defines.
+                        push_line(&mut scan.normalized, &format!("usemtl {NO_MATERIAL}"));
+                    }
+                    continue;
                 }
                 if key == "usemtl" {
                     scan.usemtls.push((rest.to_string(), lineno));
@@ -481,40 +529,42 @@ fn prescan(path: &Path, bytes: &[u8]) -> Result<Scan, AssetError> {
     }
     let p = path.display();
     let mut notes = Vec::new();
+    if let Some((line, byte)) = not_utf8.1 {
+        notes.push(format!(
+            "{p}:{line}: not UTF-8 at byte {byte} ({} lines in all); read with U+FFFD in \
+             place of the bad bytes",
+            not_utf8.0
+        ));
+    }
+    for (key, line) in unnamed {
+        let what = if key == "usemtl" {
+            "the faces after it use the default material"
+        } else {
+            "ignored"
+        };
+        notes.push(format!("{p}:{line}: `{key}` without a name; {what}"));
+    }
     if let Some(line) = first_skipped {
-        notes.push((
-            true,
-            format!(
+        notes.push(format!(
             "{p}:{line}: skipped {} point (p) and {} line (l) elements (only faces are rendered)",
             scan.points, scan.lines
-        ),
         ));
     }
     if polygons > 0 {
-        notes.push((
-            false,
-            format!("{p}: triangulated {polygons} polygons with more than 3 vertices"),
+        notes.push(format!(
+            "{p}: triangulated {polygons} polygons with more than 3 vertices"
         ));
     }
     if colors > 0 {
-        notes.push((
-            false,
-            format!("{p}: ignored vertex colours on {colors} vertices"),
-        ));
+        notes.push(format!("{p}: ignored vertex colours on {colors} vertices"));
     }
     if let Some((k, line)) = first_unsupported {
-        notes.push((
-            true,
-            format!("{p}:{line}: ignored {unsupported} unsupported statements (first: `{k}`)"),
+        notes.push(format!(
+            "{p}:{line}: ignored {unsupported} unsupported statements (first: `{k}`)"
         ));
     }
-    for (is_warning, msg) in notes {
-        if is_warning {
-            log::warn!("{msg}");
-        } else {
-            log::info!("{msg}");
-        }
-        scan.warnings.push(msg);
+    for msg in notes {
+        warn(&mut scan.warnings, msg);
     }
     Ok(scan)
 }
