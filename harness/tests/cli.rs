@@ -34,8 +34,6 @@ fn inspect_fails_cleanly_on_every_malformed_fixture() {
         ("zero_index.obj", "zero_index.obj:"),
         ("nan_coord.obj", "nan_coord.obj:"),
         ("inf_coord.obj", "inf_coord.obj:"),
-        ("non_utf8.obj", "UTF-8"),
-        ("missing_mtl.obj", "missing_mtl.obj"),
         ("missing_texture.obj", "missing_texture.mtl"),
         ("corrupt_texture.obj", "corrupt_texture.mtl"),
         ("huge_index.obj", "huge_index.obj:"),
@@ -45,6 +43,7 @@ fn inspect_fails_cleanly_on_every_malformed_fixture() {
         ("corrupt.exr", "corrupt.exr"),
         ("textures/corrupt.png", "corrupt.png"),
         ("missing_texture.mtl", "missing_texture.mtl"),
+        ("truncated.hdr", "truncated.hdr"),
     ];
     for (file, expected) in cases {
         let path = fixture(file);
@@ -61,14 +60,30 @@ fn inspect_fails_cleanly_on_every_malformed_fixture() {
 
 #[test]
 fn inspect_loads_fixtures_that_only_warn() {
-    for file in [
-        "unknown_keys.obj",
-        "points_lines.obj",
-        "ngons.obj",
-        "textured.mtl",
+    for (file, warning) in [
+        ("unknown_keys.obj", "unknown MTL key"),
+        ("points_lines.obj", "skipped"),
+        ("ngons.obj", "triangulated"),
+        ("textured.mtl", ""),
+        ("non_utf8.obj", "non_utf8.obj:4: not UTF-8"),
+        ("missing_mtl.obj", "does_not_exist.mtl` cannot be read"),
+        ("latin1_mtl.obj", "latin1.mtl:1: not UTF-8"),
+        (
+            "untidy_materials.obj",
+            "untidy_materials.obj:7: `usemtl` without a name",
+        ),
+        ("textures/gradient.jpg", ""),
+        ("textures/gradient.tga", ""),
+        ("textures/gradient.bmp", ""),
+        ("textures/fine16.png", ""),
+        ("sky.hdr", ""),
     ] {
         let (code, stdout, stderr) = harness(&["inspect", fixture(file).to_str().unwrap()]);
         assert_eq!(code, 0, "{file}: exit {code}\n{stdout}\n{stderr}");
+        assert!(
+            stdout.contains(warning),
+            "{file}: no `{warning}` in\n{stdout}"
+        );
     }
     let (code, stdout, _) = harness(&[
         "inspect",
@@ -78,6 +93,80 @@ fn inspect_loads_fixtures_that_only_warn() {
     assert_eq!(code, 0);
     let value: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     assert_eq!(value["textures_decoded"], 3);
+}
+
+/// `harness inspect` on a JPEG-textured OBJ lists its textures with their sizes, bit depths and
+/// color spaces, and its warnings (text and `--json`).
+#[test]
+fn inspect_lists_a_real_world_models_textures_and_warnings() {
+    let crate_obj = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/assets/crate.obj");
+    let (code, stdout, stderr) = harness(&["inspect", crate_obj.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stderr}");
+    for line in [
+        "crate_albedo.jpg 120x75 8-bit 7 mips Srgb",
+        "crate_roughness.tga 64x64 8-bit 7 mips Linear",
+        "crate_normal.png 64x64 16-bit 7 mips Linear",
+        "crate_specular.bmp 64x64 8-bit 7 mips Linear",
+        "crate.obj:2: not UTF-8",
+        "usemtl `shipping_label` names no material",
+    ] {
+        assert!(stdout.contains(line), "no `{line}` in\n{stdout}");
+    }
+    let (code, stdout, _) = harness(&["inspect", "--json", crate_obj.to_str().unwrap()]);
+    assert_eq!(code, 0);
+    let value: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let textures = value["model"]["textures"].as_array().unwrap();
+    assert_eq!(textures.len(), 4);
+    assert_eq!(textures[0]["width"], 120);
+    assert_eq!(textures[0]["height"], 75);
+    assert_eq!(textures[0]["color_space"], "Srgb");
+    assert_eq!(textures[2]["bits"], 16);
+    assert!(value["model"]["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|w| w.as_str().unwrap().contains("crate.mtl:1: not UTF-8")));
+}
+
+/// `harness render` of a scene with untidy assets prints each load warning once on stderr; a
+/// canonical scene has none.
+#[test]
+fn render_prints_each_load_warning_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/models/crate.toml");
+    let out = dir.path().join("crate.png");
+    let (code, stdout, stderr) = harness(&[
+        "render",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    if stderr.contains("unavailable") {
+        eprintln!("gl unavailable here; skipped");
+        return;
+    }
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    assert!(out.is_file());
+    for needle in [
+        "crate.obj:2: not UTF-8",
+        "crate.mtl:1: not UTF-8",
+        "crate.obj:30: `usemtl` without a name",
+        "usemtl `shipping_label` names no material",
+    ] {
+        let lines: Vec<&str> = stderr.lines().filter(|l| l.contains(needle)).collect();
+        assert_eq!(lines.len(), 1, "`{needle}` once in\n{stderr}");
+        assert!(lines[0].starts_with("warning: "), "{}", lines[0]);
+    }
+    let chess = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/chess.toml");
+    let (code, stdout, _) = harness(&["inspect", "--json", chess.to_str().unwrap()]);
+    assert_eq!(code, 0);
+    let value: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(
+        value["warnings"],
+        serde_json::json!([]),
+        "the canonical assets are tidy"
+    );
 }
 
 #[test]
