@@ -320,3 +320,36 @@ fn lighting_variants_follow_the_scene_and_are_compiled_once() {
         );
     }
 }
+
+/// A scene with an environment and no objects renders the sky in every pixel (it panicked
+/// indexing the shader mask, which such a scene does not have), the same sky as where the ibl
+/// scene's objects leave it visible.
+#[test]
+fn an_environment_without_objects_renders_the_sky_everywhere() {
+    harness::use_ibl_cache();
+    let with_objects = harness::load_scene("ibl").unwrap().scene;
+    let mut empty = with_objects.clone();
+    empty.objects.clear();
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        let sky = renderer::render(backend.as_mut(), &empty, Readback::Only(&["light"]))
+            .unwrap_or_else(|e| panic!("{kind}: {e}"));
+        let sky = sky.output("light").unwrap().as_f32().unwrap();
+        assert!(
+            sky.chunks_exact(4)
+                .all(|p| p[..3].iter().all(|v| v.is_finite() && *v > 0.0)),
+            "{kind}: a pixel without sky"
+        );
+        let full = render(backend.as_mut(), &with_objects);
+        let light = full.output("light").unwrap().as_f32().unwrap();
+        let mask = full.output("mask").unwrap().as_u8().unwrap();
+        let mut compared = 0;
+        for (i, (a, b)) in sky.chunks_exact(4).zip(light.chunks_exact(4)).enumerate() {
+            if mask[i * 4..i * 4 + 4].iter().all(|&m| m == 0) {
+                assert_eq!(a[..3], b[..3], "{kind}: pixel {i}");
+                compared += 1;
+            }
+        }
+        assert!(compared > 1000, "{kind}: {compared} sky pixels compared");
+    }
+}

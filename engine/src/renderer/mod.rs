@@ -872,7 +872,11 @@ fn record_and_submit(
                 pipeline,
                 vec![
                     binding(0, BindingResource::Buffer(uniform)),
-                    binding(1, BindingResource::Texture(mask_targets[0])),
+                    // No objects, no mask target: the black texel says nothing is covered.
+                    binding(
+                        1,
+                        BindingResource::Texture(mask_targets.first().copied().unwrap_or(black)),
+                    ),
                     binding(
                         2,
                         BindingResource::Texture(mask_targets.get(1).copied().unwrap_or(black)),
