@@ -497,6 +497,18 @@ impl Resolver {
         Some(index)
     }
 
+    /// Warns that `path` (the scene's `what`) is absolute: a golden made with it would not load
+    /// on another machine or checkout. Relative paths are resolved against the scene file.
+    fn warn_if_absolute(&mut self, what: &str, path: &str) {
+        if Path::new(path).is_absolute() {
+            self.warnings.push(format!(
+                "{}: {what} `{path}` is an absolute path; it will not resolve on another machine \
+                 (give it relative to the scene file)",
+                self.path.display()
+            ));
+        }
+    }
+
     /// The meshes (with their MTL materials) of an OBJ file or built-in mesh, loaded once.
     fn model(&mut self, mesh_ref: &str) -> Result<Arc<MeshParts>, SceneFileError> {
         let key = if mesh_ref.starts_with("builtin:") {
@@ -563,6 +575,7 @@ impl Resolver {
         };
         let environment = match &file.environment {
             Some(spec) => {
+                self.warn_if_absolute("[environment] path", &spec.path.to_string_lossy());
                 let env_path = self.dir.join(&spec.path);
                 self.reserve_environment(&env_path)
                     .map_err(|e| self.asset(e))?;
@@ -591,6 +604,7 @@ impl Resolver {
                     .unwrap_or("object");
                 format!("{stem}_{index}")
             });
+            self.warn_if_absolute(&format!("object `{base_name}`: mesh"), &spec.mesh);
             if !finite(&spec.position) || !finite(&spec.rotation) {
                 return Err(self.invalid(format!(
                     "object `{base_name}`: position and rotation must be finite"
@@ -706,6 +720,16 @@ impl Resolver {
             };
             if let Some(problem) = crate::renderer::shadows::settings_problem(&light) {
                 return Err(self.invalid(format!("light {index}: {problem}")));
+            }
+            let intensity = match &light {
+                Light::Directional { intensity, .. } | Light::Point { intensity, .. } => *intensity,
+            };
+            if intensity < 0.0 {
+                self.warnings.push(format!(
+                    "{}: light {index}: negative intensity {intensity} (the light takes energy \
+                     away; no physical light does)",
+                    self.path.display()
+                ));
             }
             lights.push(light);
         }

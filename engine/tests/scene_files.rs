@@ -192,3 +192,53 @@ fn canonical_scenes_load_with_valid_tangent_frames() {
         "albedo, roughness, normal, clearcoat"
     );
 }
+
+/// A negative light intensity and absolute asset paths load, each with a warning naming the
+/// scene file and what is at fault; the canonical scenes have neither.
+#[test]
+fn negative_intensities_and_absolute_paths_are_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = fixture("cube.obj");
+    let sunset = scenes_dir()
+        .join("assets/sunset.exr")
+        .canonicalize()
+        .unwrap();
+    let scene = dir.path().join("untidy.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "{CAMERA}[environment]\npath = \"{}\"\n[[objects]]\nname = \"cube\"\nmesh = \"{}\"\n\
+             [[lights]]\ntype = \"directional\"\ndirection = [0, 1, 0]\nintensity = -2.0\n",
+            sunset.display(),
+            cube.display()
+        ),
+    )
+    .unwrap();
+    let loaded = scene_file::load(&scene).unwrap();
+    let expected = [
+        "untidy.toml: light 0: negative intensity -2".to_owned(),
+        format!(
+            "untidy.toml: object `cube`: mesh `{}` is an absolute path",
+            cube.display()
+        ),
+        format!(
+            "untidy.toml: [environment] path `{}` is an absolute path",
+            sunset.display()
+        ),
+    ];
+    for needle in &expected {
+        assert!(
+            loaded.warnings.iter().any(|w| w.contains(needle.as_str())),
+            "no `{needle}` in {:#?}",
+            loaded.warnings
+        );
+    }
+    for name in scene_file::canonical_scenes(&scenes_dir()) {
+        let path = scene_file::resolve(&name, &scenes_dir()).unwrap();
+        assert_eq!(
+            scene_file::load(&path).unwrap().warnings,
+            Vec::<String>::new(),
+            "{name}"
+        );
+    }
+}

@@ -299,6 +299,37 @@ pub fn to_text(value: &Value) -> String {
             }
             out.push_str(value["plan"].as_str().unwrap_or(""));
         }
+        Some("texture") => {
+            let t = &value["texture"];
+            line(
+                &mut out,
+                format!(
+                    "texture {} {}x{} {}-bit {} mips (loaded as {})",
+                    t["path"].as_str().unwrap_or(""),
+                    t["width"],
+                    t["height"],
+                    t["bits"],
+                    t["mips"],
+                    t["color_space"].as_str().unwrap_or("")
+                ),
+            );
+        }
+        Some("environment") => {
+            let e = &value["environment"];
+            line(
+                &mut out,
+                format!(
+                    "environment {} {}x{}, radiance ({}) {} .. {}, mean {}",
+                    e["path"].as_str().unwrap_or(""),
+                    e["width"],
+                    e["height"],
+                    e["radiance_measure"].as_str().unwrap_or(""),
+                    e["min_radiance"],
+                    e["max_radiance"],
+                    e["mean_radiance"]
+                ),
+            );
+        }
         _ => {
             out = serde_json::to_string_pretty(value).unwrap_or_default();
             out.push('\n');

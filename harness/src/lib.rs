@@ -60,3 +60,36 @@ pub fn load_scene(
     let path = engine::scene_file::resolve(name_or_path, &scenes_dir())?;
     engine::scene_file::load(&path)
 }
+
+/// An error and its causes on one line, each cause once: a cause whose text the message so far
+/// already contains (the loaders' errors quote their sources) is not repeated.
+pub fn error_text(error: &(dyn std::error::Error + 'static)) -> String {
+    let mut text = error.to_string();
+    let mut cause = error.source();
+    while let Some(next) = cause {
+        let more = next.to_string();
+        if !text.contains(&more) {
+            text.push_str(": ");
+            text.push_str(&more);
+        }
+        cause = next.source();
+    }
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn error_text_says_each_cause_once() {
+        let missing = std::path::Path::new("/nonexistent/albedo.png");
+        let asset =
+            engine::assets::load_texture(missing, engine::assets::ColorSpace::Srgb).unwrap_err();
+        let error = anyhow::Error::new(asset).context("loading scene `x`");
+        let text = super::error_text(error.as_ref());
+        assert_eq!(
+            text,
+            "loading scene `x`: /nonexistent/albedo.png: cannot read file: No such file or \
+             directory (os error 2)"
+        );
+    }
+}

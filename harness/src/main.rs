@@ -202,7 +202,32 @@ fn default_out_dir() -> PathBuf {
     harness::workspace_root().join("target/harness")
 }
 
+/// Gives the process a private runtime directory when XDG_RUNTIME_DIR is unset or unusable:
+/// the Vulkan loader and Mesa's window-system probes print "XDG_RUNTIME_DIR is invalid or not
+/// set" once per device otherwise (eight times a check), although no display is used. Runs
+/// first in `main`, before any thread or driver exists.
+fn private_runtime_dir() {
+    use std::os::unix::fs::{MetadataExt, PermissionsExt};
+    let Ok(me) = std::fs::metadata("/proc/self").map(|m| m.uid()) else {
+        return;
+    };
+    let usable = |dir: &std::path::Path| {
+        std::fs::metadata(dir)
+            .is_ok_and(|m| m.is_dir() && m.uid() == me && m.permissions().mode() & 0o077 == 0)
+    };
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| usable(std::path::Path::new(&d))) {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("harness-runtime-{me}"));
+    let _ = std::fs::create_dir(&dir);
+    let _ = std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700));
+    if usable(&dir) {
+        std::env::set_var("XDG_RUNTIME_DIR", &dir);
+    }
+}
+
 fn main() -> ExitCode {
+    private_runtime_dir();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     harness::use_ibl_cache();
@@ -278,7 +303,7 @@ fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", harness::error_text(e.as_ref()));
             ExitCode::FAILURE
         }
     }
@@ -550,6 +575,15 @@ fn render(
     } else {
         passes.to_vec()
     };
+    // Pass names are checked against the plan before anything is rendered.
+    let known = plan.target_names();
+    if let Some(unknown) = names.iter().find(|n| !known.contains(&n.as_str())) {
+        anyhow::bail!(
+            "scene `{}` has no pass output `{unknown}` (its outputs: {}, or `all`)",
+            scene.name,
+            known.join(", ")
+        );
+    }
     let mut backend = engine::backend::create(kind)?;
     let wanted: Vec<&str> = names.iter().map(String::as_str).collect();
     eprintln!(

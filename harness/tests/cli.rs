@@ -72,11 +72,11 @@ fn inspect_loads_fixtures_that_only_warn() {
             "untidy_materials.obj",
             "untidy_materials.obj:7: `usemtl` without a name",
         ),
-        ("textures/gradient.jpg", ""),
-        ("textures/gradient.tga", ""),
-        ("textures/gradient.bmp", ""),
-        ("textures/fine16.png", ""),
-        ("sky.hdr", ""),
+        ("textures/gradient.jpg", "gradient.jpg 8x4 8-bit 4 mips"),
+        ("textures/gradient.tga", "gradient.tga 8x4 8-bit 4 mips"),
+        ("textures/gradient.bmp", "gradient.bmp 8x4 8-bit 4 mips"),
+        ("textures/fine16.png", "fine16.png 4x1 16-bit 3 mips"),
+        ("sky.hdr", "sky.hdr 8x4, radiance"),
     ] {
         let (code, stdout, stderr) = harness(&["inspect", fixture(file).to_str().unwrap()]);
         assert_eq!(code, 0, "{file}: exit {code}\n{stdout}\n{stderr}");
@@ -167,6 +167,32 @@ fn render_prints_each_load_warning_once() {
         serde_json::json!([]),
         "the canonical assets are tidy"
     );
+}
+
+/// A misspelt pass is refused before anything is rendered, with the scene's outputs listed.
+#[test]
+fn render_rejects_an_unknown_pass_before_rendering() {
+    let (code, stdout, stderr) = harness(&["render", "--scene", "arrow", "--pass", "finall"]);
+    assert_eq!(code, 1, "{stdout}\n{stderr}");
+    assert!(
+        stderr.contains("no pass output `finall`") && stderr.contains("final"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("rendering"), "rendered first:\n{stderr}");
+}
+
+/// Without XDG_RUNTIME_DIR the drivers' window-system probes are not left to complain: the
+/// harness gives itself a private runtime directory.
+#[test]
+fn no_runtime_dir_complaints_without_xdg_runtime_dir() {
+    let output = common::harness_command()
+        .arg("backends")
+        .env_remove("XDG_RUNTIME_DIR")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(!stderr.contains("XDG_RUNTIME_DIR"), "{stderr}");
 }
 
 #[test]
