@@ -66,6 +66,9 @@ pub struct CheckRun {
     pub results: Vec<PassCheck>,
     /// Render failures: (scene, backend, error).
     pub render_errors: Vec<(String, String, String)>,
+    /// Scenes that did not load (each a failed case; the others are checked as usual).
+    #[serde(default)]
+    pub load_errors: Vec<crate::suite::BrokenScene>,
     /// Cross-backend comparisons.
     pub cross: Vec<CrossBackend>,
     /// GPU timings.
@@ -79,7 +82,9 @@ pub struct CheckRun {
 impl CheckRun {
     /// Whether everything passed.
     pub fn passed(&self) -> bool {
-        self.render_errors.is_empty() && self.results.iter().all(|r| r.outcome.passed())
+        self.render_errors.is_empty()
+            && self.load_errors.is_empty()
+            && self.results.iter().all(|r| r.outcome.passed())
     }
 }
 
@@ -263,6 +268,7 @@ pub fn run_with(
             backends,
             results,
             render_errors,
+            load_errors: Vec::new(),
             cross,
             timings,
         },

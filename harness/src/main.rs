@@ -338,17 +338,52 @@ fn backends(json: bool) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn load_cases(scenes: &[String]) -> anyhow::Result<Vec<harness::suite::Case>> {
-    let cases: Vec<harness::suite::Case> = if scenes.is_empty() {
-        harness::suite::canonical_cases()?
+/// The scenes named (every canonical one when none is), each that loads as a case and each that
+/// does not as a broken scene with its error (printed here), so that a run can go on with the
+/// others. Fails only when the noise model cannot be read.
+fn load_cases_isolated(
+    scenes: &[String],
+) -> anyhow::Result<(Vec<harness::suite::Case>, Vec<harness::suite::BrokenScene>)> {
+    let (cases, broken) = if scenes.is_empty() {
+        harness::suite::canonical_suite()?
     } else {
-        scenes
-            .iter()
-            .map(|s| harness::suite::Case::load(s))
-            .collect::<Result<_, _>>()?
+        let model = harness::noise::NoiseModel::load(&harness::golden::GoldenStore::workspace())?;
+        let mut cases = Vec::new();
+        let mut broken = Vec::new();
+        for scene in scenes {
+            match harness::suite::Case::load_with(scene, &model) {
+                Ok(case) => cases.push(case),
+                Err(e) => broken.push(harness::suite::BrokenScene {
+                    scene: scene.clone(),
+                    error: harness::error_text(&e),
+                }),
+            }
+        }
+        (cases, broken)
     };
     for case in &cases {
         print_load_warnings(&case.loaded);
+    }
+    for b in &broken {
+        eprintln!("error: scene `{}` did not load: {}", b.scene, b.error);
+    }
+    Ok((cases, broken))
+}
+
+/// The scenes named (every canonical one when none is); any that does not load fails the
+/// command (bless and noise need every scene they were asked for).
+fn load_cases(scenes: &[String]) -> anyhow::Result<Vec<harness::suite::Case>> {
+    let (cases, broken) = load_cases_isolated(scenes)?;
+    if !broken.is_empty() {
+        anyhow::bail!(
+            "{} scene(s) did not load: {}",
+            broken.len(),
+            broken
+                .iter()
+                .map(|b| b.scene.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
     }
     Ok(cases)
 }
@@ -366,7 +401,7 @@ fn check(
     backends: &[BackendKind],
     json: bool,
 ) -> anyhow::Result<ExitCode> {
-    let cases = load_cases(scenes)?;
+    let (cases, broken) = load_cases_isolated(scenes)?;
     let store = harness::golden::GoldenStore::workspace();
     let bar = indicatif::ProgressBar::new(0).with_style(
         indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} renders  {msg}")
@@ -378,6 +413,8 @@ fn check(
         bar.set_message(what.to_owned());
     });
     bar.finish_and_clear();
+    let mut run = run;
+    run.load_errors = broken;
     for b in &run.backends {
         if let Some(reason) = &b.unavailable {
             eprintln!("note: {} unavailable: {reason}", b.backend);
@@ -448,6 +485,12 @@ fn check(
                 "-"
             );
         }
+        for b in &run.load_errors {
+            println!(
+                "{:<8} {:<17} {:<12} FAILED   load: {}",
+                b.scene, "-", "-", b.error
+            );
+        }
         let worst_cross = run
             .cross
             .iter()
@@ -461,8 +504,13 @@ fn check(
             );
         }
         let failed = run.results.iter().filter(|r| !r.outcome.passed()).count();
+        let unloaded = if run.load_errors.is_empty() {
+            String::new()
+        } else {
+            format!(", {} scene(s) did not load", run.load_errors.len())
+        };
         println!(
-            "{} checks, {failed} failed; report: {}",
+            "{} checks, {failed} failed{unloaded}; report: {}",
             run.results.len(),
             report.display()
         );
@@ -642,18 +690,26 @@ fn inspect(path: &std::path::Path, json: bool) -> anyhow::Result<ExitCode> {
     }
 }
 
+/// Lists the canonical scenes with their descriptions, loading each with its assets: one that
+/// does not load is listed with its error, and the command exits 1.
 fn scenes() -> anyhow::Result<ExitCode> {
     let dir = harness::scenes_dir();
+    let mut broken = false;
     for name in engine::scene_file::canonical_scenes(&dir) {
         let path = dir.join(format!("{name}.toml"));
-        let description = std::fs::read_to_string(&path)
-            .ok()
-            .and_then(|text| engine::scene_file::parse(&path, &text).ok())
-            .and_then(|file| file.description)
-            .unwrap_or_default();
-        println!("{name:<10} {description}");
+        match engine::scene_file::load(&path) {
+            Ok(loaded) => println!("{name:<10} {}", loaded.description.unwrap_or_default()),
+            Err(e) => {
+                broken = true;
+                println!("{name:<10} DOES NOT LOAD: {}", harness::error_text(&e));
+            }
+        }
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(if broken {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
 }
 
 fn noise(
@@ -819,7 +875,7 @@ fn noise(
 fn selftest(json: bool) -> anyhow::Result<ExitCode> {
     let store = harness::golden::GoldenStore::workspace();
     let model = harness::noise::NoiseModel::load(&store)?;
-    let cases = harness::suite::canonical_cases()?;
+    let (cases, broken) = load_cases_isolated(&[])?;
     let available: Vec<BackendKind> = BackendKind::ALL
         .into_iter()
         .filter(|&k| engine::backend::probe(k).available)
@@ -837,7 +893,12 @@ fn selftest(json: bool) -> anyhow::Result<ExitCode> {
             .collect::<Vec<_>>()
             .join(", ")
     );
-    let result = harness::selftest::run(&cases, &store, &available, &model);
+    let mut result = harness::selftest::run(&cases, &store, &available, &model);
+    result.errors.extend(
+        broken
+            .iter()
+            .map(|b| format!("scene `{}` did not load: {}", b.scene, b.error)),
+    );
     if json {
         println!("{}", serde_json::to_string_pretty(&result)?);
     } else {

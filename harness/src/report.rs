@@ -142,20 +142,30 @@ figure{{display:inline-block;margin:4px;text-align:center;vertical-align:top}} f
 figure.missing div{{width:128px;height:128px;border:1px dashed #999;line-height:128px;color:#999}}
 figcaption{{font-size:12px}} code{{font-size:12px}}
 </style></head><body>",
-        if failed == 0 { "passed" } else { "FAILED" }
+        if run.passed() { "passed" } else { "FAILED" }
     );
     let _ = write!(
         out,
-        "<h1>Render check: {}</h1><p>{} checks, {} failed, {} render errors.</p>",
-        if failed == 0 && run.render_errors.is_empty() {
+        "<h1>Render check: {}</h1><p>{} checks, {} failed, {} render errors, {} scenes that did \
+         not load.</p>",
+        if run.passed() {
             "<span class=\"pass\">passed</span>"
         } else {
             "<span class=\"fail\">FAILED</span>"
         },
         run.results.len(),
         failed,
-        run.render_errors.len()
+        run.render_errors.len(),
+        run.load_errors.len()
     );
+    for broken in &run.load_errors {
+        let _ = write!(
+            out,
+            "<p class=\"failed\">scene {} did not load: {}</p>",
+            escape(&broken.scene),
+            escape(&broken.error)
+        );
+    }
     out.push_str("<h2>Backends</h2><table><tr><th>backend</th><th>driver fingerprint</th></tr>");
     for b in &run.backends {
         let _ = write!(

@@ -271,6 +271,36 @@ impl Case {
 }
 
 /// Every canonical scene (the `.toml` files directly in `scenes/`).
+/// A canonical scene that did not load: one failed case of the run, which goes on with the
+/// others.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct BrokenScene {
+    /// The scene's name (its file stem).
+    pub scene: String,
+    /// Why it did not load, each cause once.
+    pub error: String,
+}
+
+/// Every canonical scene that loads, and every one that does not with its error: one broken
+/// scene file is one failed case, not the end of the run. Fails only when the noise model
+/// (shared by every scene) cannot be read.
+pub fn canonical_suite() -> Result<(Vec<Case>, Vec<BrokenScene>), SuiteError> {
+    let model = NoiseModel::load(&GoldenStore::workspace())?;
+    let mut cases = Vec::new();
+    let mut broken = Vec::new();
+    for name in engine::scene_file::canonical_scenes(&crate::scenes_dir()) {
+        match Case::load_with(&name, &model) {
+            Ok(case) => cases.push(case),
+            Err(e) => broken.push(BrokenScene {
+                scene: name,
+                error: crate::error_text(&e),
+            }),
+        }
+    }
+    Ok((cases, broken))
+}
+
+/// Every canonical scene, or the first error (for callers that need them all).
 pub fn canonical_cases() -> Result<Vec<Case>, SuiteError> {
     let model = NoiseModel::load(&GoldenStore::workspace())?;
     engine::scene_file::canonical_scenes(&crate::scenes_dir())

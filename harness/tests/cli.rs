@@ -169,6 +169,74 @@ fn render_prints_each_load_warning_once() {
     );
 }
 
+/// A scene in scenes/ whose mesh does not load is one failed case: `check` reports it with its
+/// error (once), checks every other scene as usual, writes the report, and exits 1.
+#[test]
+fn a_broken_scene_is_one_failed_case_and_the_others_are_checked() {
+    if !engine::backend::probe(engine::backend::BackendKind::Gl).available {
+        return;
+    }
+    let root = common::temp_workspace();
+    std::fs::write(
+        root.path().join("scenes/broken.toml"),
+        "[camera]\nposition = [0, 0, 1]\ntarget = [0, 0, 0]\n[[objects]]\nmesh = \"assets/gone.obj\"\n",
+    )
+    .unwrap();
+    let out = root.path().join("out");
+    let output = common::harness_command()
+        .args(["check", "--backend", "gl", "--out", out.to_str().unwrap()])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stdout}\n{stderr}");
+    let load_lines: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.contains("FAILED   load:"))
+        .collect();
+    assert_eq!(load_lines.len(), 1, "{stdout}");
+    assert!(
+        load_lines[0].starts_with("broken") && load_lines[0].contains("gone.obj: cannot read file"),
+        "{}",
+        load_lines[0]
+    );
+    assert_eq!(
+        load_lines[0].matches("os error 2").count(),
+        1,
+        "{}",
+        load_lines[0]
+    );
+    for scene in ["arrow", "chess", "ibl"] {
+        let rows: Vec<&str> = stdout
+            .lines()
+            .filter(|l| l.starts_with(scene) && l.contains(" gl "))
+            .collect();
+        assert!(rows.len() >= 8, "{scene} was not checked:\n{stdout}");
+        assert!(
+            rows.iter().all(|r| r.contains(" ok ")),
+            "{scene}:\n{stdout}"
+        );
+    }
+    assert!(stdout.contains("1 scene(s) did not load"), "{stdout}");
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(report.contains("scene broken did not load"));
+    // `harness scenes` does not list it as fine.
+    let output = common::harness_command()
+        .arg("scenes")
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout
+            .lines()
+            .any(|l| l.starts_with("broken") && l.contains("DOES NOT LOAD")),
+        "{stdout}"
+    );
+}
+
 /// A misspelt pass is refused before anything is rendered, with the scene's outputs listed.
 #[test]
 fn render_rejects_an_unknown_pass_before_rendering() {

@@ -110,8 +110,9 @@ impl Suite {
 fn main() {
     let arguments = Arguments::from_args();
     harness::use_ibl_cache();
-    let cases = match suite::canonical_cases() {
-        Ok(cases) => cases,
+    // A scene that does not load is one failing test with its error; the others run.
+    let (cases, broken) = match suite::canonical_suite() {
+        Ok(suite) => suite,
         Err(e) => {
             eprintln!("error: cannot set up the golden suite: {e}");
             std::process::exit(101);
@@ -120,6 +121,11 @@ fn main() {
     let required = std::env::var("REQUIRE_BACKENDS").unwrap_or_default();
     let mut available = Vec::new();
     let mut trials = Vec::new();
+    for scene in broken {
+        trials.push(Trial::test(format!("{}::load", scene.scene), move || {
+            Err(format!("scene `{}` did not load: {}", scene.scene, scene.error).into())
+        }));
+    }
     for kind in BackendKind::ALL {
         let status = backend::probe(kind);
         if status.available {
@@ -202,6 +208,7 @@ fn write_failure_report(suite: &Suite) {
         backends: vec![],
         results: failures.clone(),
         render_errors: vec![],
+        load_errors: vec![],
         cross: vec![],
         timings: vec![],
         driver_notes: vec![],
