@@ -248,8 +248,7 @@ fn with_full_disk(args: &[&str], root: Option<&Path>) -> std::process::Output {
 
 #[test]
 fn a_full_disk_while_blessing_keeps_the_old_golden_and_names_the_file() {
-    if !engine::backend::probe(BackendKind::Gl).available {
-        eprintln!("gl unavailable here; skipped");
+    if !common::gl_available() {
         return;
     }
     let root = common::temp_workspace();
@@ -301,8 +300,7 @@ fn a_full_disk_while_writing_the_report_names_the_file_and_fails() {
 /// next bless removes the dead process's temporary file.
 #[test]
 fn killing_a_bless_mid_write_leaves_the_old_golden_intact() {
-    if !engine::backend::probe(BackendKind::Gl).available {
-        eprintln!("gl unavailable here; skipped");
+    if !common::gl_available() {
         return;
     }
     let root = common::temp_workspace();

@@ -31,8 +31,7 @@ fn report_screenshot_shows_the_images() {
         );
         return;
     };
-    if !engine::backend::probe(engine::BackendKind::Gl).available {
-        eprintln!("gl unavailable here; skipped");
+    if !common::gl_available() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();

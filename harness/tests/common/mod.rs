@@ -33,6 +33,17 @@ pub fn available_backends() -> Vec<BackendKind> {
     kinds
 }
 
+/// Whether `gl` is available, for tests that need it and skip without it. Like
+/// [`available_backends`], it panics instead when REQUIRE_BACKENDS names `gl`: a test must not
+/// pass by skipping what CI requires.
+pub fn gl_available() -> bool {
+    let available = available_backends().contains(&BackendKind::Gl);
+    if !available {
+        eprintln!("gl unavailable here; skipped");
+    }
+    available
+}
+
 /// Copies a folder tree (for tests that write into a temporary copy of the workspace).
 pub fn copy_tree(from: &std::path::Path, to: &std::path::Path) {
     std::fs::create_dir_all(to).unwrap();
