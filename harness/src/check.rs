@@ -136,15 +136,24 @@ pub fn cross_compare(case: &Case, pass: &str, a: &Image, b: &Image) -> Option<(f
 }
 
 /// Runs the check on the backends in `only` (every one when empty; an unavailable one is
-/// reported as such). `progress` is called before each render with (done, total, what).
+/// reported as such), writing failure images under `failures` (each checked scene's old ones
+/// there are removed first). `progress` is called before each render with (done, total, what).
 /// Returns the run and every golden pass output, for the report.
 pub fn run(
     cases: &[Case],
     store: &GoldenStore,
     only: &[BackendKind],
+    failures: &std::path::Path,
     progress: impl FnMut(usize, usize, &str),
 ) -> (CheckRun, crate::report::Outputs) {
-    run_with(cases, store, only, &|kind| backend::create(kind), progress)
+    run_with(
+        cases,
+        store,
+        only,
+        failures,
+        &|kind| backend::create(kind),
+        progress,
+    )
 }
 
 /// Creates the backend for one render of [`run_with`].
@@ -157,9 +166,13 @@ pub fn run_with(
     cases: &[Case],
     store: &GoldenStore,
     only: &[BackendKind],
+    failures: &std::path::Path,
     create: &BackendFactory<'_>,
     mut progress: impl FnMut(usize, usize, &str),
 ) -> (CheckRun, crate::report::Outputs) {
+    for case in cases {
+        suite::clear_artifacts(failures, case.name());
+    }
     let mut outputs = crate::report::Outputs::new();
     let mut backends = Vec::new();
     let mut available = Vec::new();
@@ -213,6 +226,7 @@ pub fn run_with(
                             pass,
                             kind,
                             &frame.outputs[pass],
+                            failures,
                         ));
                     }
                     frames.insert(kind, frame);

@@ -407,11 +407,13 @@ fn check(
         indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} renders  {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let (run, outputs) = harness::check::run(&cases, &store, backends, |done, total, what| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
-        bar.set_message(what.to_owned());
-    });
+    let failures = out.join("failures");
+    let (run, outputs) =
+        harness::check::run(&cases, &store, backends, &failures, |done, total, what| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+            bar.set_message(what.to_owned());
+        });
     bar.finish_and_clear();
     let mut run = run;
     run.load_errors = broken;
@@ -515,12 +517,7 @@ fn check(
             report.display()
         );
         if failed > 0 {
-            println!(
-                "failure images: {}",
-                harness::workspace_root()
-                    .join("target/harness/failures")
-                    .display()
-            );
+            println!("failure images: {}", failures.display());
         }
     }
     Ok(if run.passed() {

@@ -380,21 +380,37 @@ impl PassCheck {
     }
 }
 
-/// Where failure artifacts go: `target/harness/failures/<scene>/<backend>/`.
-pub fn artifacts_dir(scene: &str, backend: &str) -> PathBuf {
-    crate::workspace_root()
-        .join("target/harness/failures")
-        .join(scene)
-        .join(backend)
+/// Where failure artifacts go by default (`harness check` writes `<out>/failures`):
+/// `target/harness/failures`.
+pub fn default_failures_dir() -> PathBuf {
+    crate::workspace_root().join("target/harness/failures")
 }
 
-/// Checks one pass output against its golden; writes artifacts when it does not pass.
+/// Where one scene's failure artifacts on one backend go: `<failures>/<scene>/<backend>/`.
+pub fn artifacts_dir(failures: &Path, scene: &str, backend: &str) -> PathBuf {
+    failures.join(scene).join(backend)
+}
+
+/// Removes a scene's failure artifacts from an earlier run (before this run writes its own), so
+/// that what is there after a run is this run's. Other scenes' artifacts are left alone.
+pub fn clear_artifacts(failures: &Path, scene: &str) {
+    let dir = failures.join(scene);
+    if let Err(e) = std::fs::remove_dir_all(&dir) {
+        if e.kind() != std::io::ErrorKind::NotFound {
+            log::warn!("cannot clear old failure images in {}: {e}", dir.display());
+        }
+    }
+}
+
+/// Checks one pass output against its golden; writes artifacts under `failures` when it does
+/// not pass.
 pub fn check_pass(
     store: &GoldenStore,
     case: &Case,
     pass: &str,
     backend: BackendKind,
     actual: &Image,
+    failures: &Path,
 ) -> PassCheck {
     let eight_bit = golden::is_eight_bit(actual);
     let scene = case.name();
@@ -408,7 +424,7 @@ pub fn check_pass(
     };
     let mut artifacts = Artifacts::default();
     if !outcome.passed() {
-        let dir = artifacts_dir(scene, backend.name());
+        let dir = artifacts_dir(failures, scene, backend.name());
         artifacts = write_artifacts(&dir, pass, actual, golden_image.as_ref());
     }
     PassCheck {

@@ -182,6 +182,10 @@ fn a_broken_scene_is_one_failed_case_and_the_others_are_checked() {
     )
     .unwrap();
     let out = root.path().join("out");
+    // An earlier run's failure image of a checked scene, which this run must remove.
+    let stale = out.join("failures/arrow/gl/final_diff.png");
+    std::fs::create_dir_all(stale.parent().unwrap()).unwrap();
+    std::fs::write(&stale, b"old").unwrap();
     let output = common::harness_command()
         .args(["check", "--backend", "gl", "--out", out.to_str().unwrap()])
         .env("HARNESS_ROOT", root.path())
@@ -220,6 +224,10 @@ fn a_broken_scene_is_one_failed_case_and_the_others_are_checked() {
     assert!(stdout.contains("1 scene(s) did not load"), "{stdout}");
     let report = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(report.contains("scene broken did not load"));
+    assert!(
+        !stale.exists(),
+        "the earlier run's failure image is still there"
+    );
     // `harness scenes` does not list it as fine.
     let output = common::harness_command()
         .arg("scenes")
@@ -453,7 +461,8 @@ fn check_reports_failures_with_images_and_the_bless_command() {
         "{stdout}"
     );
     assert!(line("mask").contains(" ok "), "{stdout}");
-    let failures = root.path().join("target/harness/failures/arrow/gl");
+    // Under --out, not the workspace's target/.
+    let failures = out.join("failures/arrow/gl");
     for file in [
         "final_actual.png",
         "final_golden.png",
@@ -462,6 +471,7 @@ fn check_reports_failures_with_images_and_the_bless_command() {
     ] {
         assert!(failures.join(file).is_file(), "{file} not written");
     }
+    assert!(!root.path().join("target/harness/failures").exists());
     let report = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(report.contains("data:image/png;base64,") && report.contains("FAILED"));
 }

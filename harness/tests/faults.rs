@@ -181,7 +181,9 @@ fn a_backend_lost_mid_run_fails_its_scene_and_the_run_goes_on() {
         backend.lose_device = k == kind && created.fetch_add(1, Ordering::SeqCst) == 1;
         Ok(Box::new(backend))
     };
-    let (run, _) = harness::check::run_with(&cases, &store, &[], &create, |_, _, _| {});
+    let failures = tempfile::tempdir().unwrap();
+    let (run, _) =
+        harness::check::run_with(&cases, &store, &[], failures.path(), &create, |_, _, _| {});
     assert!(!run.passed());
     assert_eq!(run.render_errors.len(), 1, "{:?}", run.render_errors);
     let (scene, backend, error) = &run.render_errors[0];

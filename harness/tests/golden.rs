@@ -93,7 +93,14 @@ impl Suite {
                 };
             }
         }
-        let check = suite::check_pass(&self.store, case, pass, kind, actual);
+        let check = suite::check_pass(
+            &self.store,
+            case,
+            pass,
+            kind,
+            actual,
+            &suite::default_failures_dir(),
+        );
         if check.outcome.passed() {
             Ok(())
         } else {
@@ -121,6 +128,12 @@ fn main() {
     let required = std::env::var("REQUIRE_BACKENDS").unwrap_or_default();
     let mut available = Vec::new();
     let mut trials = Vec::new();
+    // A whole run clears the failure images of earlier runs first (a filtered one leaves them).
+    if arguments.filter.is_none() {
+        for case in &cases {
+            suite::clear_artifacts(&suite::default_failures_dir(), case.name());
+        }
+    }
     for scene in broken {
         trials.push(Trial::test(format!("{}::load", scene.scene), move || {
             Err(format!("scene `{}` did not load: {}", scene.scene, scene.error).into())
