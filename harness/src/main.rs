@@ -460,12 +460,16 @@ fn check(
             let (label, worst) = match &r.outcome {
                 harness::golden::Outcome::Passed(v) | harness::golden::Outcome::Failed(v) => (
                     if r.outcome.passed() { "ok" } else { "FAILED" },
-                    // The check closest to (or furthest past) its limit.
+                    // The check closest to (or furthest past) its limit, and for a failure
+                    // where the largest difference is.
                     v.checks
                         .iter()
                         .max_by(|a, b| a.ratio().total_cmp(&b.ratio()))
                         .map(ToString::to_string)
-                        .unwrap_or_default(),
+                        .unwrap_or_default()
+                        + &v.largest_difference
+                            .map(|l| format!("; {l}"))
+                            .unwrap_or_default(),
                 ),
                 harness::golden::Outcome::MissingGolden => (
                     "MISSING",

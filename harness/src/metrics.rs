@@ -84,6 +84,30 @@ pub enum MetricError {
     FlipNeedsU8,
 }
 
+/// Where two images differ most: the pixel (top row 0) with the largest absolute channel
+/// difference (infinite for NaN), and how many pixels differ at all.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct LargestDifference {
+    /// Column.
+    pub x: u32,
+    /// Row, from the top.
+    pub y: u32,
+    /// The largest absolute channel difference (8-bit images in 0..1 units).
+    pub difference: f64,
+    /// Pixels with any channel different.
+    pub differing_pixels: usize,
+}
+
+impl std::fmt::Display for LargestDifference {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} px differ, the most {:.4e} at ({}, {})",
+            self.differing_pixels, self.difference, self.x, self.y
+        )
+    }
+}
+
 /// Both images as f32 values (8-bit scaled to 0..1) with their channel count.
 pub struct Pair<'a> {
     actual: Cow<'a, [f32]>,
@@ -225,6 +249,39 @@ impl<'a> Pair<'a> {
     /// images).
     pub fn pixel_differences(&self) -> Vec<f64> {
         self.pixel_errors(0, None, Channels::All)
+    }
+
+    /// The pixel with the largest absolute channel difference (no shift), and how many pixels
+    /// differ at all; `None` when nothing differs.
+    pub fn largest_difference(&self) -> Option<LargestDifference> {
+        let c = self.channels;
+        let mut differing = 0usize;
+        let mut worst: Option<(usize, f64)> = None;
+        for (i, (a, g)) in self
+            .actual
+            .chunks_exact(c)
+            .zip(self.golden.chunks_exact(c))
+            .enumerate()
+        {
+            let d = a
+                .iter()
+                .zip(g)
+                .map(|(&a, &g)| value_error(a, g, None))
+                .fold(0.0f64, f64::max);
+            if d > 0.0 {
+                differing += 1;
+                if worst.is_none_or(|(_, w)| d > w) {
+                    worst = Some((i, d));
+                }
+            }
+        }
+        let (index, difference) = worst?;
+        Some(LargestDifference {
+            x: (index % self.width) as u32,
+            y: (index / self.width) as u32,
+            difference,
+            differing_pixels: differing,
+        })
     }
 
     /// Largest absolute difference per channel (no shift).
@@ -418,6 +475,26 @@ mod tests {
         let map = Pair::flip_map(&a, &a).unwrap();
         assert_eq!(flip_stats(&map, 0.99), (0.0, 0.0));
         assert!(pair.identical());
+    }
+
+    #[test]
+    fn largest_difference_says_where_and_how_many() {
+        let golden = u8_image(4, 3, |_, _| [10, 10, 10, 255]);
+        let actual = u8_image(4, 3, |x, y| match (x, y) {
+            (2, 1) => [10, 30, 10, 255],
+            (0, 2) => [12, 10, 10, 255],
+            _ => [10, 10, 10, 255],
+        });
+        let worst = Pair::new(&actual, &golden)
+            .unwrap()
+            .largest_difference()
+            .unwrap();
+        assert_eq!((worst.x, worst.y, worst.differing_pixels), (2, 1, 2));
+        assert!((worst.difference - 20.0 / 255.0).abs() < 1e-6);
+        assert_eq!(
+            Pair::new(&golden, &golden).unwrap().largest_difference(),
+            None
+        );
     }
 
     #[test]

@@ -355,6 +355,9 @@ impl PassCheck {
                 for c in &v.checks {
                     lines.push(format!("  {c}"));
                 }
+                if let Some(largest) = &v.largest_difference {
+                    lines.push(format!("  {largest}"));
+                }
             }
             Outcome::MissingGolden => lines.push(format!(
                 "  no golden at {}; after checking the output, bless it with:\n    {}\n  (or UPDATE_GOLDENS=1 cargo test)",

@@ -286,11 +286,14 @@ impl Rule {
         let mut checks = Vec::new();
         let ratio = self.evaluate_with(&pair, actual, golden, &mut flip, &mut checks)?;
         let non_finite = pair.non_finite();
+        let passed = ratio <= 1.0 && non_finite == 0;
         Ok(Verdict {
-            passed: ratio <= 1.0 && non_finite == 0,
+            passed,
             ratio: if non_finite > 0 { f64::INFINITY } else { ratio },
             non_finite,
             checks,
+            // Where to look, for a failure only (it costs a pass over the pixels).
+            largest_difference: (!passed).then(|| pair.largest_difference()).flatten(),
         })
     }
 
@@ -330,12 +333,15 @@ impl Rule {
                 let value = metric_value(metric, pair, actual, golden, flip)?;
                 let at_least = *metric == Metric::Psnr;
                 let ratio = ratio(value, *limit, at_least);
+                let pixels_over = matches!(metric, Metric::FractionOver { .. })
+                    .then(|| (value * pair.pixels() as f64).round() as u64);
                 checks.push(CheckResult {
                     metric: metric.to_string(),
                     value,
                     limit: *limit,
                     at_least,
                     passed: ratio <= 1.0,
+                    pixels_over,
                 });
                 Ok(ratio)
             }
@@ -423,6 +429,9 @@ pub struct CheckResult {
     pub at_least: bool,
     /// Whether it passed.
     pub passed: bool,
+    /// For `fraction_over`: how many pixels are over the threshold.
+    #[serde(default)]
+    pub pixels_over: Option<u64>,
 }
 
 impl CheckResult {
@@ -436,13 +445,18 @@ impl fmt::Display for CheckResult {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{} = {:.4e} ({} {:.4e}) {}",
+            "{} = {:.4e} ({} {:.4e}, {:.2}x) {}",
             self.metric,
             self.value,
             if self.at_least { "min" } else { "max" },
             self.limit,
+            self.ratio(),
             if self.passed { "ok" } else { "FAILED" }
-        )
+        )?;
+        match self.pixels_over {
+            Some(n) => write!(f, ", {n} px over"),
+            None => Ok(()),
+        }
     }
 }
 
@@ -458,6 +472,9 @@ pub struct Verdict {
     pub non_finite: usize,
     /// Every metric evaluated, in tree order.
     pub checks: Vec<CheckResult>,
+    /// For a failure: the largest difference and where it is.
+    #[serde(default)]
+    pub largest_difference: Option<crate::metrics::LargestDifference>,
 }
 
 #[cfg(test)]

@@ -455,6 +455,14 @@ fn check_reports_failures_with_images_and_the_bless_command() {
         line("final").contains("FAILED") && line("final").contains("fraction_over"),
         "{stdout}"
     );
+    // The failing check's value / limit, the pixels over its threshold, and where the largest
+    // difference is (3/255 darker: a difference of 1.1765e-2 in 0..1 units).
+    assert!(
+        line("final").contains("px over")
+            && line("final").contains("px differ, the most 1.1765e-2 at (")
+            && line("final").contains("x) FAILED"),
+        "{stdout}"
+    );
     assert!(
         line("light").contains("MISSING")
             && line("light").contains("harness -- bless --scene arrow --pass light"),
