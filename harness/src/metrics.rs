@@ -197,22 +197,11 @@ impl<'a> Pair<'a> {
     /// docs) over `channels`, comparing each actual pixel with the closest golden pixel within
     /// `shift` pixels (0: the same pixel).
     pub fn pixel_errors(&self, shift: u32, floor: Option<f64>, channels: Channels) -> Vec<f64> {
+        if shift == 0 {
+            return self.unshifted_errors(floor, channels).collect();
+        }
         let c = self.channels;
         let used = channels.count(c);
-        if shift == 0 {
-            return self
-                .actual
-                .chunks_exact(c)
-                .zip(self.golden.chunks_exact(c))
-                .map(|(a, g)| {
-                    a[..used]
-                        .iter()
-                        .zip(&g[..used])
-                        .map(|(&a, &g)| value_error(a, g, floor))
-                        .fold(0.0f64, f64::max)
-                })
-                .collect();
-        }
         let r = shift as isize;
         let mut out = Vec::with_capacity(self.pixels());
         for y in 0..self.height {
@@ -245,6 +234,27 @@ impl<'a> Pair<'a> {
         out
     }
 
+    /// Per-pixel largest channel error over `channels` against the same golden pixel, in pixel
+    /// order (the no-shift case of [`Pair::pixel_errors`], without a list).
+    fn unshifted_errors(
+        &self,
+        floor: Option<f64>,
+        channels: Channels,
+    ) -> impl Iterator<Item = f64> + '_ {
+        let c = self.channels;
+        let used = channels.count(c);
+        self.actual
+            .chunks_exact(c)
+            .zip(self.golden.chunks_exact(c))
+            .map(move |(a, g)| {
+                a[..used]
+                    .iter()
+                    .zip(&g[..used])
+                    .map(|(&a, &g)| value_error(a, g, floor))
+                    .fold(0.0f64, f64::max)
+            })
+    }
+
     /// Per-pixel largest absolute channel difference over every channel, no shift (for diff
     /// images).
     pub fn pixel_differences(&self) -> Vec<f64> {
@@ -254,20 +264,9 @@ impl<'a> Pair<'a> {
     /// The pixel with the largest absolute channel difference (no shift), and how many pixels
     /// differ at all; `None` when nothing differs.
     pub fn largest_difference(&self) -> Option<LargestDifference> {
-        let c = self.channels;
         let mut differing = 0usize;
         let mut worst: Option<(usize, f64)> = None;
-        for (i, (a, g)) in self
-            .actual
-            .chunks_exact(c)
-            .zip(self.golden.chunks_exact(c))
-            .enumerate()
-        {
-            let d = a
-                .iter()
-                .zip(g)
-                .map(|(&a, &g)| value_error(a, g, None))
-                .fold(0.0f64, f64::max);
+        for (i, d) in self.unshifted_errors(None, Channels::All).enumerate() {
             if d > 0.0 {
                 differing += 1;
                 if worst.is_none_or(|(_, w)| d > w) {
@@ -317,17 +316,8 @@ impl<'a> Pair<'a> {
     ) -> f64 {
         let over = if shift == 0 {
             // The common case, counted without a per-pixel error list.
-            let c = self.channels;
-            let used = channels.count(c);
-            self.actual
-                .chunks_exact(c)
-                .zip(self.golden.chunks_exact(c))
-                .filter(|(a, g)| {
-                    a[..used]
-                        .iter()
-                        .zip(&g[..used])
-                        .any(|(&a, &g)| value_error(a, g, floor) > threshold)
-                })
+            self.unshifted_errors(floor, channels)
+                .filter(|&e| e > threshold)
                 .count()
         } else {
             self.pixel_errors(shift, floor, channels)
