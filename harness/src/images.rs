@@ -136,27 +136,25 @@ pub fn encode_png(
         message: format!("{:?} is a float image; write it as .exr", image.format),
     })?;
     let mut out = Vec::new();
-    let (level, filter) = match compression {
-        PngCompression::Smallest => (
-            image::codecs::png::CompressionType::Best,
-            image::codecs::png::FilterType::Adaptive,
-        ),
-        PngCompression::Fast => (
-            image::codecs::png::CompressionType::Fast,
-            image::codecs::png::FilterType::Adaptive,
-        ),
+    let level = match compression {
+        PngCompression::Smallest => image::codecs::png::CompressionType::Best,
+        PngCompression::Fast => image::codecs::png::CompressionType::Fast,
     };
-    image::codecs::png::PngEncoder::new_with_quality(&mut out, level, filter)
-        .write_image(
-            data,
-            image.width,
-            image.height,
-            image::ExtendedColorType::Rgba8,
-        )
-        .map_err(|e| ImageFileError::Png {
-            path: path.to_owned(),
-            message: e.to_string(),
-        })?;
+    image::codecs::png::PngEncoder::new_with_quality(
+        &mut out,
+        level,
+        image::codecs::png::FilterType::Adaptive,
+    )
+    .write_image(
+        data,
+        image.width,
+        image.height,
+        image::ExtendedColorType::Rgba8,
+    )
+    .map_err(|e| ImageFileError::Png {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })?;
     Ok(out)
 }
 

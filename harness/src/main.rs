@@ -344,23 +344,7 @@ fn backends(json: bool) -> anyhow::Result<ExitCode> {
 fn load_cases_isolated(
     scenes: &[String],
 ) -> anyhow::Result<(Vec<harness::suite::Case>, Vec<harness::suite::BrokenScene>)> {
-    let (cases, broken) = if scenes.is_empty() {
-        harness::suite::canonical_suite()?
-    } else {
-        let model = harness::noise::NoiseModel::load(&harness::golden::GoldenStore::workspace())?;
-        let mut cases = Vec::new();
-        let mut broken = Vec::new();
-        for scene in scenes {
-            match harness::suite::Case::load_with(scene, &model) {
-                Ok(case) => cases.push(case),
-                Err(e) => broken.push(harness::suite::BrokenScene {
-                    scene: scene.clone(),
-                    error: harness::error_text(&e),
-                }),
-            }
-        }
-        (cases, broken)
-    };
+    let (cases, broken) = harness::suite::load_suite(&scenes_or_canonical(scenes))?;
     for case in &cases {
         print_load_warnings(&case.loaded);
     }

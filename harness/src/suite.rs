@@ -285,14 +285,19 @@ pub struct BrokenScene {
 /// scene file is one failed case, not the end of the run. Fails only when the noise model
 /// (shared by every scene) cannot be read.
 pub fn canonical_suite() -> Result<(Vec<Case>, Vec<BrokenScene>), SuiteError> {
+    load_suite(&engine::scene_file::canonical_scenes(&crate::scenes_dir()))
+}
+
+/// [`canonical_suite`] for the scenes named (canonical names or scene files).
+pub fn load_suite(names: &[String]) -> Result<(Vec<Case>, Vec<BrokenScene>), SuiteError> {
     let model = NoiseModel::load(&GoldenStore::workspace())?;
     let mut cases = Vec::new();
     let mut broken = Vec::new();
-    for name in engine::scene_file::canonical_scenes(&crate::scenes_dir()) {
-        match Case::load_with(&name, &model) {
+    for name in names {
+        match Case::load_with(name, &model) {
             Ok(case) => cases.push(case),
             Err(e) => broken.push(BrokenScene {
-                scene: name,
+                scene: name.clone(),
                 error: crate::error_text(&e),
             }),
         }

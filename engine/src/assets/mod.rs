@@ -29,6 +29,7 @@ mod mesh;
 mod mtl;
 mod obj;
 mod summary;
+mod text;
 mod texture;
 
 pub use environment::{load_environment, radiance, Environment, MAX_ENVIRONMENT_TEXELS};

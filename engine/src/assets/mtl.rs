@@ -12,6 +12,7 @@
 use std::path::{Path, PathBuf};
 
 use super::error::AssetError;
+use super::text::LossyLines;
 use super::texture::ColorSpace;
 
 /// Which [`super::MaterialMaps`] slot a texture statement fills.
@@ -110,8 +111,7 @@ pub(super) fn parse_mtl_bytes(path: &Path, bytes: &[u8]) -> Result<ParsedMtl, As
     let mut materials = Vec::new();
     let mut warnings = Vec::new();
     let mut current: Option<ParsedMaterial> = None;
-    // Lines that are not UTF-8 (Latin-1 comments and names), and the first one with its byte.
-    let mut not_utf8: (usize, Option<(usize, usize)>) = (0, None);
+    let mut text = LossyLines::default();
     // Logged at debug level only: callers report the returned list (see `obj::warn`).
     let mut warn = |msg: String| {
         log::debug!("{msg}");
@@ -121,11 +121,7 @@ pub(super) fn parse_mtl_bytes(path: &Path, bytes: &[u8]) -> Result<ParsedMtl, As
     for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
         let lineno = i + 1;
         let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
-        let decoded = String::from_utf8_lossy(raw);
-        if let Err(e) = std::str::from_utf8(raw) {
-            not_utf8.0 += 1;
-            not_utf8.1.get_or_insert((lineno, e.valid_up_to() + 1));
-        }
+        let decoded = text.decode(lineno, raw);
         let line = decoded.trim();
         if line.is_empty() || line.starts_with('#') {
             continue;
@@ -235,13 +231,8 @@ pub(super) fn parse_mtl_bytes(path: &Path, bytes: &[u8]) -> Result<ParsedMtl, As
     if let Some(done) = current.take() {
         materials.push(done);
     }
-    if let Some((line, byte)) = not_utf8.1 {
-        warn(format!(
-            "{}:{line}: not UTF-8 at byte {byte} ({} lines in all); read with U+FFFD in \
-             place of the bad bytes",
-            path.display(),
-            not_utf8.0
-        ));
+    if let Some(warning) = text.warning(path) {
+        warn(warning);
     }
     Ok(ParsedMtl {
         path: path.to_path_buf(),

@@ -21,6 +21,7 @@ use std::path::{Path, PathBuf};
 use super::error::AssetError;
 use super::mesh::MeshData;
 use super::mtl::{parse_mtl_file, MapSlot, ParsedMtl};
+use super::text::LossyLines;
 use super::texture::{TextureCache, TextureId};
 
 /// A loaded OBJ file: meshes, their materials and any load warnings.
@@ -397,19 +398,13 @@ fn prescan(path: &Path, bytes: &[u8]) -> Result<Scan, AssetError> {
     };
     let (mut first_skipped, mut polygons, mut colors) = (None, 0usize, 0usize);
     let (mut unsupported, mut first_unsupported) = (0usize, None);
-    // Lines that are not UTF-8 (Latin-1 comments and names are common), and the first one
-    // with the byte where it stops being UTF-8.
-    let mut not_utf8: (usize, Option<(usize, usize)>) = (0, None);
+    let mut text = LossyLines::default();
     // Statements skipped because they name nothing (`usemtl` or `mtllib` alone).
     let mut unnamed: Vec<(String, usize)> = Vec::new();
     for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
         let lineno = i + 1;
         let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
-        let decoded = String::from_utf8_lossy(raw);
-        if let Err(e) = std::str::from_utf8(raw) {
-            not_utf8.0 += 1;
-            not_utf8.1.get_or_insert((lineno, e.valid_up_to() + 1));
-        }
+        let decoded = text.decode(lineno, raw);
         let mut line = decoded.trim();
         // Inline comments on element lines (names and file paths may contain '#').
         if matches!(
@@ -529,13 +524,7 @@ fn prescan(path: &Path, bytes: &[u8]) -> Result<Scan, AssetError> {
     }
     let p = path.display();
     let mut notes = Vec::new();
-    if let Some((line, byte)) = not_utf8.1 {
-        notes.push(format!(
-            "{p}:{line}: not UTF-8 at byte {byte} ({} lines in all); read with U+FFFD in \
-             place of the bad bytes",
-            not_utf8.0
-        ));
-    }
+    notes.extend(text.warning(path));
     for (key, line) in unnamed {
         let what = if key == "usemtl" {
             "the faces after it use the default material"

@@ -111,8 +111,7 @@ pub fn load_texture(path: &Path, color_space: ColorSpace) -> Result<TextureData,
             format!("image has zero size ({width}x{height})"),
         ));
     }
-    let sixteen_bits = image.color().bytes_per_pixel() / image.color().channel_count() == 2;
-    let (format, mips) = if sixteen_bits {
+    let (format, mips) = if is_sixteen_bit(image.color()) {
         let level0: Vec<[f32; 4]> = image
             .into_rgba16()
             .pixels()
@@ -151,6 +150,11 @@ pub fn load_texture(path: &Path, color_space: ColorSpace) -> Result<TextureData,
         format,
         mips,
     })
+}
+
+/// Whether a decoded color type has 16 bits per channel (and so becomes RGBA16F).
+fn is_sixteen_bit(color: image::ColorType) -> bool {
+    color.bytes_per_pixel() / color.channel_count() == 2
 }
 
 /// Builds the full mip chain (level 0 included) of a tightly packed RGBA8
@@ -411,11 +415,7 @@ impl TextureCache {
             })?;
         let (width, height) = image::ImageDecoder::dimensions(&decoder);
         let color = image::ImageDecoder::color_type(&decoder);
-        let texel_bytes = if color.bytes_per_pixel() / color.channel_count() == 2 {
-            8
-        } else {
-            4
-        };
+        let texel_bytes = if is_sixteen_bit(color) { 8 } else { 4 };
         drop(decoder);
         self.budget.check_image(path, width, height)?;
         self.budget.reserve(
