@@ -86,6 +86,19 @@ impl CheckRun {
             && self.load_errors.is_empty()
             && self.results.iter().all(|r| r.outcome.passed())
     }
+
+    /// One `harness bless` command per scene with a failing or missing pass, in the order of
+    /// the results (each rewrites only its scene's changed passes).
+    pub fn bless_commands(&self) -> Vec<String> {
+        let mut commands: Vec<String> = Vec::new();
+        for r in self.results.iter().filter(|r| !r.outcome.passed()) {
+            let command = suite::bless_command(&r.scene_argument);
+            if !commands.contains(&command) {
+                commands.push(command);
+            }
+        }
+        commands
+    }
 }
 
 /// Where the backends of this run differ from the drivers the goldens were blessed with (from

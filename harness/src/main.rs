@@ -64,15 +64,20 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Write new goldens after an intended change: shows the metrics against the old golden,
-    /// then writes atomically and records the driver and date in golden/<scene>/blessed.toml.
+    /// Write new goldens after an intended change: renders the scene, compares each pass with
+    /// its golden, and rewrites only the passes that changed (outside tolerance) or have no
+    /// golden, atomically, recording the driver and date in golden/<scene>/blessed.toml. Passes
+    /// within tolerance and their records are left alone.
     Bless {
-        /// Only this scene (repeatable).
+        /// Only this scene: a name in scenes/ or a path to a scene file (repeatable).
         #[arg(long = "scene")]
         scenes: Vec<String>,
-        /// Only this pass (repeatable).
+        /// Only this pass (repeatable); a pass named here is rewritten even within tolerance.
         #[arg(long = "pass")]
         passes: Vec<String>,
+        /// Rewrite every pass considered, also those within tolerance (after a driver change).
+        #[arg(long)]
+        every_pass: bool,
         /// Backend to render the goldens with.
         #[arg(long, default_value = "gl")]
         backend: BackendKind,
@@ -257,8 +262,9 @@ fn main() -> ExitCode {
             passes,
             backend,
             all,
+            every_pass,
             dry_run,
-        } => bless(&scenes, &passes, backend, all, dry_run),
+        } => bless(&scenes, &passes, backend, all, every_pass, dry_run),
         Command::Render {
             scene,
             backend,
@@ -457,10 +463,7 @@ fn check(
                 ),
                 harness::golden::Outcome::MissingGolden => (
                     "MISSING",
-                    format!(
-                        "bless: {}",
-                        harness::suite::bless_command(&r.scene, &r.pass)
-                    ),
+                    format!("no golden at {}", r.golden_path.display()),
                 ),
                 harness::golden::Outcome::Incomparable(why) => ("FAILED", why.clone()),
             };
@@ -506,6 +509,13 @@ fn check(
         );
         if failed > 0 {
             println!("failure images: {}", failures.display());
+            println!(
+                "after reviewing the report, bless what changed on purpose (one command per \
+                 scene; it rewrites only the passes outside tolerance or without a golden):"
+            );
+            for command in run.bless_commands() {
+                println!("  {command}");
+            }
         }
     }
     Ok(if run.passed() {
@@ -520,6 +530,7 @@ fn bless(
     passes: &[String],
     kind: BackendKind,
     all: bool,
+    every_pass: bool,
     dry_run: bool,
 ) -> anyhow::Result<ExitCode> {
     if scenes.is_empty() && !all {
@@ -551,38 +562,35 @@ fn bless(
             &case.loaded.scene,
             engine::renderer::Readback::Only(&wanted),
         )?;
+        let mut kept = 0;
         for pass in wanted {
             let image = &frame.outputs[pass];
-            let eight_bit = harness::golden::is_eight_bit(image);
-            let previous = match store.load(case.name(), pass, eight_bit)? {
-                None => "new".to_owned(),
-                Some(old) => match harness::golden::check(image, Some(&old), &case.rules[pass]) {
-                    harness::golden::Outcome::Passed(v) | harness::golden::Outcome::Failed(v) => {
-                        let passed = v.passed;
-                        let metrics = v
-                            .checks
-                            .iter()
-                            .map(ToString::to_string)
-                            .collect::<Vec<_>>()
-                            .join("; ");
-                        format!(
-                            "{} vs old golden: {metrics}",
-                            if passed {
-                                "within tolerance"
-                            } else {
-                                "CHANGED"
-                            }
-                        )
-                    }
-                    other => format!("{other:?}"),
-                },
-            };
-            println!("{}/{pass}: {previous}", case.name());
+            let change = harness::suite::bless_change(&store, case, pass, image);
+            // A pass named with --pass is rewritten even when it is within tolerance.
+            let write = change.changed || every_pass || passes.iter().any(|p| p == pass);
+            if !write {
+                kept += 1;
+                println!("{}/{pass}: {}; kept", case.name(), change.previous);
+                continue;
+            }
+            println!("{}/{pass}: {}", case.name(), change.previous);
             if !dry_run {
-                let path =
-                    store.bless(case.name(), pass, image, kind.name(), &driver, &previous)?;
+                let path = store.bless(
+                    case.name(),
+                    pass,
+                    image,
+                    kind.name(),
+                    &driver,
+                    &change.previous,
+                )?;
                 println!("  wrote {}", path.display());
             }
+        }
+        if kept > 0 {
+            println!(
+                "{}: {kept} pass(es) within tolerance kept as they are (--every-pass rewrites them)",
+                case.name()
+            );
         }
     }
     Ok(ExitCode::SUCCESS)

@@ -239,6 +239,12 @@ impl Case {
         &self.loaded.scene.name
     }
 
+    /// How to name this scene on the command line: its file stem when it lives in scenes/ (so
+    /// `--scene arrow` finds it again), otherwise the path it was loaded from.
+    pub fn argument(&self) -> String {
+        scene_argument(&self.loaded.path)
+    }
+
     /// Pixels of a pass's output (0 for an unknown pass).
     pub fn pixels(&self, pass: &str) -> usize {
         self.targets
@@ -330,6 +336,8 @@ pub struct Artifacts {
 pub struct PassCheck {
     /// Scene.
     pub scene: String,
+    /// The scene as the command line names it ([`Case::argument`]).
+    pub scene_argument: String,
     /// Pass.
     pub pass: String,
     /// Backend.
@@ -342,9 +350,33 @@ pub struct PassCheck {
     pub artifacts: Artifacts,
 }
 
-/// The `harness bless` command line that would bless this pass.
-pub fn bless_command(scene: &str, pass: &str) -> String {
-    format!("cargo run --release -p harness -- bless --scene {scene} --pass {pass}")
+/// How to name the scene file at `path` on the command line: its file stem when it lives in
+/// scenes/, otherwise the path.
+pub fn scene_argument(path: &Path) -> String {
+    let in_scenes_dir = path
+        .parent()
+        .and_then(|dir| dir.canonicalize().ok())
+        .zip(crate::scenes_dir().canonicalize().ok())
+        .is_some_and(|(dir, scenes)| dir == scenes);
+    match path.file_stem().and_then(|s| s.to_str()) {
+        Some(stem) if in_scenes_dir => stem.to_owned(),
+        _ => path.display().to_string(),
+    }
+}
+
+/// The `harness bless` command line that rewrites the goldens of a scene's changed or missing
+/// passes (`scene` as [`Case::argument`] gives it), quoted for a POSIX shell where needed.
+pub fn bless_command(scene: &str) -> String {
+    let plain = !scene.is_empty()
+        && scene
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_-./".contains(c));
+    let quoted = if plain {
+        scene.to_owned()
+    } else {
+        format!("'{}'", scene.replace('\'', "'\\''"))
+    };
+    format!("cargo run --release -p harness -- bless --scene {quoted}")
 }
 
 impl PassCheck {
@@ -363,16 +395,23 @@ impl PassCheck {
                 if let Some(largest) = &v.largest_difference {
                     lines.push(format!("  {largest}"));
                 }
+                if !v.passed {
+                    lines.push(format!(
+                        "  if the change is intended, bless the scene's changed passes with:\n    {}",
+                        bless_command(&self.scene_argument)
+                    ));
+                }
             }
             Outcome::MissingGolden => lines.push(format!(
-                "  no golden at {}; after checking the output, bless it with:\n    {}\n  (or UPDATE_GOLDENS=1 cargo test)",
+                "  no golden at {}; after checking the output, bless the scene's new and changed \
+                 passes with:\n    {}\n  (or UPDATE_GOLDENS=1 cargo test)",
                 golden.display(),
-                bless_command(&self.scene, &self.pass)
+                bless_command(&self.scene_argument)
             )),
             Outcome::Incomparable(why) => lines.push(format!(
                 "  cannot compare with {}: {why}\n  if the change is intended, bless with: {}",
                 golden.display(),
-                bless_command(&self.scene, &self.pass)
+                bless_command(&self.scene_argument)
             )),
         }
         for (label, path) in [
@@ -385,6 +424,67 @@ impl PassCheck {
             }
         }
         lines.join("\n")
+    }
+}
+
+/// What blessing one fresh pass output would change.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlessChange {
+    /// Whether the golden needs rewriting: it is missing, cannot be compared, or the output is
+    /// outside the pass's tolerance.
+    pub changed: bool,
+    /// How the output differs from the golden it would replace (recorded in blessed.toml):
+    /// "new", or the metrics against the old golden.
+    pub previous: String,
+}
+
+/// Compares a fresh output of `case`'s `pass` with its golden, for `harness bless` and
+/// `UPDATE_GOLDENS=1`: a pass within tolerance is left alone unless asked for by name.
+pub fn bless_change(store: &GoldenStore, case: &Case, pass: &str, image: &Image) -> BlessChange {
+    let old = match store.load(case.name(), pass, golden::is_eight_bit(image)) {
+        Ok(Some(old)) => old,
+        Ok(None) => {
+            return BlessChange {
+                changed: true,
+                previous: "new".to_owned(),
+            }
+        }
+        // A golden that cannot be read is what a bless repairs.
+        Err(e) => {
+            return BlessChange {
+                changed: true,
+                previous: format!("old golden unreadable: {e}"),
+            }
+        }
+    };
+    match golden::check(image, Some(&old), &case.rules[pass]) {
+        Outcome::Passed(v) | Outcome::Failed(v) => {
+            let metrics = v
+                .checks
+                .iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join("; ");
+            BlessChange {
+                changed: !v.passed,
+                previous: format!(
+                    "{} vs old golden: {metrics}",
+                    if v.passed {
+                        "within tolerance"
+                    } else {
+                        "CHANGED"
+                    }
+                ),
+            }
+        }
+        Outcome::MissingGolden => BlessChange {
+            changed: true,
+            previous: "new".to_owned(),
+        },
+        Outcome::Incomparable(why) => BlessChange {
+            changed: true,
+            previous: format!("incomparable with old golden: {why}"),
+        },
     }
 }
 
@@ -437,6 +537,7 @@ pub fn check_pass(
     }
     PassCheck {
         scene: scene.to_owned(),
+        scene_argument: case.argument(),
         pass: pass.to_owned(),
         backend: backend.name().to_owned(),
         outcome,
@@ -480,4 +581,29 @@ pub fn write_artifacts(
         }
     }
     artifacts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bless_commands_quote_paths_a_shell_would_split() {
+        assert_eq!(
+            bless_command("chess"),
+            "cargo run --release -p harness -- bless --scene chess"
+        );
+        assert_eq!(
+            bless_command("my scenes/it's.toml"),
+            "cargo run --release -p harness -- bless --scene 'my scenes/it'\\''s.toml'"
+        );
+    }
+
+    #[test]
+    fn a_scene_outside_scenes_is_named_by_its_path() {
+        let inside = crate::scenes_dir().join("arrow.toml");
+        assert_eq!(scene_argument(&inside), "arrow");
+        let outside = Path::new("/tmp/elsewhere/arrow.toml");
+        assert_eq!(scene_argument(outside), "/tmp/elsewhere/arrow.toml");
+    }
 }

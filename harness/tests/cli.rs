@@ -414,6 +414,121 @@ fn bless_rewrites_only_the_named_golden() {
     assert_eq!(output.status.code(), Some(1));
 }
 
+/// After a change to one light's intensity, `bless --scene arrow` rewrites only the passes that
+/// light reaches (light and final) and their blessed.toml entries; the G-buffer, shadow and mask
+/// goldens and their records stay as they were. A scene given by path gets a bless suggestion
+/// with its path, which works.
+#[test]
+fn bless_after_a_light_change_rewrites_only_the_changed_passes() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    let scene = root.path().join("scenes/arrow.toml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(text.contains("intensity = 2.5"));
+    std::fs::write(&scene, text.replace("intensity = 2.5", "intensity = 3.0")).unwrap();
+    let golden = root.path().join("golden");
+    let records_before = std::fs::read_to_string(golden.join("arrow/blessed.toml")).unwrap();
+    let before = snapshot(&golden);
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    let output = common::harness_command()
+        .args(["bless", "--scene", "arrow"])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let after = snapshot(&golden);
+    let changed: Vec<String> = after
+        .iter()
+        .filter(|(path, state)| before.get(*path) != Some(*state))
+        .map(|(path, _)| path.strip_prefix(&golden).unwrap().display().to_string())
+        .collect();
+    assert_eq!(
+        changed,
+        ["arrow/blessed.toml", "arrow/final.png", "arrow/light.exr"],
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("arrow/light: CHANGED vs old golden"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("arrow/mask: within tolerance vs old golden"),
+        "{stdout}"
+    );
+    // The records of the passes kept are the same lines as before.
+    let records_after = std::fs::read_to_string(golden.join("arrow/blessed.toml")).unwrap();
+    let section = |text: &str, pass: &str| {
+        let start = text.find(&format!("[passes.{pass}]")).unwrap();
+        let rest = &text[start..];
+        let end = rest[1..].find("\n[").map_or(rest.len(), |e| e + 1);
+        rest[..end].to_owned()
+    };
+    for pass in [
+        "mask",
+        "depth",
+        "gbuffer_albedo",
+        "shadow_0",
+        "shadow_term_0",
+    ] {
+        assert_eq!(
+            section(&records_before, pass),
+            section(&records_after, pass),
+            "{pass}"
+        );
+    }
+    assert_ne!(
+        section(&records_before, "light"),
+        section(&records_after, "light")
+    );
+
+    // A second bless finds nothing to rewrite.
+    let again = snapshot(&golden);
+    let output = common::harness_command()
+        .args(["bless", "--scene", "arrow"])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    assert_eq!(snapshot(&golden), again);
+
+    // A copy of the scene given by path: check suggests blessing it by path, and that works.
+    let copy = root.path().join("elsewhere/arrow.toml");
+    std::fs::create_dir_all(copy.parent().unwrap()).unwrap();
+    let text = std::fs::read_to_string(&scene).unwrap();
+    // Relative asset paths resolve against the scene file: point them back at scenes/. The
+    // copy's light differs from the blessed one, so its light and final passes fail.
+    let moved = text
+        .replace("\"assets/", "\"../scenes/assets/")
+        .replace("intensity = 3.0", "intensity = 2.0");
+    std::fs::write(&copy, moved).unwrap();
+    let output = common::harness_command()
+        .args([
+            "check",
+            "--backend",
+            "gl",
+            "--scene",
+            copy.to_str().unwrap(),
+            "--out",
+            root.path().join("out").to_str().unwrap(),
+        ])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let suggestion = format!(
+        "  cargo run --release -p harness -- bless --scene {}",
+        copy.display()
+    );
+    assert!(stdout.lines().any(|l| l == suggestion), "{stdout}");
+}
+
 /// Darkens an 8-bit image's RGB by `steps` (of 255), in place.
 fn darken(png: &Path, steps: u8) {
     let mut image = image::open(png).unwrap().to_rgba8();
@@ -464,8 +579,17 @@ fn check_reports_failures_with_images_and_the_bless_command() {
         "{stdout}"
     );
     assert!(
-        line("light").contains("MISSING")
-            && line("light").contains("harness -- bless --scene arrow --pass light"),
+        line("light").contains("MISSING") && line("light").contains("no golden at "),
+        "{stdout}"
+    );
+    // One bless suggestion for the scene, not one per pass.
+    let suggestions: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.contains("harness -- bless"))
+        .collect();
+    assert_eq!(
+        suggestions,
+        ["  cargo run --release -p harness -- bless --scene arrow"],
         "{stdout}"
     );
     assert!(line("mask").contains(" ok "), "{stdout}");

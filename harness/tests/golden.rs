@@ -51,23 +51,12 @@ impl Suite {
         let actual = &frame.outputs[pass];
         if self.update {
             if kind == REFERENCE_BACKEND {
-                let previous =
-                    match self
-                        .store
-                        .load(case.name(), pass, golden::is_eight_bit(actual))
-                    {
-                        Ok(Some(old)) => match golden::check(actual, Some(&old), &case.rules[pass])
-                        {
-                            golden::Outcome::Passed(v) | golden::Outcome::Failed(v) => v
-                                .checks
-                                .iter()
-                                .map(ToString::to_string)
-                                .collect::<Vec<_>>()
-                                .join("; "),
-                            other => format!("{other:?}"),
-                        },
-                        _ => "new".to_owned(),
-                    };
+                let change = suite::bless_change(&self.store, case, pass, actual);
+                if !change.changed {
+                    eprintln!("{}/{pass}: {}; kept", case.name(), change.previous);
+                    return Ok(());
+                }
+                let previous = change.previous;
                 let driver = backend::create(kind)
                     .map(|b| golden::fingerprint(b.info()))
                     .unwrap_or_default();
