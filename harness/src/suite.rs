@@ -348,6 +348,9 @@ pub struct PassCheck {
     pub golden_path: PathBuf,
     /// Files written.
     pub artifacts: Artifacts,
+    /// The rule's per-pixel criterion, which scales the review page's false-colour diff.
+    #[serde(default)]
+    pub criterion: Option<crate::tolerance::PixelCriterion>,
 }
 
 /// How to name the scene file at `path` on the command line: its file stem when it lives in
@@ -543,6 +546,7 @@ pub fn check_pass(
         outcome,
         golden_path: store.path(scene, pass, eight_bit),
         artifacts,
+        criterion: case.rules.get(pass).and_then(Rule::pixel_criterion),
     }
 }
 

@@ -165,7 +165,51 @@ fn number(table: &toml::Table, key: &str, path: &str) -> Result<Option<f64>, Rul
     }
 }
 
+/// The per-pixel criterion of a rule, for showing differences in units of the tolerance: a
+/// pixel's error is its largest channel difference, divided by `max(|golden|, floor)` when the
+/// criterion is relative, and the pixel counts as over at `error > threshold`.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PixelCriterion {
+    /// The error at which a pixel counts as over.
+    pub threshold: f64,
+    /// Denominator floor of a relative criterion; `None` for an absolute one.
+    pub floor: Option<f64>,
+    /// Which channels count.
+    pub channels: Channels,
+}
+
 impl Rule {
+    /// The first per-pixel criterion of the rule: a `fraction_over` threshold, or a `max_abs`
+    /// limit. `None` when the rule only has whole-image metrics (RMSE, PSNR, FLIP).
+    pub fn pixel_criterion(&self) -> Option<PixelCriterion> {
+        match self {
+            Rule::All(rules) | Rule::Any(rules) => rules.iter().find_map(Rule::pixel_criterion),
+            Rule::Check {
+                metric:
+                    Metric::FractionOver {
+                        threshold,
+                        floor,
+                        channels,
+                        ..
+                    },
+                ..
+            } => Some(PixelCriterion {
+                threshold: *threshold,
+                floor: *floor,
+                channels: *channels,
+            }),
+            Rule::Check {
+                metric: Metric::MaxAbs { channels, .. },
+                limit,
+            } => Some(PixelCriterion {
+                threshold: *limit,
+                floor: None,
+                channels: *channels,
+            }),
+            Rule::Check { .. } => None,
+        }
+    }
+
     /// Reads a rule from its TOML table; `path` names it in errors.
     pub fn from_toml(value: &toml::Value, path: &str) -> Result<Rule, RuleError> {
         let err = |message: String| RuleError {

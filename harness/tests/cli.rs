@@ -224,6 +224,13 @@ fn a_broken_scene_is_one_failed_case_and_the_others_are_checked() {
     assert!(stdout.contains("1 scene(s) did not load"), "{stdout}");
     let report = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(report.contains("scene broken did not load"));
+    // The canonical scenes pass: the review page shows them as thumbnails and stays small
+    // (the thumbnails are per scene and pass, so more backends add only table rows).
+    assert!(
+        report.len() < 5_000_000,
+        "report.html is {} bytes",
+        report.len()
+    );
     assert!(
         !stale.exists(),
         "the earlier run's failure image is still there"
