@@ -240,36 +240,46 @@ pub struct ShadowSpec {
     pub vsm_bleeding_reduction: Option<f32>,
 }
 
-/// `[[lights]]`.
+/// `[[lights]]`, by its `type`.
 #[derive(Debug, Deserialize)]
-#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+#[serde(tag = "type", rename_all = "kebab-case")]
 pub enum LightSpec {
     /// A directional light.
-    Directional {
-        /// Direction from the scene towards the light.
-        direction: [f64; 3],
-        /// Linear color (default white).
-        color: Option<[f32; 3]>,
-        /// Intensity (default 1).
-        intensity: Option<f32>,
-        /// Shadow settings; absent means no shadows.
-        shadow: Option<ShadowSpec>,
-    },
+    Directional(DirectionalLightSpec),
     /// A point light with r2 attenuation.
-    Point {
-        /// Position.
-        position: [f64; 3],
-        /// Linear color (default white).
-        color: Option<[f32; 3]>,
-        /// Intensity (default 1).
-        intensity: Option<f32>,
-        /// Radius where the light reaches zero.
-        radius: f32,
-        /// Falloff exponent shape (default 1, linear).
-        falloff: Option<f32>,
-        /// Shadow settings; absent means no shadows.
-        shadow: Option<ShadowSpec>,
-    },
+    Point(PointLightSpec),
+}
+
+/// `[[lights]]` with `type = "directional"`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DirectionalLightSpec {
+    /// Direction from the scene towards the light.
+    pub direction: [f64; 3],
+    /// Linear color (default white).
+    pub color: Option<[f32; 3]>,
+    /// Intensity (default 1).
+    pub intensity: Option<f32>,
+    /// Shadow settings; absent means no shadows.
+    pub shadow: Option<ShadowSpec>,
+}
+
+/// `[[lights]]` with `type = "point"`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLightSpec {
+    /// Position.
+    pub position: [f64; 3],
+    /// Linear color (default white).
+    pub color: Option<[f32; 3]>,
+    /// Intensity (default 1).
+    pub intensity: Option<f32>,
+    /// Radius where the light reaches zero.
+    pub radius: f32,
+    /// Falloff exponent shape (default 1, linear).
+    pub falloff: Option<f32>,
+    /// Shadow settings; absent means no shadows.
+    pub shadow: Option<ShadowSpec>,
 }
 
 /// A parsed scene file, before any asset is loaded.
@@ -345,16 +355,66 @@ fn line_column(text: &str, offset: usize) -> (usize, usize) {
 /// Parses scene-file text (no assets are loaded).
 pub fn parse(path: &Path, text: &str) -> Result<SceneFile, SceneFileError> {
     toml::from_str(text).map_err(|e| {
-        let (line, column) = e
-            .span()
-            .map_or((1, 1), |span| line_column(text, span.start));
+        let start = e.span().map_or(0, |span| span.start);
+        let (start, message) =
+            light_error(text, start).unwrap_or_else(|| (start, e.message().trim().to_owned()));
+        let (line, column) = line_column(text, start);
         SceneFileError::Parse {
             path: path.to_owned(),
             line,
             column,
-            message: e.message().trim().to_owned(),
+            message,
         }
     })
+}
+
+/// serde reads a `[[lights]]` table whole before it knows the light's `type`, so an error in one
+/// of its keys is reported at the table's header. When `start` is such a header, this reads the
+/// table again on its own, as the struct of its type, and returns where the key at fault is and
+/// the error.
+fn light_error(text: &str, start: usize) -> Option<(usize, String)> {
+    let rest = &text[start..];
+    if !rest.starts_with("[[lights]]") {
+        return None;
+    }
+    // The table's body: from the line after the header to the next header.
+    let body_start = start + rest.find('\n')? + 1;
+    let body_len = text[body_start..]
+        .match_indices('\n')
+        .map(|(i, _)| i + 1)
+        .find(|&i| text[body_start + i..].trim_start().starts_with('['))
+        .unwrap_or(text.len() - body_start);
+    let body = &text[body_start..body_start + body_len];
+    let kind = toml::from_str::<toml::Table>(body)
+        .ok()?
+        .get("type")?
+        .as_str()?
+        .to_owned();
+    // The same text without its `type` line (kept as an empty line, so offsets still match).
+    let untyped: String = body
+        .split_inclusive('\n')
+        .map(|line| {
+            let key = line.trim_start();
+            let is_type = key
+                .strip_prefix("type")
+                .is_some_and(|after| after.trim_start().starts_with('='));
+            if is_type {
+                " ".repeat(line.trim_end_matches('\n').len())
+                    + if line.ends_with('\n') { "\n" } else { "" }
+            } else {
+                line.to_owned()
+            }
+        })
+        .collect();
+    let error = match kind.as_str() {
+        "directional" => toml::from_str::<DirectionalLightSpec>(&untyped).err()?,
+        "point" => toml::from_str::<PointLightSpec>(&untyped).err()?,
+        _ => return None,
+    };
+    Some((
+        body_start + error.span()?.start,
+        error.message().trim().to_owned(),
+    ))
 }
 
 /// Finds a scene by canonical name (`chess`) or path (`scenes/chess.toml`). Names are looked
@@ -691,31 +751,19 @@ impl Resolver {
                 })
             };
             let light = match spec {
-                LightSpec::Directional {
-                    direction,
-                    color,
-                    intensity,
-                    shadow: s,
-                } => Light::Directional {
-                    direction: DVec3::from(*direction),
-                    color: color.unwrap_or([1.0; 3]),
-                    intensity: intensity.unwrap_or(1.0),
-                    shadow: shadow(s),
+                LightSpec::Directional(l) => Light::Directional {
+                    direction: DVec3::from(l.direction),
+                    color: l.color.unwrap_or([1.0; 3]),
+                    intensity: l.intensity.unwrap_or(1.0),
+                    shadow: shadow(&l.shadow),
                 },
-                LightSpec::Point {
-                    position,
-                    color,
-                    intensity,
-                    radius,
-                    falloff,
-                    shadow: s,
-                } => Light::Point {
-                    position: DVec3::from(*position),
-                    color: color.unwrap_or([1.0; 3]),
-                    intensity: intensity.unwrap_or(1.0),
-                    radius: *radius,
-                    falloff: falloff.unwrap_or(1.0),
-                    shadow: shadow(s),
+                LightSpec::Point(l) => Light::Point {
+                    position: DVec3::from(l.position),
+                    color: l.color.unwrap_or([1.0; 3]),
+                    intensity: l.intensity.unwrap_or(1.0),
+                    radius: l.radius,
+                    falloff: l.falloff.unwrap_or(1.0),
+                    shadow: shadow(&l.shadow),
                 },
             };
             if let Some(problem) = crate::renderer::shadows::settings_problem(&light) {

@@ -41,6 +41,34 @@ fn unknown_keys_name_the_key_the_file_and_the_line() {
     assert!(e.contains("dir/bad.toml:2:"), "{e}");
 }
 
+/// A light's table is read whole before its `type` is known; its errors still point at the key
+/// at fault, not at the `[[lights]]` header, for either type and for a nested shadow table.
+#[test]
+fn errors_in_a_light_name_the_line_of_the_key() {
+    let light = |body: &str| {
+        parse_err(&format!(
+            "{CAMERA}\n[[lights]]\ntype = \"point\"\nposition = [0, 0, 0]\nradius = 1\n{body}\n\
+             [[lights]]\ntype = \"directional\"\ndirection = [0, 1, 0]\n"
+        ))
+    };
+    // CAMERA is 3 lines, then an empty line, the header (5), type, position, radius: line 9.
+    let e = light("intensty = 3");
+    assert!(e.starts_with("dir/bad.toml:9:1:"), "{e}");
+    assert!(e.contains("unknown field `intensty`"), "{e}");
+    let e = light("falloff = \"steep\"");
+    assert!(e.starts_with("dir/bad.toml:9:"), "{e}");
+    assert!(e.contains("expected f32"), "{e}");
+    let e = light("shadow = { map_sise = 512 }");
+    assert!(e.starts_with("dir/bad.toml:9:"), "{e}");
+    assert!(e.contains("`map_sise`"), "{e}");
+    // The second light, a directional one, with a key only point lights have.
+    let e = parse_err(&format!(
+        "{CAMERA}\n[[lights]]\ntype = \"directional\"\ndirection = [0, 1, 0]\nradius = 2\n"
+    ));
+    assert!(e.starts_with("dir/bad.toml:8:1:"), "{e}");
+    assert!(e.contains("unknown field `radius`"), "{e}");
+}
+
 #[test]
 fn paths_are_relative_to_the_scene_file_and_shared_textures_load_once() {
     let loaded = scene_file::load(&fixture("scenes/two_materials.toml")).unwrap();
