@@ -1,5 +1,6 @@
 //! No GPU object leaks: creating and dropping a backend with resources 50 times keeps process
-//! memory flat, and (ignored by default: minutes) 500 renders of chess on one backend keep it
+//! memory flat (and a backend leaked on purpose shows the bound would catch a leak by 3x or
+//! more), and (ignored by default: minutes) 500 renders of chess on one backend keep it
 //! within 10% of its value after the first 20. Its own test binary, so no other test's
 //! allocations disturb the measurement.
 
@@ -19,58 +20,92 @@ fn resident_bytes() -> u64 {
     kib * 1024
 }
 
-/// One cycle: a backend, a full render (which frees its own resources), and resources left
-/// alive for the backend's Drop to free.
-fn cycle(kind: BackendKind) {
+/// Bytes of the texture and of the buffer each cycle leaves alive for the backend's Drop: both
+/// written, so that a leak of them is resident memory.
+const TEXTURE_SIZE: u32 = 512;
+const BUFFER_BYTES: usize = 2 << 20;
+
+/// One cycle: a backend, a full render (which frees its own resources), and a texture and a
+/// buffer left alive for the backend's Drop to free. Returns the backend, for the caller to drop
+/// (or, to show what a leak looks like, to forget).
+fn cycle(kind: BackendKind) -> Box<dyn Backend> {
     let mut backend = create(kind).unwrap();
     engine::lit_cube::render(backend.as_mut(), 64).unwrap();
     let texture = backend
         .create_texture(&TextureDesc::d2(
             "left alive",
-            256,
-            256,
+            TEXTURE_SIZE,
+            TEXTURE_SIZE,
             TextureFormat::Rgba16Float,
         ))
         .unwrap();
+    // Non-zero data: zero pages could be shared copy-on-write and not count as resident.
+    let texels = vec![0x3cu8; (TEXTURE_SIZE * TEXTURE_SIZE * 8) as usize];
     backend
-        .write_texture(texture, Subresource::default(), &vec![0u8; 256 * 256 * 8])
+        .write_texture(texture, Subresource::default(), &texels)
         .unwrap();
-    backend
+    let buffer = backend
         .create_buffer(&BufferDesc {
             label: "left alive".into(),
-            size: 1 << 20,
+            size: BUFFER_BYTES as u64,
             usage: BufferUsage::Vertex,
         })
         .unwrap();
+    backend
+        .write_buffer(buffer, 0, &vec![0x5au8; BUFFER_BYTES])
+        .unwrap();
+    backend
+}
+
+/// Resident growth over `cycles` cycles, dropping each backend (or forgetting it: a leak).
+fn growth_over(kind: BackendKind, cycles: usize, leak: bool) -> u64 {
+    let before = resident_bytes();
+    for _ in 0..cycles {
+        let backend = cycle(kind);
+        if leak {
+            std::mem::forget(backend);
+        }
+    }
+    resident_bytes().saturating_sub(before)
 }
 
 #[test]
 fn creating_and_dropping_backends_keeps_memory_flat() {
     const WARM_UP: usize = 10;
     const CYCLES: usize = 50;
-    /// Allowed growth over 50 cycles. One leaked cycle holds at least 1.5 MiB (the texture and
-    /// buffer above), so a per-cycle leak shows up as 75 MiB or more.
+    /// Allowed growth over 50 cycles: the measured no-leak growth is a few MiB (see the note
+    /// printed), and the leak measured below must exceed this at least 3x.
     const BOUND: u64 = 24 << 20;
+    /// Cycles leaked on purpose to measure what a per-cycle leak costs.
+    const LEAKED: usize = 4;
     for kind in common::available_backends() {
         for _ in 0..WARM_UP {
-            cycle(kind);
+            drop(cycle(kind));
         }
-        let before = resident_bytes();
-        for _ in 0..CYCLES {
-            cycle(kind);
-        }
-        let after = resident_bytes();
-        let growth = after.saturating_sub(before);
+        let growth = growth_over(kind, CYCLES, false);
+        // What the bound is for: a backend (with its texture and buffer) that is never freed.
+        let leak_per_cycle = growth_over(kind, LEAKED, true) / LEAKED as u64;
+        let leak_over_cycles = leak_per_cycle * CYCLES as u64;
         eprintln!(
-            "{kind}: RSS {} KiB -> {} KiB over {CYCLES} cycles (+{} KiB)",
-            before >> 10,
-            after >> 10,
-            growth >> 10
+            "{kind}: +{} KiB over {CYCLES} create/drop cycles (bound {} KiB); a leaked cycle \
+             holds {} KiB, {} KiB over {CYCLES} cycles ({:.1}x the bound)",
+            growth >> 10,
+            BOUND >> 10,
+            leak_per_cycle >> 10,
+            leak_over_cycles >> 10,
+            leak_over_cycles as f64 / BOUND as f64
         );
         assert!(
             growth <= BOUND,
             "{kind}: memory grew by {} KiB over {CYCLES} create/drop cycles",
             growth >> 10
+        );
+        assert!(
+            leak_over_cycles >= 3 * BOUND,
+            "{kind}: a leaked cycle holds only {} KiB: the bound of {} KiB over {CYCLES} \
+             cycles would not catch it by 3x",
+            leak_per_cycle >> 10,
+            BOUND >> 10
         );
     }
 }
