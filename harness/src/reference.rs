@@ -11,8 +11,8 @@
 use std::f64::consts::PI;
 
 use engine::plan;
-use engine::renderer::{ambient_radiance, light_uniforms, Frame};
-use engine::scene::{LightingModel, Scene};
+use engine::renderer::Frame;
+use engine::scene::{Light, LightingModel, Scene};
 use engine::Image;
 use glam::DVec3;
 
@@ -55,25 +55,50 @@ pub enum RefLight {
     Point(DVec3, DVec3, f64, f64),
 }
 
-/// The scene's lights for the reference, from the same f64 scene data the renderer starts from.
+/// The scene's lights for the reference, derived here from the scene in f64 (exposure applied,
+/// positions relative to the camera), sharing no code with the renderer's uniform packing: a
+/// wrong intensity, direction or falloff there shows up as a reference failure.
 pub fn reference_lights(scene: &Scene) -> Vec<RefLight> {
-    // The GPU receives exactly these f32 values; the reference starts from them too, in f64.
-    light_uniforms(scene)
+    let exposure = f64::from(scene.quality.exposure);
+    let radiance = |color: &[f32; 3], intensity: f32| {
+        DVec3::new(
+            f64::from(color[0]),
+            f64::from(color[1]),
+            f64::from(color[2]),
+        ) * f64::from(intensity)
+            * exposure
+    };
+    scene
+        .lights
         .iter()
-        .map(|l| {
-            let p = DVec3::new(
-                l.position[0] as f64,
-                l.position[1] as f64,
-                l.position[2] as f64,
-            );
-            let c = DVec3::new(l.color[0] as f64, l.color[1] as f64, l.color[2] as f64);
-            if l.position[3] < 0.5 {
-                RefLight::Directional(p, c)
-            } else {
-                RefLight::Point(p, c, l.color[3] as f64, l.params[0] as f64)
-            }
+        .map(|light| match light {
+            Light::Directional {
+                direction,
+                color,
+                intensity,
+                ..
+            } => RefLight::Directional(direction.normalize(), radiance(color, *intensity)),
+            Light::Point {
+                position,
+                color,
+                intensity,
+                radius,
+                falloff,
+                ..
+            } => RefLight::Point(
+                *position - scene.camera.position,
+                radiance(color, *intensity),
+                f64::from(*radius),
+                1.0 / f64::from(*falloff),
+            ),
         })
         .collect()
+}
+
+/// The scene's uniform ambient radiance with exposure applied, from the scene in f64.
+pub fn reference_ambient(scene: &Scene) -> DVec3 {
+    let [r, g, b] = scene.ambient;
+    DVec3::new(f64::from(r), f64::from(g), f64::from(b)) * f64::from(scene.quality.exposure)
 }
 
 fn pow5(x: f64) -> f64 {
@@ -315,9 +340,7 @@ pub fn reference_light_buffer(
         return Err(ReferenceError("frame has no mask output".into()));
     }
     let lights = reference_lights(scene);
-    let exposure = scene.quality.exposure as f64;
-    let [r, g, b] = ambient_radiance(scene);
-    let ambient = DVec3::new(r as f64, g as f64, b as f64) * exposure;
+    let ambient = reference_ambient(scene);
     let pixels = (frame.plan.width * frame.plan.height) as usize;
     let mut out = Vec::new();
     for index in 0..pixels {

@@ -49,6 +49,33 @@ fn lighting_pass_matches_the_f64_reference() {
     }
 }
 
+/// The reference derives the lights from the scene itself: a renderer whose light uniforms carry
+/// a radiance 1% off fails it (99.9th-percentile error far over 2e-3), while the same render
+/// without the fault passes.
+#[test]
+fn a_wrong_light_radiance_in_the_uniforms_fails_the_reference() {
+    let scene = test_scenes::material_grid(128);
+    let Some(&kind) = common::available_backends().first() else {
+        return;
+    };
+    let mut backend = engine::backend::create(kind).unwrap();
+    let faults = renderer::Faults {
+        light_radiance_scale: Some(1.01),
+        ..Default::default()
+    };
+    let frame =
+        renderer::render_with_faults(backend.as_mut(), &scene, Readback::All, &faults).unwrap();
+    let wrong = reference::lighting_error(&scene, &frame).unwrap();
+    let frame = render(backend.as_mut(), &scene);
+    let right = reference::lighting_error(&scene, &frame).unwrap();
+    eprintln!("{kind}: with the fault {wrong:?}, without {right:?}");
+    assert!(right.p999_relative <= 2e-3, "{right:?}");
+    assert!(
+        wrong.p999_relative > 5e-3,
+        "a 1% radiance error in the uniforms passes the reference: {wrong:?}"
+    );
+}
+
 /// A white dielectric Lambert surface under uniform unit radiance returns its albedo within 1%.
 #[test]
 fn white_furnace_returns_the_albedo() {

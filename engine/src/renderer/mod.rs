@@ -121,6 +121,9 @@ pub struct Faults {
     /// The lighting passes run without this part of their work (see
     /// [`RenderPlan::remove_lighting_feature`]).
     pub remove_lighting: Option<LightingFeature>,
+    /// The light uniforms carry each light's radiance times this: a fault in the uniform
+    /// packing, which only a reference that derives the lights from the scene itself catches.
+    pub light_radiance_scale: Option<f32>,
 }
 
 /// Renders `scene` and reads back the requested outputs. Everything created is destroyed before
@@ -962,7 +965,14 @@ fn record_and_submit(
             bytemuck::cast_slice(texels),
         )?;
     }
-    let lights = light_uniforms(scene);
+    let mut lights = light_uniforms(scene);
+    if let Some(scale) = faults.light_radiance_scale {
+        for light in &mut lights {
+            for channel in &mut light.color[..3] {
+                *channel *= scale;
+            }
+        }
+    }
     let shadow_sampler = scope.sampler(
         backend,
         &SamplerDesc {
