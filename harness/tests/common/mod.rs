@@ -10,13 +10,12 @@ use engine::backend::{self, BackendKind};
 /// `gl,wgpu-vulkan,wgpu-gl`) must be available, or the test fails; any other missing backend
 /// is reported on stderr and left out.
 pub fn available_backends() -> Vec<BackendKind> {
-    let required = std::env::var("REQUIRE_BACKENDS").unwrap_or_default();
     let mut kinds = Vec::new();
     for kind in BackendKind::ALL {
         let status = backend::probe(kind);
         if status.available {
             kinds.push(kind);
-        } else if required.split(',').any(|r| r.trim() == kind.name()) {
+        } else if required(kind) {
             panic!(
                 "{kind} is required by REQUIRE_BACKENDS but unavailable: {} (fix: {})",
                 status.reason.unwrap_or_default(),
@@ -31,6 +30,14 @@ pub fn available_backends() -> Vec<BackendKind> {
         }
     }
     kinds
+}
+
+/// Whether `REQUIRE_BACKENDS` names `kind`: then a test must fail rather than skip without it.
+pub fn required(kind: BackendKind) -> bool {
+    std::env::var("REQUIRE_BACKENDS")
+        .unwrap_or_default()
+        .split(',')
+        .any(|r| r.trim() == kind.name())
 }
 
 /// Whether `gl` is available, for tests that need it and skip without it. Like
