@@ -25,6 +25,10 @@ use crate::images;
 /// Largest thumbnail edge in pixels.
 const PREVIEW: u32 = 160;
 
+/// Pixel data embedded at full resolution before the remaining failures fall back to
+/// thumbnails (base64 bytes).
+const EMBED_BUDGET: usize = 64 << 20;
+
 /// The page's style sheet.
 const STYLE: &str = include_str!("review.css");
 
@@ -168,6 +172,11 @@ impl Blobs {
             }
             None => index,
         }
+    }
+
+    /// Base64 bytes embedded so far.
+    fn bytes(&self) -> usize {
+        self.0.iter().map(String::len).sum()
     }
 
     fn encode(&mut self, bytes: &[u8]) -> usize {
@@ -454,6 +463,19 @@ fn cases(
                 )
                 && actual.as_u8().is_some() == golden_image.as_u8().is_some();
             if !comparable {
+                out.push_str(&thumbnail("actual", actual, pass));
+                out.push_str(&thumbnail("golden", golden_image, pass));
+                continue;
+            }
+            if blobs.bytes() > EMBED_BUDGET {
+                // A change that fails everything would make a page too large to open: the
+                // remaining failures get thumbnails, and their files are linked above.
+                let _ = write!(
+                    out,
+                    "<p class=\"note\">Not embedded at full resolution: the page already holds \
+                     {} MB of pixel data (see the files linked above).</p>",
+                    EMBED_BUDGET >> 20
+                );
                 out.push_str(&thumbnail("actual", actual, pass));
                 out.push_str(&thumbnail("golden", golden_image, pass));
                 continue;

@@ -1,0 +1,238 @@
+#!/usr/bin/env python3
+"""Cross-check the harness's image-based lighting against Mitsuba 3, a path tracer with no code in
+common with it.
+
+A row of five spheres lit only by an environment (no lights, no ambient) is rendered twice:
+
+- by the harness (`harness render --pass light`, the linear light buffer, exposure 1, on gl);
+- by Mitsuba 3 (scalar_rgb), direct environment light only (the `direct` integrator), each
+  sphere alone in its own render, since the harness models neither light bouncing between
+  spheres nor one sphere hiding part of the sky from another.
+
+Spheres, left to right: Lambert (albedo 0.8, the harness's `lambert` model), then white metals
+(base colour 1, so Fresnel is exactly 1 in both renderers) of GGX roughness 0.2, 0.5 and 0.8
+(Mitsuba `roughconductor`, alpha = roughness^2), and a mirror (roughness 0; Mitsuba
+`conductor`). Environments: the two the project ships (scenes/assets/sunset.exr and
+interior.exr), with negative texels clamped to 0 as the harness's precompute does (Mitsuba
+drops samples with negative values). Mitsuba's envmap needs to_world = rotate(Y, 180 +
+rotation) to match the harness's equirectangular convention.
+
+Per sphere, over the pixels where both renders see the sphere away from its silhouette (N.V >=
+0.3), it prints harness mean / Mitsuba mean, and the mean and 95th percentile of the per-pixel
+relative error |harness - mitsuba| / mitsuba (luminance). The per-pixel figures include
+Mitsuba's own noise, about 1/sqrt(spp) of the pixel value; the ratio of means does not.
+
+    pip install mitsuba          # 3.x; the scalar_rgb variant ships in the wheel
+    python3 scripts/mitsuba_crosscheck.py [--spp 1024] [--out target/mitsuba]
+
+Not part of `cargo test`: it takes a few minutes and needs Mitsuba. The README's "IBL against a
+path tracer" section records its table.
+"""
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+
+try:
+    import numpy as np
+    import mitsuba as mi
+except ImportError as missing:  # pragma: no cover
+    sys.exit(f"error: {missing.name} is missing: pip install mitsuba numpy")
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+WIDTH, HEIGHT = 640, 140
+FOV_Y = 12.0
+CAMERA = (0.0, 0.0, 12.0)
+RADIUS = 0.8
+# (label, harness material and model, Mitsuba BSDF)
+SPHERES = [
+    ("Lambert 0.8", {"lighting": "lambert", "base_color": 0.8}, {"type": "diffuse", "reflectance": 0.8}),
+    ("metal r 0.2", {"roughness": 0.2}, None),
+    ("metal r 0.5", {"roughness": 0.5}, None),
+    ("metal r 0.8", {"roughness": 0.8}, None),
+    ("mirror r 0", {"roughness": 0.0}, {"type": "conductor", "material": "none"}),
+]
+ENVIRONMENTS = ["sunset.exr", "interior.exr"]
+
+
+def sphere_x(index):
+    return (index - (len(SPHERES) - 1) / 2) * 2.2
+
+
+def harness_scene(environment):
+    """The scene file the harness renders (in the folder that holds a copy of the environment)."""
+    lines = [
+        "# Written by scripts/mitsuba_crosscheck.py.",
+        'description = "Spheres lit by the environment only, for the Mitsuba cross-check"',
+        "[camera]",
+        f"position = [{CAMERA[0]}, {CAMERA[1]}, {CAMERA[2]}]",
+        "target = [0.0, 0.0, 0.0]",
+        f"fov_y = {FOV_Y}",
+        "near = 0.1",
+        "far = 100.0",
+        "[quality]",
+        f"width = {WIDTH}",
+        f"height = {HEIGHT}",
+        "exposure = 1.0",
+        "[environment]",
+        f'path = "{environment}"',
+        "rotation = 0.0",
+        "intensity = 1.0",
+    ]
+    for index, (label, material, _) in enumerate(SPHERES):
+        lighting = material.get("lighting", "pbr")
+        if lighting == "lambert":
+            c = material["base_color"]
+            body = f"base_color = [{c}, {c}, {c}]"
+        else:
+            body = f'roughness = {material["roughness"]}, metallic = 1.0, base_color = [1.0, 1.0, 1.0]'
+        lines += [
+            "[[objects]]",
+            f'name = "{label.replace(" ", "_").replace(".", "")}"',
+            'mesh = "builtin:sphere"',
+            f"position = [{sphere_x(index)}, 0.0, 0.0]",
+            f"scale = {RADIUS}",
+            f'lighting = "{lighting}"',
+            f"material = {{ {body} }}",
+        ]
+    return "\n".join(lines) + "\n"
+
+
+def mitsuba_sphere(environment_bitmap, spp, index, crop):
+    """Mitsuba's render of sphere `index` alone (the harness does not model one sphere hiding
+    the sky from another), over the pixel rectangle `crop` = (x, y, width, height)."""
+    label, material, bsdf = SPHERES[index]
+    if bsdf is None:
+        alpha = material["roughness"] ** 2
+        bsdf = {"type": "roughconductor", "distribution": "ggx", "alpha": alpha, "material": "none"}
+    x, y, w, h = crop
+    scene = {
+        "type": "scene",
+        "integrator": {"type": "direct", "emitter_samples": 1, "bsdf_samples": 1},
+        "sensor": {
+            "type": "perspective",
+            "fov": FOV_Y,
+            "fov_axis": "y",
+            "to_world": mi.ScalarTransform4f().look_at(origin=CAMERA, target=[0, 0, 0], up=[0, 1, 0]),
+            "sampler": {"type": "independent", "sample_count": spp, "seed": 7 + index},
+            "film": {
+                "type": "hdrfilm",
+                "width": WIDTH,
+                "height": HEIGHT,
+                "crop_offset_x": x,
+                "crop_offset_y": y,
+                "crop_width": w,
+                "crop_height": h,
+                "rfilter": {"type": "box"},
+                "pixel_format": "rgb",
+            },
+        },
+        "environment": {
+            "type": "envmap",
+            "bitmap": environment_bitmap,
+            "scale": 1.0,
+            "to_world": mi.ScalarTransform4f().rotate(axis=[0, 1, 0], angle=180.0 + 0.0),
+        },
+        "sphere": {
+            "type": "sphere",
+            "center": [sphere_x(index), 0.0, 0.0],
+            "radius": RADIUS,
+            "bsdf": bsdf,
+        },
+    }
+    return np.array(mi.render(mi.load_dict(scene)), dtype=np.float64)[..., :3]
+
+
+def mitsuba_render(environment_bitmap, spp, masks):
+    """The five spheres' pixels from Mitsuba, each sphere rendered alone; zero elsewhere."""
+    image = np.zeros((HEIGHT, WIDTH, 3))
+    for index, mask in enumerate(masks):
+        ys, xs = np.nonzero(mask)
+        x0, y0, x1, y1 = xs.min(), ys.min(), xs.max() + 1, ys.max() + 1
+        crop = mitsuba_sphere(environment_bitmap, spp, index, (int(x0), int(y0), int(x1 - x0), int(y1 - y0)))
+        image[y0:y1, x0:x1] = crop
+    return image
+
+
+def luminance(rgb):
+    return rgb[..., 0] * 0.2126 + rgb[..., 1] * 0.7152 + rgb[..., 2] * 0.0722
+
+
+def sphere_pixels():
+    """Per sphere, a boolean mask of the pixels whose ray hits it with N.V >= 0.3, from the
+    camera model both renderers share (pixel centres)."""
+    ys, xs = np.mgrid[0:HEIGHT, 0:WIDTH]
+    tan_half = np.tan(np.radians(FOV_Y) / 2)
+    aspect = WIDTH / HEIGHT
+    # Camera at CAMERA looking down -Z, +Y up, +X right.
+    dx = ((xs + 0.5) / WIDTH * 2 - 1) * tan_half * aspect
+    dy = (1 - (ys + 0.5) / HEIGHT * 2) * tan_half
+    directions = np.stack([dx, dy, -np.ones_like(dx)], axis=-1)
+    directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
+    origin = np.array(CAMERA)
+    masks = []
+    for index in range(len(SPHERES)):
+        center = np.array([sphere_x(index), 0.0, 0.0])
+        oc = origin - center
+        b = directions @ oc
+        c = oc @ oc - RADIUS**2
+        disc = b * b - c
+        hit = disc > 0
+        t = -b - np.sqrt(np.maximum(disc, 0))
+        points = origin + directions * t[..., None]
+        normals = (points - center) / RADIUS
+        n_dot_v = -(normals * directions).sum(axis=-1)
+        masks.append(hit & (n_dot_v >= 0.3))
+    return masks
+
+
+def run_harness(scene_path, light_path):
+    """The harness's light buffer of the scene, rendered on gl into `light_path` (EXR)."""
+    command = [
+        "cargo", "run", "--release", "-q", "-p", "harness", "--",
+        "render", "--scene", scene_path, "--backend", "gl", "--pass", "light", "--out", light_path,
+    ]
+    subprocess.run(command, cwd=ROOT, check=True)
+    return np.array(mi.Bitmap(light_path), dtype=np.float64)[..., :3]
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--spp", type=int, default=1024, help="Mitsuba samples per pixel (default 1024)")
+    parser.add_argument("--out", default=os.path.join(ROOT, "target", "mitsuba"), help="working folder")
+    args = parser.parse_args()
+    mi.set_variant("scalar_rgb")
+    os.makedirs(args.out, exist_ok=True)
+    masks = sphere_pixels()
+    rows = []
+    for environment in ENVIRONMENTS:
+        source = os.path.join(ROOT, "scenes", "assets", environment)
+        work = os.path.join(args.out, os.path.splitext(environment)[0])
+        os.makedirs(work, exist_ok=True)
+        shutil.copyfile(source, os.path.join(work, environment))
+        scene_path = os.path.join(work, "spheres.toml")
+        with open(scene_path, "w") as f:
+            f.write(harness_scene(environment))
+        print(f"{environment}: harness ...", file=sys.stderr)
+        harness = run_harness(scene_path, os.path.join(work, "light.exr"))
+        texels = np.array(mi.Bitmap(source), dtype=np.float32)[..., :3]
+        clamped = mi.Bitmap(np.ascontiguousarray(np.maximum(texels, 0.0)))
+        print(f"{environment}: Mitsuba, {args.spp} spp ...", file=sys.stderr)
+        reference = mitsuba_render(clamped, args.spp, masks)
+        mi.Bitmap(reference.astype(np.float32)).write(os.path.join(work, "mitsuba.exr"))
+        for (label, _, _), mask in zip(SPHERES, masks):
+            h = luminance(harness[mask])
+            m = luminance(reference[mask])
+            relative = np.abs(h - m) / np.maximum(m, 1e-6)
+            rows.append((environment, label, h.mean() / m.mean(), relative.mean(), np.percentile(relative, 95), int(mask.sum())))
+    print(f"| environment | sphere | harness / Mitsuba (means) | per-pixel error, mean | p95 | pixels |")
+    print("|---|---|---|---|---|---|")
+    for environment, label, ratio, mean, p95, pixels in rows:
+        print(f"| {environment} | {label} | {ratio:.4f} | {mean * 100:.1f}% | {p95 * 100:.1f}% | {pixels} |")
+
+
+if __name__ == "__main__":
+    main()
