@@ -543,6 +543,9 @@ pub struct LightingVariant {
     pub vogel_samples: u32,
     /// Image-based lighting in this draw (`IBL`).
     pub ibl: bool,
+    /// Filtered importance samples of the specular IBL per pixel; 0 for the split sum
+    /// (`IBL_SAMPLES`, from `[quality.ibl] runtime_samples`).
+    pub ibl_samples: u32,
     /// Some surface of the model has clearcoat (`CLEARCOAT`; the shader still branches per
     /// pixel when true).
     pub clearcoat: bool,
@@ -588,6 +591,7 @@ impl LightingVariant {
             ("DIRECTIONAL_LIGHTS", flag(self.directional)),
             ("POINT_LIGHTS", flag(self.point)),
             ("IBL", flag(self.ibl)),
+            ("IBL_SAMPLES", f64::from(self.ibl_samples)),
             ("CLEARCOAT", flag(self.clearcoat)),
             ("ANISOTROPY", flag(self.anisotropy)),
             ("POSITION_MODE", position),
@@ -621,8 +625,11 @@ impl fmt::Display for LightingVariant {
                 write!(f, " ({} samples)", self.vogel_samples)?;
             }
         }
+        if self.ibl && self.ibl_samples > 0 {
+            write!(f, ", ibl ({} samples)", self.ibl_samples)?;
+        }
         for (on, name) in [
-            (self.ibl, "ibl"),
+            (self.ibl && self.ibl_samples == 0, "ibl"),
             (self.clearcoat, "clearcoat"),
             (self.anisotropy, "anisotropy"),
             (self.input_floor, "input floor"),
@@ -806,6 +813,7 @@ fn lighting_passes(
                 shadow: None,
                 vogel_samples: 0,
                 ibl: false,
+                ibl_samples: 0,
                 clearcoat: pbr
                     && materials().any(|m| m.clearcoat != 0.0 || m.clearcoat_map.is_some()),
                 anisotropy: pbr && materials().any(|m| m.anisotropy != 0.0),
@@ -831,6 +839,11 @@ fn lighting_passes(
                             first: index == 0,
                             variant: LightingVariant {
                                 ibl: ibl && index == 0,
+                                ibl_samples: if ibl && index == 0 && pbr {
+                                    scene.quality.ibl.runtime_samples
+                                } else {
+                                    0
+                                },
                                 ..base
                             },
                         };
@@ -890,7 +903,10 @@ impl RenderPlan {
             for draw in &mut pass.draws {
                 match feature {
                     LightingFeature::Shading => draw.variant.input_floor = true,
-                    LightingFeature::Ibl => draw.variant.ibl = false,
+                    LightingFeature::Ibl => {
+                        draw.variant.ibl = false;
+                        draw.variant.ibl_samples = 0;
+                    }
                     LightingFeature::Shadows => draw.shadowed = None,
                     LightingFeature::Clearcoat => draw.variant.clearcoat = false,
                     LightingFeature::Light(light) => {
@@ -903,6 +919,7 @@ impl RenderPlan {
                         draw.lights.clear();
                         draw.shadowed = None;
                         draw.variant.ibl = false;
+                        draw.variant.ibl_samples = 0;
                     }
                     LightingFeature::Lights => {
                         draw.lights.clear();

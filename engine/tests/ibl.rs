@@ -51,6 +51,7 @@ fn uniform_environment_gives_uniform_maps() {
             irradiance_size: 8,
             irradiance: method,
             seed: 0,
+            runtime_samples: 0,
         };
         let maps = ibl::build(&uniform(1.0), &settings);
         for (m, level) in maps.specular.levels.iter().enumerate() {
@@ -212,6 +213,18 @@ fn disk_cache_round_trips_and_rebuilds_corrupt_entries() {
         ..IblSettings::default()
     };
     let key = ibl::cache::key(&image, &settings);
+    // The render-time sample count changes no map, so it shares the maps' cache entry; a map
+    // setting does not.
+    let sampled = IblSettings {
+        runtime_samples: 64,
+        ..settings.clone()
+    };
+    assert_eq!(ibl::cache::key(&image, &sampled), key);
+    let finer = IblSettings {
+        specular_samples: 32,
+        ..settings.clone()
+    };
+    assert_ne!(ibl::cache::key(&image, &finer), key);
     let built = ibl::build(&image, &settings);
     let path = ibl::cache::write(dir.path(), &key, &built).unwrap();
     assert_eq!(ibl::cache::read(dir.path(), &key).unwrap(), built);

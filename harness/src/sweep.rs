@@ -321,13 +321,19 @@ pub fn stable_table(rows: &[SweepRow]) -> String {
 /// Which points (cost, error) are on the Pareto front: no other point is at most as costly
 /// and at most as wrong, and strictly better in one of the two.
 pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
+    let points: Vec<Vec<f64>> = points.iter().map(|&(c, e)| vec![c, e]).collect();
+    pareto_front_n(&points)
+}
+
+/// [`pareto_front`] over any number of criteria, each to be minimised: a point is on the front
+/// when no other point is at most as large in every criterion and smaller in one.
+pub fn pareto_front_n(points: &[Vec<f64>]) -> Vec<bool> {
+    let dominates = |a: &[f64], b: &[f64]| {
+        a.iter().zip(b).all(|(x, y)| x <= y) && a.iter().zip(b).any(|(x, y)| x < y)
+    };
     points
         .iter()
-        .map(|&(cost, error)| {
-            !points
-                .iter()
-                .any(|&(c, e)| c <= cost && e <= error && (c < cost || e < error))
-        })
+        .map(|p| !points.iter().any(|q| dominates(q, p)))
         .collect()
 }
 
@@ -465,6 +471,27 @@ pub fn ibl_settings() -> Vec<(String, engine::ibl::IblSettings)> {
             "sh9 irradiance".to_owned(),
             IblSettings {
                 irradiance: IrradianceMethod::Sh9,
+                ..d.clone()
+            },
+        ),
+        (
+            "fis 16".to_owned(),
+            IblSettings {
+                runtime_samples: 16,
+                ..d.clone()
+            },
+        ),
+        (
+            "fis 64".to_owned(),
+            IblSettings {
+                runtime_samples: 64,
+                ..d.clone()
+            },
+        ),
+        (
+            "fis 256".to_owned(),
+            IblSettings {
+                runtime_samples: 256,
                 ..d
             },
         ),
@@ -543,11 +570,19 @@ pub fn ibl_sweep(
             pareto: false,
         });
     }
-    let points: Vec<(f64, f64)> = rows
+    // Two costs: the precompute (once per environment and settings) and the lighting pass (every
+    // frame; the filtered importance sampling settings spend it there).
+    let points: Vec<Vec<f64>> = rows
         .iter()
-        .map(|r| (r.precompute_s, r.mean_relative))
+        .map(|r| {
+            vec![
+                r.precompute_s,
+                r.lighting_ms.unwrap_or(f64::INFINITY),
+                r.mean_relative,
+            ]
+        })
         .collect();
-    for (row, on_front) in rows.iter_mut().zip(pareto_front(&points)) {
+    for (row, on_front) in rows.iter_mut().zip(pareto_front_n(&points)) {
         row.pareto = on_front;
     }
     Ok(rows)
@@ -594,19 +629,30 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
         out.push_str(&format!(" {:>6.2}%", g.reference_noise * 100.0));
     }
     out.push('\n');
-    out.push_str("* = on the Pareto front of precompute time against mean error\n");
-    out.push_str(&format!(
-        "\n{} settings, mean relative error per material row:\n",
-        first.setting
-    ));
-    for (family, cells) in &first.by_family {
-        out.push_str(&format!("{family:<15} {:>13} {:>12}", "", ""));
-        for (_, error, _) in cells {
-            out.push_str(&format!(" {:>6.2}%", error * 100.0));
+    out.push_str("* = on the Pareto front of precompute time, lighting time and mean error\n");
+    for row in family_rows(rows) {
+        out.push_str(&format!(
+            "\n{}, mean relative error per material row:\n",
+            row.setting
+        ));
+        for (family, cells) in &row.by_family {
+            out.push_str(&format!("{family:<15} {:>13} {:>12}", "", ""));
+            for (_, error, _) in cells {
+                out.push_str(&format!(" {:>6.2}%", error * 100.0));
+            }
+            out.push('\n');
         }
-        out.push('\n');
     }
     out
+}
+
+/// The rows whose error per material row the tables show: the first (the defaults) and every
+/// filtered-importance-sampling setting.
+fn family_rows(rows: &[IblSweepRow]) -> impl Iterator<Item = &IblSweepRow> {
+    rows.iter()
+        .enumerate()
+        .filter(|(i, r)| *i == 0 || r.settings.runtime_samples > 0)
+        .map(|(_, r)| r)
 }
 
 /// The IBL sweep's errors without times, rounded so that the text is stable: the insta
@@ -627,13 +673,15 @@ pub fn stable_ibl_table(rows: &[IblSweepRow]) -> String {
         }
         out.push_str(&format!(" {:>5.1}%\n", r.mean_relative * 100.0));
     }
-    out.push_str("\ndefault, per material row:\n");
-    for (family, cells) in &first.by_family {
-        out.push_str(&format!("{family:<15}"));
-        for (_, error, _) in cells {
-            out.push_str(&format!(" {:>5.1}%", error * 100.0));
+    for row in family_rows(rows) {
+        out.push_str(&format!("\n{}, per material row:\n", row.setting));
+        for (family, cells) in &row.by_family {
+            out.push_str(&format!("{family:<15}"));
+            for (_, error, _) in cells {
+                out.push_str(&format!(" {:>5.1}%", error * 100.0));
+            }
+            out.push('\n');
         }
-        out.push('\n');
     }
     out
 }

@@ -67,8 +67,13 @@ pub fn key(image: &EnvironmentImage, settings: &IblSettings) -> Key {
             hash.update(c.to_bits().to_le_bytes());
         }
     }
+    // The render-time sample count changes no map: maps are shared across it.
+    let maps_settings = IblSettings {
+        runtime_samples: 0,
+        ..settings.clone()
+    };
     hash.update(
-        serde_json::to_vec(settings).expect("IBL settings serialise"), // plain struct
+        serde_json::to_vec(&maps_settings).expect("IBL settings serialise"), // plain struct
     );
     hash.finalize().into()
 }
