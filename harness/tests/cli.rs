@@ -369,6 +369,37 @@ fn snapshot(dir: &Path) -> std::collections::BTreeMap<PathBuf, (Vec<u8>, std::ti
     out
 }
 
+/// Runs `harness bless ARGS` against the workspace copy at `root`; fails the test unless it
+/// succeeds. Returns its stdout.
+fn bless_in(root: &Path, args: &[&str]) -> String {
+    let output = common::harness_command()
+        .arg("bless")
+        .args(args)
+        .env("HARNESS_ROOT", root)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(
+        output.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    stdout
+}
+
+/// The files under `dir` that differ between two snapshots (new ones too), relative to `dir`.
+fn changed_files(
+    dir: &Path,
+    before: &std::collections::BTreeMap<PathBuf, (Vec<u8>, std::time::SystemTime)>,
+    after: &std::collections::BTreeMap<PathBuf, (Vec<u8>, std::time::SystemTime)>,
+) -> Vec<String> {
+    after
+        .iter()
+        .filter(|(path, state)| before.get(*path) != Some(*state))
+        .map(|(path, _)| path.strip_prefix(dir).unwrap().display().to_string())
+        .collect()
+}
+
 /// `bless --scene chess --pass final` rewrites that golden and chess's blessed.toml, and nothing
 /// else (run against a temporary copy of scenes/ and golden/ through HARNESS_ROOT).
 #[test]
@@ -380,17 +411,7 @@ fn bless_rewrites_only_the_named_golden() {
     let golden = root.path().join("golden");
     let before = snapshot(&golden);
     std::thread::sleep(std::time::Duration::from_millis(20));
-    let output = common::harness_command()
-        .args(["bless", "--scene", "chess", "--pass", "final"])
-        .env("HARNESS_ROOT", root.path())
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    assert!(
-        output.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    let stdout = bless_in(root.path(), &["--scene", "chess", "--pass", "final"]);
     assert!(
         stdout.contains("chess/final: within tolerance vs old golden"),
         "{stdout}"
@@ -400,12 +421,10 @@ fn bless_rewrites_only_the_named_golden() {
         before.keys().collect::<Vec<_>>(),
         after.keys().collect::<Vec<_>>()
     );
-    let changed: Vec<String> = after
-        .iter()
-        .filter(|(path, state)| before[*path] != **state)
-        .map(|(path, _)| path.strip_prefix(&golden).unwrap().display().to_string())
-        .collect();
-    assert_eq!(changed, ["chess/blessed.toml", "chess/final.png"]);
+    assert_eq!(
+        changed_files(&golden, &before, &after),
+        ["chess/blessed.toml", "chess/final.png"]
+    );
     let record = std::fs::read_to_string(golden.join("chess/blessed.toml")).unwrap();
     assert!(
         record.contains("[passes.final]") && record.contains("driver = "),
@@ -439,25 +458,10 @@ fn bless_after_a_light_change_rewrites_only_the_changed_passes() {
     let records_before = std::fs::read_to_string(golden.join("arrow/blessed.toml")).unwrap();
     let before = snapshot(&golden);
     std::thread::sleep(std::time::Duration::from_millis(20));
-    let output = common::harness_command()
-        .args(["bless", "--scene", "arrow"])
-        .env("HARNESS_ROOT", root.path())
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    assert!(
-        output.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    let stdout = bless_in(root.path(), &["--scene", "arrow"]);
     let after = snapshot(&golden);
-    let changed: Vec<String> = after
-        .iter()
-        .filter(|(path, state)| before.get(*path) != Some(*state))
-        .map(|(path, _)| path.strip_prefix(&golden).unwrap().display().to_string())
-        .collect();
     assert_eq!(
-        changed,
+        changed_files(&golden, &before, &after),
         ["arrow/blessed.toml", "arrow/final.png", "arrow/light.exr"],
         "{stdout}"
     );
@@ -497,12 +501,7 @@ fn bless_after_a_light_change_rewrites_only_the_changed_passes() {
 
     // A second bless finds nothing to rewrite.
     let again = snapshot(&golden);
-    let output = common::harness_command()
-        .args(["bless", "--scene", "arrow"])
-        .env("HARNESS_ROOT", root.path())
-        .output()
-        .unwrap();
-    assert!(output.status.success());
+    bless_in(root.path(), &["--scene", "arrow"]);
     assert_eq!(snapshot(&golden), again);
 
     // A copy of the scene given by path: check suggests blessing it by path, and that works.
