@@ -492,6 +492,21 @@ pub fn ibl_settings() -> Vec<(String, engine::ibl::IblSettings)> {
             "fis 256".to_owned(),
             IblSettings {
                 runtime_samples: 256,
+                ..d.clone()
+            },
+        ),
+        (
+            "sun".to_owned(),
+            IblSettings {
+                extract_sun: true,
+                ..d.clone()
+            },
+        ),
+        (
+            "sun + fis 64".to_owned(),
+            IblSettings {
+                extract_sun: true,
+                runtime_samples: 64,
                 ..d
             },
         ),
@@ -651,7 +666,7 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
 fn family_rows(rows: &[IblSweepRow]) -> impl Iterator<Item = &IblSweepRow> {
     rows.iter()
         .enumerate()
-        .filter(|(i, r)| *i == 0 || r.settings.runtime_samples > 0)
+        .filter(|(i, r)| *i == 0 || r.settings.runtime_samples > 0 || r.settings.extract_sun)
         .map(|(_, r)| r)
 }
 

@@ -20,6 +20,7 @@ pub mod cube;
 pub mod dfg;
 pub mod irradiance;
 pub mod specular;
+pub mod sun;
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -76,6 +77,9 @@ pub struct IblSettings {
     /// the roughness whose lobe covers the sample's solid angle (Krivanek and Colbert, "Real-time
     /// Shading with Filtered Importance Sampling", 2008). It changes no precomputed map.
     pub runtime_samples: u32,
+    /// Cut the environment's sun out of the maps and light it as a directional light instead
+    /// ([`sun`]).
+    pub extract_sun: bool,
 }
 
 impl Default for IblSettings {
@@ -88,6 +92,7 @@ impl Default for IblSettings {
             irradiance: IrradianceMethod::Convolution,
             seed: 0,
             runtime_samples: 0,
+            extract_sun: false,
         }
     }
 }
@@ -148,6 +153,10 @@ impl IblSettings {
             format!(", seed {}", self.seed)
         } else {
             String::new()
+        } + if self.extract_sun {
+            "; sun extracted into a directional light"
+        } else {
+            ""
         } + &if self.runtime_samples != 0 {
             format!(
                 "; specular by {} filtered importance samples per pixel",
@@ -172,6 +181,13 @@ pub struct IblMaps {
 
 /// Builds the maps (the whole precompute, no caches).
 pub fn build(image: &EnvironmentImage, settings: &IblSettings) -> IblMaps {
+    let residual;
+    let image = if settings.extract_sun {
+        residual = sun::without_sun(image);
+        &residual
+    } else {
+        image
+    };
     let base = cube::cube_from_equirect(image, settings.source_size);
     let source = CubeMap::with_mips(base, 1);
     IblMaps {

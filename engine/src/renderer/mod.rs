@@ -143,6 +143,8 @@ pub fn render_with_faults(
     readback: Readback<'_>,
     faults: &Faults,
 ) -> Result<Frame, RenderError> {
+    let with_sun = crate::ibl::sun::scene_with_sun(scene);
+    let scene = with_sun.as_ref().unwrap_or(scene);
     validate(scene)?;
     let mut plan = RenderPlan::new(scene);
     if let Some(feature) = faults.remove_lighting {
