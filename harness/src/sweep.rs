@@ -535,11 +535,21 @@ pub fn ibl_sweep(
     let mut backend = backend::create(kind).map_err(|e| SweepError::Render(e.to_string()))?;
     let mut rows = Vec::new();
     let mut references = None;
+    let mut built: Vec<(engine::ibl::cache::Key, f64)> = Vec::new();
     for (name, settings) in ibl_settings() {
         progress(&format!("precompute {name}"));
         engine::ibl::dfg_table();
-        // Timed, and kept in memory for the render below.
-        let (_, precompute_s) = engine::ibl::build_timed(&environment.image, &settings);
+        // Timed, and kept in memory for the render below. Settings that change only the
+        // render (the runtime samples) share an earlier setting's maps and its time.
+        let key = engine::ibl::cache::key_of_shared(&environment.image, &settings);
+        let precompute_s = match built.iter().find(|(k, _)| *k == key) {
+            Some(&(_, seconds)) => seconds,
+            None => {
+                let (_, seconds) = engine::ibl::build_timed(&environment.image, &settings);
+                built.push((key, seconds));
+                seconds
+            }
+        };
         let mut variant = scene.clone();
         variant.quality.ibl = settings.clone();
         let mut frames = Vec::new();
