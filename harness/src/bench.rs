@@ -987,12 +987,6 @@ pub const BENCH_JSON: &str = "bench.json";
 /// File name of `harness bench --series`'s results in the output folder.
 pub const SERIES_JSON: &str = "bench_series.json";
 
-fn escape(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-}
-
 /// A small SVG line chart of a series' pass time against its value (log2 x axis).
 pub fn series_svg(points: &[SeriesPoint]) -> String {
     let (w, h, left, bottom, top, right) = (380.0, 200.0, 50.0, 30.0, 20.0, 35.0);
@@ -1007,8 +1001,8 @@ pub fn series_svg(points: &[SeriesPoint]) -> String {
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
          style=\"background:#fff;border:1px solid #ccc\">\
          <text x=\"{left}\" y=\"14\" font-size=\"12\">{} ms against {}</text>",
-        escape(&first.pass),
-        escape(&first.series)
+        crate::html::escape(&first.pass),
+        crate::html::escape(&first.series)
     );
     if data.is_empty() {
         svg.push_str("<text x=\"60\" y=\"100\" font-size=\"12\">no timestamps</text></svg>");
@@ -1071,12 +1065,12 @@ pub fn report_sections(dir: &std::path::Path) -> String {
                 .map_or("-".to_owned(), |x| format!("{x:.digits$}"))
         };
         for b in &benches {
-            let scene = escape(b["scene"].as_str().unwrap_or("?"));
-            let backend = escape(b["backend"].as_str().unwrap_or("?"));
+            let scene = crate::html::escape(b["scene"].as_str().unwrap_or("?"));
+            let backend = crate::html::escape(b["backend"].as_str().unwrap_or("?"));
             for p in b["passes"].as_array().into_iter().flatten() {
                 out.push_str(&format!(
                     "<tr><td>{scene}</td><td>{backend}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                    escape(p["pass"].as_str().unwrap_or("?")),
+                    crate::html::escape(p["pass"].as_str().unwrap_or("?")),
                     cell(&p["median_ms"], 2),
                     cell(&p["floor_ms"], 2),
                     cell(&p["ratio"], 1)
@@ -1103,7 +1097,7 @@ pub fn report_sections(dir: &std::path::Path) -> String {
             out.push_str(&format!(
                 "<figure>{}<figcaption>{}</figcaption></figure>",
                 series_svg(&points),
-                escape(s["backend"].as_str().unwrap_or("?"))
+                crate::html::escape(s["backend"].as_str().unwrap_or("?"))
             ));
         }
     }

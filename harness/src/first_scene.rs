@@ -2,9 +2,7 @@
 //! is compared with the first available backend under the foundation's tolerances.
 
 use engine::backend::{self, BackendKind, BackendStatus};
-use engine::image::Image;
 use engine::lit_cube::{self, LitCubeImages};
-use image::ImageEncoder;
 
 use crate::compare::{relative_difference, u8_difference, RelativeDifference, U8Difference};
 
@@ -81,21 +79,4 @@ pub fn agreement(
 /// Probes every backend.
 pub fn probe_all() -> Vec<BackendStatus> {
     BackendKind::ALL.into_iter().map(backend::probe).collect()
-}
-
-/// Encodes an 8-bit RGBA image as PNG bytes.
-pub fn png_bytes(image: &Image) -> Result<Vec<u8>, image::ImageError> {
-    let data = image.as_u8().ok_or_else(|| {
-        image::ImageError::Parameter(image::error::ParameterError::from_kind(
-            image::error::ParameterErrorKind::Generic("PNG output needs an 8-bit image".to_owned()),
-        ))
-    })?;
-    let mut out = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut out).write_image(
-        data,
-        image.width,
-        image.height,
-        image::ExtendedColorType::Rgba8,
-    )?;
-    Ok(out)
 }

@@ -338,7 +338,7 @@ pub fn report_section(dir: &std::path::Path) -> String {
          <table><tr><th>case</th><th>backend</th><th>NaN/Inf</th><th>light max</th>\
          <th>check</th><th>value</th><th>bound</th><th></th></tr>",
     );
-    let escape = |t: &str| t.replace('&', "&amp;").replace('<', "&lt;");
+    let escape = crate::html::escape;
     for r in rows {
         let passed = r["passed"].as_bool().unwrap_or(false);
         out.push_str(&format!(

@@ -7,6 +7,7 @@ pub mod compare;
 pub mod first_scene;
 pub mod golden;
 pub mod hard_cases;
+pub mod html;
 pub mod ibl_reference;
 pub mod images;
 pub mod inspect;

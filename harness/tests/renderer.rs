@@ -17,8 +17,8 @@ fn render(backend: &mut dyn Backend, scene: &Scene) -> Frame {
 fn save(name: &str, image: &Image) {
     let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("renderer");
     std::fs::create_dir_all(&out).unwrap();
-    let png = harness::first_scene::png_bytes(image).unwrap();
-    std::fs::write(out.join(format!("{name}.png")), png).unwrap();
+    let path = out.join(format!("{name}.png"));
+    harness::images::write_image(image, &path, harness::images::PngCompression::Fast).unwrap();
 }
 
 /// Issue 3: the lighting pass against the f64 reference on the same G-buffer, 99.9th-percentile

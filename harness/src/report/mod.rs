@@ -35,12 +35,7 @@ const STYLE: &str = include_str!("review.css");
 /// The viewers, filter and copy buttons.
 const SCRIPT: &str = include_str!("review.js");
 
-fn escape(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
+use crate::html::escape;
 
 /// An 8-bit thumbnail of a pass output: HDR values Reinhard-mapped, depth stretched over its
 /// range, 8-bit images as they are; box-downscaled to at most [`PREVIEW`] pixels.
