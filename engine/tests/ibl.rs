@@ -290,3 +290,37 @@ fn prepare_uses_memory_then_disk() {
     assert_eq!(*fifth, *first);
     ibl::cache::set_directory(None);
 }
+
+/// With `extract_sun`, the maps carry the sun they were built without (and the cache keeps it):
+/// the sun's flux is in `maps.sun`, not in the irradiance map.
+#[test]
+fn an_extracted_sun_travels_with_the_maps_and_through_the_cache() {
+    let mut image = uniform(0.5);
+    for (x, y) in [(40, 10), (41, 10), (40, 11), (41, 11)] {
+        image.texels[y * 64 + x] = [2e4, 2e4, 2e4, 1.0];
+    }
+    let settings = IblSettings {
+        source_size: 32,
+        specular_size: 16,
+        specular_samples: 16,
+        irradiance_size: 8,
+        extract_sun: true,
+        ..IblSettings::default()
+    };
+    let maps = ibl::build(&image, &settings);
+    let sun = maps.sun.clone().expect("the sun was extracted");
+    assert_eq!(sun.texels, 4);
+    // Without the sun the environment is uniform 0.5 again, and so is the irradiance map.
+    assert!((max_of(&maps.irradiance) - 0.5).abs() < 1e-3);
+    let kept = ibl::build(
+        &image,
+        &IblSettings {
+            extract_sun: false,
+            ..settings.clone()
+        },
+    );
+    assert!(kept.sun.is_none() && max_of(&kept.irradiance) > 1.0);
+    let key = ibl::cache::key(&image, &settings);
+    let decoded = ibl::cache::decode(&key, &ibl::cache::encode(&key, &maps)).unwrap();
+    assert_eq!(decoded, maps);
+}

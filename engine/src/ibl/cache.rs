@@ -18,7 +18,7 @@ use super::{CubeLevel, CubeMap, IblMaps, IblSettings};
 use crate::scene::EnvironmentImage;
 
 /// Bump when the maps an entry holds would change for the same key (algorithm or layout).
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 const MAGIC: &[u8; 8] = b"IBLMAPS\0";
 
@@ -148,6 +148,18 @@ pub fn encode(key: &Key, maps: &IblMaps) -> Vec<u8> {
         payload.extend_from_slice(&t[0].to_le_bytes());
         payload.extend_from_slice(&t[1].to_le_bytes());
     }
+    // The extracted sun: a texel count (0: none), then direction, irradiance and solid angle.
+    match &maps.sun {
+        None => payload.extend_from_slice(&0u32.to_le_bytes()),
+        Some(sun) => {
+            payload.extend_from_slice(&(sun.texels as u32).to_le_bytes());
+            let d = sun.direction;
+            let [r, g, b] = sun.irradiance;
+            for v in [d.x, d.y, d.z, r, g, b, sun.solid_angle] {
+                payload.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+    }
     let mut out = Vec::with_capacity(payload.len() + 84);
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
@@ -235,16 +247,29 @@ pub fn decode(key: &Key, bytes: &[u8]) -> Result<IblMaps, String> {
     };
     let irradiance = p.level()?;
     let dfg_len = p.u32()? as usize;
-    if p.0.len() != dfg_len * 8 {
+    if p.0.len() < dfg_len * 8 {
         return Err("bad DFG table length".into());
     }
     let dfg = (0..dfg_len)
         .map(|_| Ok([p.f32()?, p.f32()?]))
         .collect::<Result<_, String>>()?;
+    let sun = match p.u32()? as usize {
+        0 => None,
+        texels => Some(super::sun::Sun {
+            direction: glam::Vec3::new(p.f32()?, p.f32()?, p.f32()?),
+            irradiance: [p.f32()?, p.f32()?, p.f32()?],
+            solid_angle: p.f32()?,
+            texels,
+        }),
+    };
+    if !p.0.is_empty() {
+        return Err("trailing bytes in the payload".into());
+    }
     Ok(IblMaps {
         specular,
         irradiance,
         dfg,
+        sun,
     })
 }
 

@@ -177,23 +177,24 @@ pub struct IblMaps {
     pub irradiance: CubeLevel,
     /// DFG table (`scale`, `bias`), [`dfg::SIZE`] square, `NoV` across, roughness down.
     pub dfg: Vec<[f32; 2]>,
+    /// With `extract_sun`: the sun cut out of the maps, to be lit as a directional light.
+    pub sun: Option<sun::Sun>,
 }
 
 /// Builds the maps (the whole precompute, no caches).
 pub fn build(image: &EnvironmentImage, settings: &IblSettings) -> IblMaps {
-    let residual;
-    let image = if settings.extract_sun {
-        residual = sun::without_sun(image);
-        &residual
+    let (residual, sun) = if settings.extract_sun {
+        sun::extract(image).map_or((None, None), |(residual, sun)| (Some(residual), Some(sun)))
     } else {
-        image
+        (None, None)
     };
-    let base = cube::cube_from_equirect(image, settings.source_size);
+    let base = cube::cube_from_equirect(residual.as_ref().unwrap_or(image), settings.source_size);
     let source = CubeMap::with_mips(base, 1);
     IblMaps {
         specular: specular::prefilter(&source, settings),
         irradiance: irradiance::irradiance(&source, settings.irradiance_size, settings.irradiance),
         dfg: dfg_table().as_ref().clone(),
+        sun,
     }
 }
 

@@ -13,6 +13,7 @@
 
 use glam::{DVec3, Vec3};
 
+use super::IblMaps;
 use crate::scene::{Environment, EnvironmentImage, Light, Scene};
 
 /// An extracted sun, in the environment image's frame (before the environment's rotation).
@@ -129,10 +130,12 @@ fn sun_region(image: &EnvironmentImage) -> Option<(Vec<usize>, [f32; 3])> {
     Some((region, sky))
 }
 
-/// The image's sun, if it has one (see the module documentation).
-pub fn find(image: &EnvironmentImage) -> Option<Sun> {
+/// The image's sun, if it has one (see the module documentation), and the image without it:
+/// its texels replaced by the sky around it.
+pub fn extract(image: &EnvironmentImage) -> Option<(EnvironmentImage, Sun)> {
     let (region, sky) = sun_region(image)?;
     let (w, h) = (image.width, image.height);
+    let mut residual = image.clone();
     let mut irradiance = [0.0f64; 3];
     let mut weighted = DVec3::ZERO;
     let mut solid_angle = 0.0;
@@ -148,31 +151,20 @@ pub fn find(image: &EnvironmentImage) -> Option<Sun> {
         }
         weighted += texel_direction(x, y, w, h) * excess;
         solid_angle += omega;
+        residual.texels[i] = [sky[0], sky[1], sky[2], t[3]];
     }
-    Some(Sun {
+    let sun = Sun {
         direction: weighted.normalize_or_zero().as_vec3(),
         irradiance: irradiance.map(|e| e as f32),
         solid_angle: solid_angle as f32,
         texels: region.len(),
-    })
+    };
+    Some((residual, sun))
 }
 
-/// The image with its sun's texels replaced by the sky around it (the image itself when it has
-/// no sun).
-pub fn without_sun(image: &EnvironmentImage) -> EnvironmentImage {
-    let mut residual = image.clone();
-    if let Some((region, sky)) = sun_region(image) {
-        for i in region {
-            residual.texels[i] = [sky[0], sky[1], sky[2], image.texels[i][3]];
-        }
-    }
-    residual
-}
-
-/// The directional light that stands for the environment's sun in the world (the environment's
-/// rotation and intensity applied), if it has one.
-pub fn light(environment: &Environment) -> Option<Light> {
-    let sun = find(&environment.image)?;
+/// The directional light that stands for `sun` in the world (the environment's rotation and
+/// intensity applied).
+pub fn light(environment: &Environment, sun: &Sun) -> Option<Light> {
     let r = environment.rotation_degrees.to_radians();
     let (c, s) = (r.cos(), r.sin());
     // The inverse of the lighting pass's environment_direction (a rotation about +Y).
@@ -190,14 +182,11 @@ pub fn light(environment: &Environment) -> Option<Light> {
     })
 }
 
-/// The scene as the renderer draws it: with `[quality.ibl] extract_sun`, its environment's sun
-/// added as a directional light (the maps are built without it); otherwise `None`, the scene as
-/// it is.
-pub fn scene_with_sun(scene: &Scene) -> Option<Scene> {
-    if !scene.quality.ibl.extract_sun {
-        return None;
-    }
-    let light = light(scene.environment.as_ref()?)?;
+/// The scene as the renderer draws it: with the sun that `maps` (built with `extract_sun`) cut
+/// out of the environment added as a directional light; `None` when there is none, the scene
+/// as it is.
+pub fn scene_with_sun(scene: &Scene, maps: Option<&IblMaps>) -> Option<Scene> {
+    let light = light(scene.environment.as_ref()?, maps?.sun.as_ref()?)?;
     let mut with_sun = scene.clone();
     with_sun.lights.push(light);
     Some(with_sun)
@@ -226,7 +215,7 @@ mod tests {
     #[test]
     fn a_sun_carries_its_excess_flux_towards_its_texels() {
         let image = sky_with_sun(Some((40, 10, 1e4)));
-        let sun = find(&image).expect("a sun");
+        let (residual, sun) = extract(&image).expect("a sun");
         assert_eq!(sun.texels, 4);
         // Excess radiance over the sky, times the four texels' solid angle.
         let omega: f64 = [10, 11]
@@ -241,16 +230,11 @@ mod tests {
             (u * 64.0 - 41.0).abs() < 0.05 && (v * 32.0 - 11.0).abs() < 0.05,
             "{u} {v}"
         );
-        let residual = without_sun(&image);
         assert!(residual.texels.iter().all(|t| t[0] < 1.0));
     }
 
     #[test]
     fn an_even_sky_has_no_sun() {
-        assert_eq!(find(&sky_with_sun(None)), None);
-        assert_eq!(
-            without_sun(&sky_with_sun(None)).texels,
-            sky_with_sun(None).texels
-        );
+        assert!(extract(&sky_with_sun(None)).is_none());
     }
 }

@@ -143,9 +143,14 @@ pub fn render_with_faults(
     readback: Readback<'_>,
     faults: &Faults,
 ) -> Result<Frame, RenderError> {
-    let with_sun = crate::ibl::sun::scene_with_sun(scene);
-    let scene = with_sun.as_ref().unwrap_or(scene);
     validate(scene)?;
+    let ibl_maps = scene
+        .environment
+        .as_ref()
+        .map(|environment| crate::ibl::prepare(&environment.image, &scene.quality.ibl).0);
+    // With `extract_sun`, the maps lack the environment's sun: it is lit as a light instead.
+    let with_sun = crate::ibl::sun::scene_with_sun(scene, ibl_maps.as_deref());
+    let scene = with_sun.as_ref().unwrap_or(scene);
     let mut plan = RenderPlan::new(scene);
     if let Some(feature) = faults.remove_lighting {
         plan.remove_lighting_feature(feature, scene);
@@ -169,10 +174,6 @@ pub fn render_with_faults(
             names.iter().map(|s| (*s).to_owned()).collect()
         }
     };
-    let ibl_maps = scene
-        .environment
-        .as_ref()
-        .map(|environment| crate::ibl::prepare(&environment.image, &scene.quality.ibl).0);
     let mut scope = ResourceScope::default();
     let result = record_and_submit(
         backend,
