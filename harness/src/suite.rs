@@ -276,7 +276,6 @@ impl Case {
     }
 }
 
-/// Every canonical scene (the `.toml` files directly in `scenes/`).
 /// A canonical scene that did not load: one failed case of the run, which goes on with the
 /// others.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
@@ -311,7 +310,8 @@ pub fn load_suite(names: &[String]) -> Result<(Vec<Case>, Vec<BrokenScene>), Sui
     Ok((cases, broken))
 }
 
-/// Every canonical scene, or the first error (for callers that need them all).
+/// Every canonical scene (the `.toml` files directly in `scenes/`), or the first error (for
+/// callers that need them all).
 pub fn canonical_cases() -> Result<Vec<Case>, SuiteError> {
     let model = NoiseModel::load(&GoldenStore::workspace())?;
     engine::scene_file::canonical_scenes(&crate::scenes_dir())

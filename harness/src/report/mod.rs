@@ -152,43 +152,44 @@ fn pixel_bytes(image: &Image, like: &Image) -> (&'static str, Vec<u8>) {
 
 /// Pixel data embedded once each at the end of the page, zlib-compressed and base64-encoded in
 /// `<script type="application/octet-stream" id="blob-N">` elements; identical data (backends
-/// that render the same pixels) is embedded once.
+/// that render the same pixels) is embedded once, and compressed once.
 #[derive(Default)]
-struct Blobs(Vec<String>);
+struct Blobs {
+    /// Encoded blobs, in page order.
+    encoded: Vec<String>,
+    /// Hash and length of each blob's raw bytes, to find repeats before compressing.
+    raw: Vec<(u64, usize)>,
+}
 
 impl Blobs {
     fn add(&mut self, bytes: &[u8]) -> usize {
-        let index = self.encode(bytes);
-        let last = self.0.len() - 1;
-        match self.0[..last].iter().position(|b| *b == self.0[last]) {
-            Some(same) => {
-                self.0.pop();
-                same
-            }
-            None => index,
+        use std::hash::{Hash as _, Hasher as _};
+        let mut hasher = std::collections::hash_map::DefaultHasher::new();
+        bytes.hash(&mut hasher);
+        let id = (hasher.finish(), bytes.len());
+        if let Some(same) = self.raw.iter().position(|r| *r == id) {
+            return same;
         }
-    }
-
-    /// Base64 bytes embedded so far.
-    fn bytes(&self) -> usize {
-        self.0.iter().map(String::len).sum()
-    }
-
-    fn encode(&mut self, bytes: &[u8]) -> usize {
         use std::io::Write as _;
         let mut encoder =
             flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
         // Writing to a Vec cannot fail.
         let _ = encoder.write_all(bytes);
         let compressed = encoder.finish().unwrap_or_default();
-        self.0
+        self.encoded
             .push(base64::engine::general_purpose::STANDARD.encode(compressed));
-        self.0.len() - 1
+        self.raw.push(id);
+        self.encoded.len() - 1
+    }
+
+    /// Base64 bytes embedded so far.
+    fn bytes(&self) -> usize {
+        self.encoded.iter().map(String::len).sum()
     }
 
     fn html(&self) -> String {
         let mut out = String::new();
-        for (i, blob) in self.0.iter().enumerate() {
+        for (i, blob) in self.encoded.iter().enumerate() {
             let _ = writeln!(
                 out,
                 "<script type=\"application/octet-stream\" id=\"blob-{i}\">{blob}</script>"

@@ -75,7 +75,6 @@
       this.floor = d.floor === '' ? null : Number(d.floor);
       this.counted = d.rgb === '1' ? Math.min(3, this.channels) : this.channels;
       this.exposure = 0;
-      this.zoom = 1;
     }
 
     async load() {
@@ -91,6 +90,7 @@
         this.depthRange = [lo, Math.max(hi - lo, 1e-9)];
       }
       this.build();
+      this.drawDiff();
       this.draw();
     }
 
@@ -122,7 +122,8 @@
       return worst / this.threshold;
     }
 
-    paint(canvas, data) {
+    // The display image of `data` at the current exposure, put into each of `canvases`.
+    paint(canvases, data) {
       const image = new ImageData(this.width, this.height);
       const n = this.width * this.height;
       for (let p = 0; p < n; p++) {
@@ -132,12 +133,17 @@
         }
         image.data[4 * p + 3] = 255;
       }
-      canvas.getContext('2d').putImageData(image, 0, 0);
+      for (const canvas of canvases) canvas.getContext('2d').putImageData(image, 0, 0);
     }
 
+    // Golden and actual, redrawn when the exposure changes.
     draw() {
-      for (const c of this.canvases.golden) this.paint(c, this.golden);
-      for (const c of this.canvases.actual) this.paint(c, this.actual);
+      this.paint(this.canvases.golden, this.golden);
+      this.paint(this.canvases.actual, this.actual);
+    }
+
+    // The false-colour difference, which the exposure does not change: drawn once.
+    drawDiff() {
       const diff = new ImageData(this.width, this.height);
       const n = this.width * this.height;
       for (let p = 0; p < n; p++) {
@@ -244,7 +250,6 @@
     }
 
     setZoom(zoom) {
-      this.zoom = zoom;
       for (const c of this.canvases.all) {
         c.style.width = this.width * zoom + 'px';
         c.style.height = this.height * zoom + 'px';
@@ -252,7 +257,6 @@
     }
 
     setSwipe(percent) {
-      this.swipe = percent;
       this.swipeActual.style.clipPath = 'inset(0 0 0 ' + percent + '%)';
     }
 
