@@ -33,6 +33,9 @@ override VOGEL_SAMPLES: u32 = 0u;
 override LIGHT_COUNT: u32 = 0u;
 override DIRECTIONAL_LIGHTS: bool = true;
 override POINT_LIGHTS: bool = true;
+// Whether a directional light of the draw is a disc (an extracted sun; params.yz = sine and
+// cosine of its angular radius): the PBR model widens its highlight to the disc.
+override SUN_DISC: bool = false;
 // Image-based lighting in this draw (the first draw of a scene with an environment).
 override IBL: bool = false;
 // Filtered importance samples of the PBR specular IBL per pixel; 0: the split sum.
@@ -64,7 +67,8 @@ struct LightData {
     position: vec4<f32>,
     // rgb = color * intensity * exposure, a = radius (point lights).
     color: vec4<f32>,
-    // x = 1 / falloff (point lights).
+    // x = 1 / falloff (point lights); y, z = sine and cosine of a directional light's disc
+    // radius (0 and 0 for a point at infinity).
     params: vec4<f32>,
 }
 
@@ -488,6 +492,33 @@ fn v_smith_ggx_correlated_anisotropic(
 }
 
 fn pbr_brdf_times_cosine(s: Surface, v: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
+    return pbr_brdf_scaled(s, v, l, 1.0, 1.0);
+}
+
+// The PBR BRDF times N.L towards a directional light's disc of angular radius (sine, cosine)
+// = disc: the specular lobes are evaluated towards the point of the disc closest to the
+// reflection vector and scaled by (alpha / alpha')^2 with alpha' = alpha + sin(radius) / 2, the
+// representative point and the sphere-light normalisation of Karis, "Real Shading in Unreal
+// Engine 4" (SIGGRAPH 2013 course), for a disc at infinity (a half-vector moves half the angle
+// its light direction does). Diffuse uses the same point, within the disc's radius of its
+// centre (a sun's is about a degree).
+fn pbr_disc_times_cosine(s: Surface, v: vec3<f32>, l: vec3<f32>, disc: vec2<f32>) -> vec3<f32> {
+    let r = reflect(-v, s.normal);
+    let r_dot_l = dot(r, l);
+    let edge = l * disc.y + safe_normalize(r - r_dot_l * l, l) * disc.x;
+    let towards = normalize(select(edge, r, r_dot_l >= disc.y));
+    let alpha = s.roughness * s.roughness + 0.001;
+    let base = alpha / min(alpha + 0.5 * disc.x, 1.0);
+    let clearcoat_alpha = s.clearcoat_roughness * s.clearcoat_roughness + 0.001;
+    let clearcoat = clearcoat_alpha / min(clearcoat_alpha + 0.5 * disc.x, 1.0);
+    return pbr_brdf_scaled(s, v, towards, base * base, clearcoat * clearcoat);
+}
+
+// The PBR BRDF times N.L, its base specular lobe scaled by specular_scale and its clearcoat lobe
+// by clearcoat_scale (1 and 1: the BRDF itself).
+fn pbr_brdf_scaled(
+    s: Surface, v: vec3<f32>, l: vec3<f32>, specular_scale: f32, clearcoat_scale: f32,
+) -> vec3<f32> {
     let n = s.normal;
     let n_dot_l = clamp(dot(n, l), 0.0, 1.0);
     if n_dot_l <= 0.0 {
@@ -516,7 +547,7 @@ fn pbr_brdf_times_cosine(s: Surface, v: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
         d = d_ggx(n, h, n_dot_h, alpha);
         vis = v_smith_ggx_correlated(n_dot_v, n_dot_l, alpha);
     }
-    let specular = fresnel * (d * vis);
+    let specular = fresnel * (d * vis * specular_scale);
     let k_d = (vec3<f32>(1.0) - fresnel) * (1.0 - s.metallic);
     let diffuse = s.base_color * k_d * (1.0 / PI);
     if !CLEARCOAT {
@@ -527,7 +558,7 @@ fn pbr_brdf_times_cosine(s: Surface, v: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
     let clearcoat_fresnel = (0.04 + 0.96 * pow5(1.0 - l_dot_h)) * s.clearcoat;
     let clearcoat_d = d_ggx(n, h, n_dot_h, clearcoat_alpha);
     let clearcoat_v = 0.25 / max(l_dot_h * l_dot_h, 1e-4);
-    let clearcoat = clearcoat_d * clearcoat_v * clearcoat_fresnel;
+    let clearcoat = clearcoat_d * clearcoat_v * clearcoat_fresnel * clearcoat_scale;
 
     return ((diffuse + specular) * (1.0 - clearcoat_fresnel) + vec3<f32>(clearcoat)) * n_dot_l;
 }
@@ -739,8 +770,14 @@ fn shade(model: u32, pixel: vec2<i32>) -> vec4<f32> {
     }
     for (var i = 0u; i < min(LIGHT_COUNT, MAX_LIGHTS); i++) {
         let light = incoming(u.lights[i], s);
-        radiance += brdf_times_cosine(model, s, v, light.direction) * light.radiance
-            * visibility(i, s, light.direction, u.lights[i]);
+        var brdf: vec3<f32>;
+        if SUN_DISC && model == MODEL_PBR && u.lights[i].position.w < 0.5
+            && u.lights[i].params.y > 0.0 {
+            brdf = pbr_disc_times_cosine(s, v, light.direction, u.lights[i].params.yz);
+        } else {
+            brdf = brdf_times_cosine(model, s, v, light.direction);
+        }
+        radiance += brdf * light.radiance * visibility(i, s, light.direction, u.lights[i]);
     }
     if KEEP_INPUTS {
         radiance += input_floor(model, pixel).rgb * u.ambient.w;

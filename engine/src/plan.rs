@@ -537,6 +537,9 @@ pub struct LightingVariant {
     pub directional: bool,
     /// Whether any of them is a point light (`POINT_LIGHTS`).
     pub point: bool,
+    /// Whether any of them is a directional light with a disc (an extracted sun), whose
+    /// specular the PBR model widens to the disc (`SUN_DISC`).
+    pub sun_disc: bool,
     /// The shadowed light in slot 0, its kind and filter (`SHADOW_KIND`, `SHADOW_FILTER`).
     pub shadow: Option<(ShadowKind, ShadowFilter)>,
     /// Samples of the Vogel-disk filters (`VOGEL_SAMPLES`; 0 for the other filters).
@@ -590,6 +593,7 @@ impl LightingVariant {
             ("LIGHT_COUNT", f64::from(self.lights)),
             ("DIRECTIONAL_LIGHTS", flag(self.directional)),
             ("POINT_LIGHTS", flag(self.point)),
+            ("SUN_DISC", flag(self.sun_disc)),
             ("IBL", flag(self.ibl)),
             ("IBL_SAMPLES", f64::from(self.ibl_samples)),
             ("CLEARCOAT", flag(self.clearcoat)),
@@ -629,6 +633,7 @@ impl fmt::Display for LightingVariant {
             write!(f, ", ibl ({} samples)", self.ibl_samples)?;
         }
         for (on, name) in [
+            (self.sun_disc, "sun disc"),
             (self.ibl && self.ibl_samples == 0, "ibl"),
             (self.clearcoat, "clearcoat"),
             (self.anisotropy, "anisotropy"),
@@ -810,6 +815,7 @@ fn lighting_passes(
                 lights: 0,
                 directional: false,
                 point: false,
+                sun_disc: false,
                 shadow: None,
                 vogel_samples: 0,
                 ibl: false,
@@ -848,6 +854,8 @@ fn lighting_passes(
                             },
                         };
                         draw.specialise(scene);
+                        // Only the PBR model widens its highlight to a disc.
+                        draw.variant.sun_disc &= pbr;
                         draw
                     })
                     .collect()
@@ -874,6 +882,9 @@ impl LightingDraw {
             .lights
             .iter()
             .any(|&i| matches!(light(i), Light::Point { .. }));
+        self.variant.sun_disc = self.lights.iter().any(|&i| {
+            matches!(light(i), Light::Directional { angular_radius, .. } if *angular_radius > 0.0)
+        });
         let settings = self.shadowed.and_then(|i| match light(i) {
             Light::Directional { shadow, .. } => shadow.map(|s| (ShadowKind::Directional, s)),
             Light::Point { shadow, .. } => shadow.map(|s| (ShadowKind::Point, s)),

@@ -395,6 +395,10 @@ pub enum Light {
         color: [f32; 3],
         /// Intensity multiplier.
         intensity: f32,
+        /// Angular radius of the light's disc in radians (0: a point at infinity). A disc widens
+        /// and dims the specular highlight it makes on smooth surfaces; `intensity` stays the
+        /// irradiance it gives a surface facing it.
+        angular_radius: f32,
         /// Shadow map, if it casts shadows.
         shadow: Option<ShadowSettings>,
     },

@@ -755,6 +755,7 @@ impl Resolver {
                     direction: DVec3::from(l.direction),
                     color: l.color.unwrap_or([1.0; 3]),
                     intensity: l.intensity.unwrap_or(1.0),
+                    angular_radius: 0.0,
                     shadow: shadow(&l.shadow),
                 },
                 LightSpec::Point(l) => Light::Point {

@@ -53,6 +53,7 @@ fn uniform_environment_gives_uniform_maps() {
             seed: 0,
             runtime_samples: 0,
             extract_sun: false,
+            sun_shadow: true,
         };
         let maps = ibl::build(&uniform(1.0), &settings);
         for (m, level) in maps.specular.levels.iter().enumerate() {

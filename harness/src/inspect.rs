@@ -134,10 +134,12 @@ pub fn inspect(path: &Path) -> Result<Value, InspectError> {
                         direction,
                         color,
                         intensity,
+                        angular_radius,
                         shadow,
                     } => json!({
                         "type": "directional", "direction": direction.to_array(), "color": color,
-                        "intensity": intensity, "shadow_map": shadow.map(|s| s.map_size),
+                        "intensity": intensity, "angular_radius": angular_radius,
+                        "shadow_map": shadow.map(|s| s.map_size),
                     }),
                     Light::Point {
                         position,

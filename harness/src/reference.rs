@@ -57,7 +57,9 @@ pub enum RefLight {
 
 /// The scene's lights for the reference, derived here from the scene in f64 (exposure applied,
 /// positions relative to the camera), sharing no code with the renderer's uniform packing: a
-/// wrong intensity, direction or falloff there shows up as a reference failure.
+/// wrong intensity, direction or falloff there shows up as a reference failure. Directional
+/// lights are points at infinity: a disc's angular radius (only an extracted sun has one) is
+/// not modelled here.
 pub fn reference_lights(scene: &Scene) -> Vec<RefLight> {
     let exposure = f64::from(scene.quality.exposure);
     let radiance = |color: &[f32; 3], intensity: f32| {

@@ -123,6 +123,7 @@ pub fn material_grid(size: u32) -> Scene {
             direction: DVec3::new(-0.4, 0.6, 0.7),
             color: [1.0, 0.95, 0.9],
             intensity: 3.0,
+            angular_radius: 0.0,
             shadow: None,
         },
         Light::Point {
@@ -221,6 +222,7 @@ pub fn five_models(size: u32) -> Scene {
         direction: DVec3::new(0.3, 1.0, 0.5),
         color: [1.0; 3],
         intensity: 3.0,
+        angular_radius: 0.0,
         shadow: None,
     });
     scene.ambient = [0.05; 3];

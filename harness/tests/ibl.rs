@@ -3,8 +3,12 @@
 
 mod common;
 
+use std::sync::Arc;
+
 use engine::renderer::{self, Frame, Readback};
-use engine::scene::{LightingModel, Material, Scene};
+use engine::scene::{
+    Environment, EnvironmentImage, LightingModel, Material, Object, Scene, Transform,
+};
 use engine::Backend;
 use harness::test_scenes;
 
@@ -139,4 +143,192 @@ fn sample_seeds_give_the_same_picture() {
         errors.last().unwrap()
     );
     assert!(p99 <= 0.02, "{kind}: p99 {p99}");
+}
+
+/// A sky of radiance 0.05 with a round sun of `radius_degrees` around `towards` (renderer's
+/// equirectangular convention: u = 0.5 + atan2(x, -z) / 2 pi, v = acos(y) / pi).
+fn sky_with_sun(towards: glam::DVec3, radius_degrees: f64, radiance: f32) -> Environment {
+    let (width, height) = (512u32, 256u32);
+    let towards = towards.normalize();
+    let cos_radius = radius_degrees.to_radians().cos();
+    let mut texels = Vec::with_capacity((width * height) as usize);
+    for y in 0..height {
+        for x in 0..width {
+            let phi = ((f64::from(x) + 0.5) / f64::from(width) - 0.5) * std::f64::consts::TAU;
+            let theta = (f64::from(y) + 0.5) / f64::from(height) * std::f64::consts::PI;
+            let d = glam::DVec3::new(
+                theta.sin() * phi.sin(),
+                theta.cos(),
+                -theta.sin() * phi.cos(),
+            );
+            let value = if d.dot(towards) >= cos_radius {
+                radiance
+            } else {
+                0.05
+            };
+            texels.push([value, value, value, 1.0]);
+        }
+    }
+    Environment {
+        image: Arc::new(EnvironmentImage {
+            label: "sky with a sun".to_owned(),
+            width,
+            height,
+            texels,
+        }),
+        rotation_degrees: 0.0,
+        intensity: 1.0,
+    }
+}
+
+/// The extracted sun casts a shadow: a white floor under a sphere, the sun nearly overhead. The
+/// floor where the sphere hides the sun (found by ray casting from its G-buffer position) is
+/// under a tenth as bright as the open floor; with `sun_shadow = false` it is as bright.
+#[test]
+fn extracted_sun_casts_a_shadow() {
+    let sun = glam::DVec3::new(0.0, 1.0, 0.15).normalize();
+    let mut scene = test_scenes::ibl_furnace(
+        128,
+        Material {
+            base_color: [0.8; 3],
+            ..Material::default()
+        },
+        LightingModel::Pbr,
+    );
+    scene.environment = Some(sky_with_sun(sun, 2.0, 2000.0));
+    scene.quality.ibl.extract_sun = true;
+    scene.camera.position = glam::DVec3::new(0.0, 3.0, 5.0);
+    scene.camera.target = glam::DVec3::new(0.0, -0.8, 0.0);
+    scene.objects.push(Object {
+        name: "floor".to_owned(),
+        mesh: Arc::new(engine::mesh::plane(8.0, 1.0)),
+        transform: Transform {
+            translation: glam::DVec3::new(0.0, -1.2, 0.0),
+            ..Transform::default()
+        },
+        material: Material {
+            base_color: [0.8; 3],
+            ..Material::default()
+        },
+        lighting: LightingModel::Pbr,
+        casts_shadows: true,
+    });
+    let camera = scene.camera.position;
+    // Floor pixels, split by whether the unit sphere at the origin hides the sun from them.
+    let floor_light = |frame: &Frame| {
+        let light = frame.output("light").unwrap().as_f32().unwrap();
+        let position = frame.output("gbuffer_position").unwrap().as_f32().unwrap();
+        let (mut shadowed, mut open) = (Vec::new(), Vec::new());
+        for i in 0..light.len() / 4 {
+            let p = glam::Vec3::from_slice(&position[i * 4..i * 4 + 3]).as_dvec3() + camera;
+            if (p.y + 1.2).abs() > 1e-3 {
+                continue;
+            }
+            // Distance from the sphere's centre to the ray towards the sun.
+            let along = (-p).dot(sun);
+            let miss = (p + sun * along).length();
+            if along > 0.0 && miss < 0.9 {
+                shadowed.push(light[i * 4 + 1]);
+            } else if miss > 1.2 {
+                open.push(light[i * 4 + 1]);
+            }
+        }
+        let mean = |v: &[f32]| v.iter().sum::<f32>() / v.len().max(1) as f32;
+        assert!(
+            shadowed.len() > 50 && open.len() > 500,
+            "{} {}",
+            shadowed.len(),
+            open.len()
+        );
+        (mean(&shadowed), mean(&open))
+    };
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        let frame = render(backend.as_mut(), &scene);
+        assert!(
+            frame
+                .plan
+                .passes
+                .iter()
+                .any(|p| p.name.starts_with("shadow")),
+            "{kind}: no shadow pass for the sun"
+        );
+        let (shadowed, open) = floor_light(&frame);
+        eprintln!("{kind}: floor in the sun's shadow {shadowed:.4}, open {open:.4}");
+        assert!(shadowed < 0.1 * open, "{kind}: {shadowed} vs {open}");
+        let mut unshadowed = scene.clone();
+        unshadowed.quality.ibl.sun_shadow = false;
+        let (shadowed, open) = floor_light(&render(backend.as_mut(), &unshadowed));
+        assert!(
+            shadowed > 0.9 * open,
+            "{kind}: {shadowed} vs {open} without the shadow"
+        );
+    }
+}
+
+/// The extracted sun is a disc of its solid angle: on a mirror sphere (roughness 0), the
+/// centre of its reflection is as bright as the sun itself times the Fresnel reflectance
+/// (within 15%), not the point light's spike of (alpha' / alpha)^2, hundreds of times brighter,
+/// nor a miss between pixels; the disc's area is that of the sun's reflection.
+#[test]
+fn extracted_sun_reflects_as_a_disc() {
+    // 20 degrees above the camera's axis: the reflection is where n is 10 degrees up.
+    let towards = glam::DVec3::new(0.0, 20f64.to_radians().sin(), 20f64.to_radians().cos());
+    let sun_radiance = 2000.0f32;
+    let base = 0.9f32;
+    let mut scene = test_scenes::ibl_furnace(
+        256,
+        Material {
+            base_color: [base; 3],
+            metallic: 1.0,
+            roughness: 0.0,
+            ..Material::default()
+        },
+        LightingModel::Pbr,
+    );
+    scene.environment = Some(sky_with_sun(towards, 3.0, sun_radiance));
+    scene.quality.ibl.extract_sun = true;
+    scene.quality.ibl.sun_shadow = false;
+    // Schlick's Fresnel at v.h = cos(10 degrees).
+    let v_dot_h = 10f32.to_radians().cos();
+    let fresnel = base + (1.0 - base) * (1.0 - v_dot_h).powi(5);
+    let expected = fresnel * (sun_radiance - 0.05);
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        let frame = render(backend.as_mut(), &scene);
+        let light = frame.output("light").unwrap().as_f32().unwrap();
+        let peak = light.chunks_exact(4).map(|p| p[1]).fold(0.0f32, f32::max);
+        let bright = light
+            .chunks_exact(4)
+            .filter(|p| p[1] > 0.5 * expected)
+            .count();
+        // Pixels whose mirror direction falls inside the sun's disc, from the G-buffer.
+        let position = frame.output("gbuffer_position").unwrap().as_f32().unwrap();
+        let normal = frame.output("gbuffer_normal").unwrap().as_f32().unwrap();
+        let cos_radius = 3f32.to_radians().cos();
+        let inside = (0..light.len() / 4)
+            .filter(|&i| {
+                let n = glam::Vec3::from_slice(&normal[i * 4..i * 4 + 3]);
+                let v = -glam::Vec3::from_slice(&position[i * 4..i * 4 + 3]);
+                if n.length_squared() < 0.5 || v.length_squared() == 0.0 {
+                    return false;
+                }
+                let (n, v) = (n.normalize(), v.normalize());
+                let r = 2.0 * n.dot(v) * n - v;
+                r.dot(towards.as_vec3()) >= cos_radius
+            })
+            .count();
+        eprintln!(
+            "{kind}: reflection peak {peak:.1}, expected {expected:.1}; {bright} pixels over \
+             half of it, {inside} mirror the sun's disc"
+        );
+        assert!(
+            (peak / expected - 1.0).abs() <= 0.15,
+            "{kind}: peak {peak} vs {expected}"
+        );
+        assert!(
+            inside >= 20 && (0.5..=1.5).contains(&(bright as f64 / inside as f64)),
+            "{kind}: {bright} bright pixels where {inside} mirror the sun"
+        );
+    }
 }

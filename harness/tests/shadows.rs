@@ -108,6 +108,7 @@ fn open_plane_has_no_shadow_acne() {
                         direction,
                         color: [1.0; 3],
                         intensity: 3.0,
+                        angular_radius: 0.0,
                         shadow,
                     },
                 );
@@ -212,6 +213,7 @@ fn box_on_a_plane_shows_at_most_a_two_texel_contact_gap() {
         direction,
         color: [1.0; 3],
         intensity: 3.0,
+        angular_radius: 0.0,
         shadow: Some(ShadowSettings {
             filter: ShadowFilter::Hard,
             ..ShadowSettings::default()

@@ -67,9 +67,11 @@ pub fn key(image: &EnvironmentImage, settings: &IblSettings) -> Key {
             hash.update(c.to_bits().to_le_bytes());
         }
     }
-    // The render-time sample count changes no map: maps are shared across it.
+    // The render-time knobs (sample count, the sun's shadow) change no map: maps are shared
+    // across them.
     let maps_settings = IblSettings {
         runtime_samples: 0,
+        sun_shadow: true,
         ..settings.clone()
     };
     hash.update(

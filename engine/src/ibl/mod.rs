@@ -80,6 +80,11 @@ pub struct IblSettings {
     /// Cut the environment's sun out of the maps and light it as a directional light instead
     /// ([`sun`]).
     pub extract_sun: bool,
+    /// Whether the extracted sun casts a shadow (with the default [`ShadowSettings`]). It
+    /// changes no precomputed map.
+    ///
+    /// [`ShadowSettings`]: crate::scene::ShadowSettings
+    pub sun_shadow: bool,
 }
 
 impl Default for IblSettings {
@@ -93,6 +98,7 @@ impl Default for IblSettings {
             seed: 0,
             runtime_samples: 0,
             extract_sun: false,
+            sun_shadow: true,
         }
     }
 }

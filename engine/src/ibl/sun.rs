@@ -5,7 +5,9 @@
 //! texels of 1024 x 512, 38%). With `[quality.ibl] extract_sun = true` the sun is cut out of the
 //! image before the maps are built (its texels replaced by the sky around it) and lit instead as
 //! a directional light carrying its flux, which the lighting pass evaluates with the full BRDF
-//! (anisotropy included) at every pixel.
+//! (anisotropy included) at every pixel. The light is a disc of the sun's solid angle (its
+//! specular highlight widened and dimmed to match, as for Karis's sphere lights) and casts a
+//! shadow unless `[quality.ibl] sun_shadow = false`.
 //!
 //! The sun is the 8-connected region around the brightest texel (by luminance) of texels
 //! brighter than `max(1% of the peak, 100 x the median)`; there is none when the peak is under
@@ -14,7 +16,7 @@
 use glam::{DVec3, Vec3};
 
 use super::IblMaps;
-use crate::scene::{Environment, EnvironmentImage, Light, Scene};
+use crate::scene::{Environment, EnvironmentImage, Light, Scene, ShadowSettings};
 
 /// An extracted sun, in the environment image's frame (before the environment's rotation).
 #[derive(Clone, Debug, PartialEq)]
@@ -162,9 +164,19 @@ pub fn extract(image: &EnvironmentImage) -> Option<(EnvironmentImage, Sun)> {
     Some((residual, sun))
 }
 
+/// Angular radius of the disc with the sun's solid angle: `omega = 2 pi (1 - cos radius)`.
+pub fn angular_radius(sun: &Sun) -> f32 {
+    let omega = f64::from(sun.solid_angle).clamp(0.0, 4.0 * std::f64::consts::PI);
+    (1.0 - omega / std::f64::consts::TAU).acos() as f32
+}
+
 /// The directional light that stands for `sun` in the world (the environment's rotation and
-/// intensity applied).
-pub fn light(environment: &Environment, sun: &Sun) -> Option<Light> {
+/// intensity applied): a disc of the sun's solid angle, casting `shadow` if any.
+pub fn light(
+    environment: &Environment,
+    sun: &Sun,
+    shadow: Option<ShadowSettings>,
+) -> Option<Light> {
     let r = environment.rotation_degrees.to_radians();
     let (c, s) = (r.cos(), r.sin());
     // The inverse of the lighting pass's environment_direction (a rotation about +Y).
@@ -178,15 +190,17 @@ pub fn light(environment: &Environment, sun: &Sun) -> Option<Light> {
         direction: world.as_dvec3(),
         color: sun.irradiance.map(|e| e / peak),
         intensity: peak * environment.intensity,
-        shadow: None,
+        angular_radius: angular_radius(sun),
+        shadow,
     })
 }
 
 /// The scene as the renderer draws it: with the sun that `maps` (built with `extract_sun`) cut
-/// out of the environment added as a directional light; `None` when there is none, the scene
-/// as it is.
+/// out of the environment added as a directional light, with a shadow unless
+/// `[quality.ibl] sun_shadow` is off; `None` when there is none, the scene as it is.
 pub fn scene_with_sun(scene: &Scene, maps: Option<&IblMaps>) -> Option<Scene> {
-    let light = light(scene.environment.as_ref()?, maps?.sun.as_ref()?)?;
+    let shadow = scene.quality.ibl.sun_shadow.then(ShadowSettings::default);
+    let light = light(scene.environment.as_ref()?, maps?.sun.as_ref()?, shadow)?;
     let mut with_sun = scene.clone();
     with_sun.lights.push(light);
     Some(with_sun)
@@ -231,6 +245,10 @@ mod tests {
             "{u} {v}"
         );
         assert!(residual.texels.iter().all(|t| t[0] < 1.0));
+        // Its disc has the four texels' solid angle.
+        let radius = f64::from(angular_radius(&sun));
+        let disc = std::f64::consts::TAU * (1.0 - radius.cos());
+        assert!((disc / omega - 1.0).abs() < 1e-3, "{disc} vs {omega}");
     }
 
     #[test]

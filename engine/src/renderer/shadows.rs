@@ -578,6 +578,7 @@ mod tests {
             direction: DVec3::Y,
             color: [1.0; 3],
             intensity: 1.0,
+            angular_radius: 0.0,
             shadow: Some(settings),
         };
         assert!(settings_problem(&directional(vsm)).is_none());

@@ -19,7 +19,8 @@ pub struct LightData {
     pub position: [f32; 4],
     /// rgb = color * intensity * exposure; a = radius.
     pub color: [f32; 4],
-    /// x = 1 / falloff.
+    /// x = 1 / falloff (point lights); y, z = sine and cosine of the disc's angular radius
+    /// (directional lights).
     pub params: [f32; 4],
 }
 
@@ -35,13 +36,18 @@ pub fn light_uniforms(scene: &Scene) -> Vec<LightData> {
                 direction,
                 color,
                 intensity,
+                angular_radius,
                 ..
             } => {
                 let d = direction.normalize().as_vec3();
                 LightData {
                     position: [d.x, d.y, d.z, 0.0],
                     color: scaled(color, intensity * exposure, 0.0),
-                    params: [0.0; 4],
+                    params: if *angular_radius > 0.0 {
+                        [0.0, angular_radius.sin(), angular_radius.cos(), 0.0]
+                    } else {
+                        [0.0; 4]
+                    },
                 }
             }
             Light::Point {
