@@ -449,9 +449,21 @@ pub fn error_by_roughness(frame: &Frame, references: &[PixelReference]) -> Vec<R
         .collect()
 }
 
-/// One material row of [`error_by_family`]: the family and, per roughness, (roughness, mean
-/// relative error, pixels).
-pub type FamilyRow = (String, Vec<(f64, f64, usize)>);
+/// One cell of [`error_by_family`]: the reference pixels of one material row at one roughness.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CellError {
+    /// Perceptual roughness (rounded to 0.1).
+    pub roughness: f64,
+    /// Mean relative error (r + g + b) over the cell's pixels.
+    pub mean: f64,
+    /// 95th percentile (nearest rank) of the cell's relative errors.
+    pub p95: f64,
+    /// Reference pixels in the cell.
+    pub pixels: usize,
+}
+
+/// One material row of [`error_by_family`]: the family and its cells, by roughness.
+pub type FamilyRow = (String, Vec<CellError>);
 
 /// The material family of a surface, for grouping errors: `anisotropic`, `clearcoat`, `metal`
 /// or `dielectric` (first that applies).
@@ -467,8 +479,8 @@ pub fn material_family(s: &Surface) -> &'static str {
     }
 }
 
-/// Mean relative error (r + g + b) per material family and roughness (rounded to 0.1), as
-/// rows of a table: family, then (roughness, mean error, pixels) per column.
+/// Mean and 95th-percentile relative error (r + g + b) per material family and roughness
+/// (rounded to 0.1), as rows of a table: family, then one cell per roughness.
 pub fn error_by_family(frame: &Frame, references: &[PixelReference]) -> Vec<FamilyRow> {
     let light = light_buffer(frame);
     let mut groups: std::collections::BTreeMap<(&str, i64), Vec<f64>> = Default::default();
@@ -485,12 +497,14 @@ pub fn error_by_family(frame: &Frame, references: &[PixelReference]) -> Vec<Fami
             .push(error);
     }
     let mut rows: Vec<FamilyRow> = Vec::new();
-    for ((family, key), errors) in groups {
-        let cell = (
-            key as f64 / 10.0,
-            errors.iter().sum::<f64>() / errors.len() as f64,
-            errors.len(),
-        );
+    for ((family, key), mut errors) in groups {
+        errors.sort_by(f64::total_cmp);
+        let cell = CellError {
+            roughness: key as f64 / 10.0,
+            mean: errors.iter().sum::<f64>() / errors.len() as f64,
+            p95: crate::metrics::percentile_of_sorted(&errors, 0.95),
+            pixels: errors.len(),
+        };
         match rows.iter_mut().find(|(f, _)| f == family) {
             Some((_, cells)) => cells.push(cell),
             None => rows.push((family.to_owned(), vec![cell])),

@@ -2,7 +2,7 @@
 //!
 //! `cargo run --release -p harness` runs `check`, the main job.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -146,6 +146,10 @@ enum Command {
         /// Renders per setting (timings are their median).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
+        /// Light the scene with this environment (EXR or .hdr) instead of its own, keeping its
+        /// rotation and intensity: the IBL sweep under another sky.
+        #[arg(long)]
+        environment: Option<PathBuf>,
         /// Print JSON.
         #[arg(long)]
         json: bool,
@@ -286,8 +290,16 @@ fn main() -> ExitCode {
             knob,
             backend,
             repeats,
+            environment,
             json,
-        } => sweep(&scene, &knob, backend, repeats, json),
+        } => sweep(
+            &scene,
+            &knob,
+            backend,
+            repeats,
+            environment.as_deref(),
+            json,
+        ),
         Command::Bench {
             scenes,
             backends,
@@ -939,9 +951,13 @@ fn sweep(
     knob: &str,
     kind: BackendKind,
     repeats: usize,
+    environment: Option<&Path>,
     json: bool,
 ) -> anyhow::Result<ExitCode> {
-    let loaded = harness::load_scene(scene)?;
+    let mut loaded = harness::load_scene(scene)?;
+    if let Some(path) = environment {
+        replace_environment(&mut loaded.scene, path)?;
+    }
     if knob == "ibl" {
         let rows = harness::sweep::ibl_sweep(&loaded.scene, kind, repeats, |what| {
             eprintln!("  {what} ...");
@@ -1047,6 +1063,33 @@ fn hard(backends: &[BackendKind], json: bool) -> anyhow::Result<ExitCode> {
     } else {
         ExitCode::FAILURE
     })
+}
+
+/// Lights `scene` with the environment at `path` (its rotation and intensity kept, or none and
+/// 1 where it had no environment) and names it `<scene>-<file stem>`, so that the sweep's
+/// results are kept apart from the scene's own.
+fn replace_environment(scene: &mut engine::scene::Scene, path: &Path) -> anyhow::Result<()> {
+    let loaded = engine::assets::load_environment(path)?;
+    let (rotation_degrees, intensity) = scene
+        .environment
+        .as_ref()
+        .map_or((0.0, 1.0), |e| (e.rotation_degrees, e.intensity));
+    scene.environment = Some(engine::scene::Environment {
+        image: std::sync::Arc::new(engine::scene::EnvironmentImage {
+            label: path.display().to_string(),
+            width: loaded.width,
+            height: loaded.height,
+            texels: loaded.texels,
+        }),
+        rotation_degrees,
+        intensity,
+    });
+    let stem = path.file_stem().map_or_else(
+        || "environment".to_owned(),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    scene.name = format!("{}-{stem}", scene.name);
+    Ok(())
 }
 
 /// Keeps a sweep's results (target/harness/sweep_<scene>_<knob>.json) for the check report; a
