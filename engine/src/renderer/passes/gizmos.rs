@@ -49,7 +49,7 @@ pub fn lines(scene: &Scene) -> Vec<[f32; 6]> {
 }
 
 /// Records the gizmos pass onto `target` (loaded, not cleared).
-pub(super) fn pass(
+pub(in crate::renderer) fn pass(
     backend: &mut dyn Backend,
     scope: &mut ResourceScope,
     scene: &Scene,

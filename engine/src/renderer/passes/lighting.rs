@@ -1,0 +1,550 @@
+//! The lighting passes: per lighting model, its draws of `lighting.wgsl` (one per batch of
+//! lights, each a pipeline specialised to the draw's variant) add into the light buffer, only
+//! over the model's pixels: a routing draw marks them in a depth target that the shading draws
+//! test for equality. Also the debug shadow-term outputs, through the same shader's lookup.
+
+use std::collections::HashMap;
+
+use super::super::builders::{
+    attachment, binding, cube_layout, filterable_texture_layout, fullscreen_draw,
+    fullscreen_pipeline, shader, texture_layout,
+};
+use super::super::ibl::{self, IblTextures};
+use super::super::resources::FrameResources;
+use super::super::shadows::{self, ShadowView};
+use super::super::{light_uniforms, uniforms, Faults, RenderError};
+use crate::backend::*;
+use crate::plan::RenderPlan;
+use crate::plan::{self, LightingDraw, LightingPass, LightingVariant, MaskChannel, PassKind};
+use crate::scene::Scene;
+use crate::shaders;
+
+/// The layout of `lighting.wgsl`'s bindings 0..17. Parameters are in uniform buffers; nothing
+/// in them steers a branch or loop (see the top of lighting.wgsl), so lavapipe has nothing to
+/// specialise per draw.
+fn binding_layouts() -> Vec<BindingLayout> {
+    let mut layouts = vec![BindingLayout {
+        binding: 0,
+        kind: BindingKind::UniformBuffer,
+    }];
+    layouts.extend((1..=6).map(texture_layout));
+    layouts.extend([
+        BindingLayout {
+            binding: 7,
+            kind: BindingKind::Texture {
+                sample_type: TextureSampleType::Depth,
+                view: TextureViewKind::D2,
+            },
+        },
+        BindingLayout {
+            binding: 8,
+            kind: BindingKind::Sampler(SamplerBindingKind::Comparison),
+        },
+        BindingLayout {
+            binding: 9,
+            kind: BindingKind::UniformBuffer,
+        },
+        BindingLayout {
+            binding: 10,
+            kind: BindingKind::Texture {
+                sample_type: TextureSampleType::UnfilterableFloat,
+                view: TextureViewKind::D2Array,
+            },
+        },
+        filterable_texture_layout(11),
+        BindingLayout {
+            binding: 12,
+            kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
+        },
+        cube_layout(13),
+        cube_layout(14),
+        filterable_texture_layout(15),
+        BindingLayout {
+            binding: 16,
+            kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
+        },
+        texture_layout(17),
+    ]);
+    layouts
+}
+
+/// The soft shadow filters' jitter: rotation offsets per pixel of a tile, one layer per pair
+/// of samples.
+fn upload_jitter(
+    backend: &mut dyn Backend,
+    scope: &mut ResourceScope,
+) -> Result<Handle<Texture>, RenderError> {
+    let jitter_layers = (shadows::SOFT_RINGS * shadows::SOFT_SECTORS / 2) as u32;
+    let jitter = scope.texture(
+        backend,
+        &TextureDesc {
+            kind: TextureKind::D2Array {
+                layers: jitter_layers,
+            },
+            ..TextureDesc::d2(
+                "shadow jitter",
+                shadows::JITTER_TILE,
+                shadows::JITTER_TILE,
+                TextureFormat::Rgba16Float,
+            )
+        },
+    )?;
+    let jitter_texels = shadows::jitter_texels();
+    let layer_len = (shadows::JITTER_TILE * shadows::JITTER_TILE * 4) as usize;
+    for (layer, texels) in jitter_texels.chunks(layer_len).enumerate() {
+        backend.write_texture(
+            jitter,
+            Subresource {
+                mip: 0,
+                layer: layer as u32,
+            },
+            bytemuck::cast_slice(texels),
+        )?;
+    }
+    Ok(jitter)
+}
+
+/// A shadowed light's bindings: its map, its VSM moments (or the placeholder), its shadow
+/// uniforms and the comparison sampler its filter needs.
+#[derive(Clone, Copy)]
+struct ShadowBindings {
+    map: Handle<Texture>,
+    moments: Handle<Texture>,
+    uniform: Handle<Buffer>,
+    sampler: Handle<Sampler>,
+}
+
+/// The resources of one lighting draw ([`plan::LightingDraw`]): its lights' uniforms, and the
+/// maps of its shadowed light (placeholders when it has none).
+struct LightDraw {
+    lights: Vec<uniforms::LightData>,
+    shadow: ShadowBindings,
+}
+
+/// What every lighting draw of the frame binds, and the pipelines made so far.
+struct LightingResources<'a> {
+    frame: &'a FrameResources,
+    shader: Handle<Shader>,
+    layouts: Vec<BindingLayout>,
+    ibl: IblTextures,
+    jitter: Handle<Texture>,
+    lights: Vec<uniforms::LightData>,
+    moments_sampler: Handle<Sampler>,
+    /// What a draw without a shadowed light binds.
+    no_shadow: ShadowBindings,
+    /// Each shadowed light's bindings, by scene light index.
+    shadowed: HashMap<usize, ShadowBindings>,
+    /// One pipeline per (entry point, variant, routed or not), created on first use.
+    pipelines: HashMap<String, Handle<Pipeline>>,
+}
+
+impl<'a> LightingResources<'a> {
+    fn create(
+        backend: &mut dyn Backend,
+        scope: &mut ResourceScope,
+        scene: &Scene,
+        frame: &'a FrameResources,
+        views: &[ShadowView],
+        faults: &Faults,
+        ibl_maps: Option<&crate::ibl::IblMaps>,
+    ) -> Result<Self, RenderError> {
+        let lighting_shader = shader(scope, backend, shaders::LIGHTING)?;
+        let ibl = ibl::upload(backend, scope, ibl_maps)?;
+        let jitter = upload_jitter(backend, scope)?;
+        let mut lights = light_uniforms(scene);
+        if let Some(scale) = faults.light_radiance_scale {
+            for light in &mut lights {
+                for channel in &mut light.color[..3] {
+                    *channel *= scale;
+                }
+            }
+        }
+        let shadow_sampler = scope.sampler(
+            backend,
+            &SamplerDesc {
+                compare: Some(CompareFunction::LessEqual),
+                ..SamplerDesc::nearest("shadow compare")
+            },
+        )?;
+        let linear_shadow_sampler = scope.sampler(
+            backend,
+            &SamplerDesc {
+                compare: Some(CompareFunction::LessEqual),
+                mipmap_filter: FilterMode::Nearest,
+                ..SamplerDesc::linear("shadow compare linear", AddressMode::ClampToEdge)
+            },
+        )?;
+        let moments_sampler = scope.sampler(
+            backend,
+            &SamplerDesc {
+                mipmap_filter: FilterMode::Nearest,
+                ..SamplerDesc::linear("shadow moments", AddressMode::ClampToEdge)
+            },
+        )?;
+        let no_shadow_map = scope.texture(
+            backend,
+            &TextureDesc::d2("no shadow", 1, 1, TextureFormat::Depth32Float),
+        )?;
+        let no_moments = scope.texture(
+            backend,
+            &TextureDesc::d2("no moments", 1, 1, TextureFormat::Rgba16Float),
+        )?;
+        let no_shadow_uniform = scope.buffer(
+            backend,
+            "no shadow uniforms",
+            BufferUsage::Uniform,
+            bytemuck::cast_slice(&shadows::shadow_uniforms(None)),
+        )?;
+        let mut shadowed = HashMap::new();
+        for view in views {
+            let uniform = scope.buffer(
+                backend,
+                &format!("shadow uniforms light {}", view.light),
+                BufferUsage::Uniform,
+                bytemuck::cast_slice(&shadows::shadow_uniforms(Some(view))),
+            )?;
+            let moments = plan::shadow_moments_target_name(view.light);
+            let sampler = if view.settings.filter.linear_comparison() {
+                linear_shadow_sampler
+            } else {
+                shadow_sampler
+            };
+            shadowed.insert(
+                view.light,
+                ShadowBindings {
+                    map: frame.target(&plan::shadow_target_name(view.light)),
+                    moments: frame.optional_target(&moments).unwrap_or(no_moments),
+                    uniform,
+                    sampler,
+                },
+            );
+        }
+        Ok(Self {
+            frame,
+            shader: lighting_shader,
+            layouts: binding_layouts(),
+            ibl,
+            jitter,
+            lights,
+            moments_sampler,
+            no_shadow: ShadowBindings {
+                map: no_shadow_map,
+                moments: no_moments,
+                uniform: no_shadow_uniform,
+                sampler: shadow_sampler,
+            },
+            shadowed,
+            pipelines: HashMap::new(),
+        })
+    }
+
+    /// The resources of one of the plan's lighting draws.
+    fn light_draw(&self, draw: &LightingDraw) -> LightDraw {
+        let shadow = draw
+            .shadowed
+            .and_then(|light| self.shadowed.get(&light).copied())
+            .unwrap_or(self.no_shadow);
+        LightDraw {
+            lights: draw.lights.iter().map(|&i| self.lights[i]).collect(),
+            shadow,
+        }
+    }
+
+    /// Bind group of a lighting-shader draw (`lighting.wgsl` bindings 0..17).
+    fn bind_group(
+        &self,
+        uniform: Handle<Buffer>,
+        mask: Handle<Texture>,
+        draw: &LightDraw,
+    ) -> Vec<Binding> {
+        let mut bindings = vec![binding(0, BindingResource::Buffer(uniform))];
+        bindings.extend(plan::GBUFFER_TARGETS.iter().enumerate().map(|(i, name)| {
+            binding(
+                i as u32 + 1,
+                BindingResource::Texture(self.frame.target(name)),
+            )
+        }));
+        bindings.extend([
+            binding(6, BindingResource::Texture(mask)),
+            binding(7, BindingResource::Texture(draw.shadow.map)),
+            binding(8, BindingResource::Sampler(draw.shadow.sampler)),
+            binding(9, BindingResource::Buffer(draw.shadow.uniform)),
+            binding(10, BindingResource::Texture(self.jitter)),
+            binding(11, BindingResource::Texture(draw.shadow.moments)),
+            binding(12, BindingResource::Sampler(self.moments_sampler)),
+            binding(13, BindingResource::Texture(self.ibl.irradiance)),
+            binding(14, BindingResource::Texture(self.ibl.specular)),
+            binding(15, BindingResource::Texture(self.ibl.dfg)),
+            binding(16, BindingResource::Sampler(self.ibl.sampler)),
+            binding(17, BindingResource::Texture(self.frame.target(plan::DEPTH))),
+        ]);
+        bindings
+    }
+
+    /// The pipeline of `entry` specialised to `variant`; `routed` ones add into the light
+    /// buffer where the routing target's depth is equal (the model's pixels).
+    fn pipeline(
+        &mut self,
+        scope: &mut ResourceScope,
+        backend: &mut dyn Backend,
+        entry: &str,
+        variant: &LightingVariant,
+        routed: bool,
+    ) -> Result<Handle<Pipeline>, RenderError> {
+        let key = format!("{entry} {variant:?} {routed}");
+        if let Some(&pipeline) = self.pipelines.get(&key) {
+            return Ok(pipeline);
+        }
+        let blend = routed.then_some(BlendState::ADDITIVE);
+        let desc = PipelineDesc {
+            depth: routed.then_some(DepthState {
+                format: TextureFormat::Depth32Float,
+                write: false,
+                compare: CompareFunction::Equal,
+            }),
+            constants: variant.constants(),
+            ..fullscreen_pipeline(
+                &format!("lighting {entry} ({variant})"),
+                self.shader,
+                entry,
+                self.layouts.clone(),
+                TextureFormat::Rgba16Float,
+                blend,
+            )
+        };
+        let pipeline = scope.pipeline(backend, &desc)?;
+        self.pipelines.insert(key, pipeline);
+        Ok(pipeline)
+    }
+
+    /// Routing: marks the pass's model's pixels at depth 0 in the cleared routing target; it
+    /// adds zero to the light buffer (a pass's pipelines must all match its attachments).
+    fn route_pipeline(
+        &self,
+        scope: &mut ResourceScope,
+        backend: &mut dyn Backend,
+    ) -> Result<Handle<Pipeline>, RenderError> {
+        Ok(scope.pipeline(
+            backend,
+            &PipelineDesc {
+                depth: Some(DepthState {
+                    format: TextureFormat::Depth32Float,
+                    write: true,
+                    compare: CompareFunction::Always,
+                }),
+                ..fullscreen_pipeline(
+                    "lighting route",
+                    self.shader,
+                    "fs_route",
+                    vec![
+                        BindingLayout {
+                            binding: 0,
+                            kind: BindingKind::UniformBuffer,
+                        },
+                        texture_layout(6),
+                    ],
+                    TextureFormat::Rgba16Float,
+                    Some(BlendState::ADDITIVE),
+                )
+            },
+        )?)
+    }
+}
+
+/// Records the lighting passes into `passes` (and a clear of the light buffer where nothing
+/// else writes it), then the debug shadow terms if the scene asks for them. `light_cleared`:
+/// whether an earlier pass (the skybox) cleared the light buffer.
+#[allow(clippy::too_many_arguments)]
+pub(in crate::renderer) fn record(
+    backend: &mut dyn Backend,
+    scope: &mut ResourceScope,
+    scene: &Scene,
+    plan: &RenderPlan,
+    frame: &FrameResources,
+    views: &[ShadowView],
+    faults: &Faults,
+    ibl_maps: Option<&crate::ibl::IblMaps>,
+    mut light_cleared: bool,
+    passes: &mut Vec<RenderPass>,
+) -> Result<(), RenderError> {
+    let mut resources =
+        LightingResources::create(backend, scope, scene, frame, views, faults, ibl_maps)?;
+    let route_pipeline = if plan.lighting.is_empty() {
+        None
+    } else {
+        Some(resources.route_pipeline(scope, backend)?)
+    };
+    for (channel, pass) in plan.mask_channels.iter().zip(&plan.lighting) {
+        let draws = model_draws(
+            backend,
+            scope,
+            scene,
+            &mut resources,
+            *channel,
+            pass,
+            route_pipeline,
+        )?;
+        let load = if light_cleared {
+            LoadOp::Load
+        } else {
+            LoadOp::Clear([0.0; 4])
+        };
+        light_cleared = true;
+        passes.push(model_pass(plan, frame, *channel, pass, load, draws));
+    }
+    if !light_cleared {
+        // No objects and no environment: the light buffer is black.
+        passes.push(RenderPass {
+            name: "clear_light".to_owned(),
+            color_attachments: vec![attachment(
+                frame.target(plan::LIGHT),
+                LoadOp::Clear([0.0; 4]),
+            )],
+            depth_attachment: None,
+            viewports: vec![],
+            draws: vec![],
+        });
+    }
+    if scene.quality.debug_shadow_terms {
+        record_shadow_terms(backend, scope, scene, plan, views, &mut resources, passes)?;
+    }
+    Ok(())
+}
+
+/// The draws of one model's lighting pass: the routing draw, then one per batch of lights.
+fn model_draws(
+    backend: &mut dyn Backend,
+    scope: &mut ResourceScope,
+    scene: &Scene,
+    resources: &mut LightingResources<'_>,
+    channel: MaskChannel,
+    pass: &LightingPass,
+    route_pipeline: Option<Handle<Pipeline>>,
+) -> Result<Vec<Draw>, RenderError> {
+    let model = channel.model;
+    let mask = resources.frame.mask_targets[channel.target];
+    let mut draws = Vec::new();
+    for (index, draw) in pass.draws.iter().enumerate() {
+        let light_draw = resources.light_draw(draw);
+        let data = uniforms::lighting_uniforms(
+            scene,
+            &resources.frame.camera,
+            channel,
+            &light_draw.lights,
+            draw.first,
+            resources.ibl.max_lod,
+        );
+        let uniform = scope.buffer(
+            backend,
+            &format!("lighting {model} batch {index}"),
+            BufferUsage::Uniform,
+            bytemuck::cast_slice(&data),
+        )?;
+        if index == 0 {
+            if let Some(route) = route_pipeline {
+                draws.push(fullscreen_draw(
+                    route,
+                    vec![
+                        binding(0, BindingResource::Buffer(uniform)),
+                        binding(6, BindingResource::Texture(mask)),
+                    ],
+                ));
+            }
+        }
+        let pipeline =
+            resources.pipeline(scope, backend, model.entry_point(), &draw.variant, true)?;
+        let bindings = resources.bind_group(uniform, mask, &light_draw);
+        draws.push(fullscreen_draw(pipeline, bindings));
+    }
+    Ok(draws)
+}
+
+/// One model's lighting pass over its `draws`: into the light buffer, routed through the
+/// cleared routing depth target, rasterising only the model's rectangle.
+fn model_pass(
+    plan: &RenderPlan,
+    frame: &FrameResources,
+    channel: MaskChannel,
+    pass: &LightingPass,
+    load: LoadOp<[f32; 4]>,
+    draws: Vec<Draw>,
+) -> RenderPass {
+    let model = channel.model;
+    RenderPass {
+        name: plan
+            .passes
+            .iter()
+            .find(|p| p.kind == PassKind::Lighting(model))
+            .map_or_else(|| format!("lighting_{model}"), |p| p.name.clone()),
+        color_attachments: vec![attachment(frame.target(plan::LIGHT), load)],
+        depth_attachment: Some(DepthAttachment {
+            texture: frame.target(plan::ROUTE),
+            subresource: Subresource::default(),
+            load: LoadOp::Clear(1.0),
+        }),
+        // Only the pixels around the model's objects are rasterized (frag.xy stays in image
+        // coordinates, so the shaders read the right texels).
+        viewports: pass
+            .rect
+            .map(|r| Viewport {
+                x: r.x as f32,
+                y: r.y as f32,
+                width: r.width as f32,
+                height: r.height as f32,
+                min_depth: 0.0,
+                max_depth: 1.0,
+            })
+            .into_iter()
+            .collect(),
+        draws,
+    }
+}
+
+/// Debug: each shadowed light's shadow term, through the lighting shader's own lookup.
+fn record_shadow_terms(
+    backend: &mut dyn Backend,
+    scope: &mut ResourceScope,
+    scene: &Scene,
+    plan: &RenderPlan,
+    views: &[ShadowView],
+    resources: &mut LightingResources<'_>,
+    passes: &mut Vec<RenderPass>,
+) -> Result<(), RenderError> {
+    for view in views {
+        let name = plan::shadow_term_target_name(view.light);
+        let mut draws = plan.lighting.iter().flat_map(|pass| &pass.draws);
+        let Some(draw) = draws.find(|d| d.shadowed == Some(view.light)) else {
+            continue;
+        };
+        let pipeline =
+            resources.pipeline(scope, backend, "fs_shadow_term", &draw.variant, false)?;
+        let light_draw = resources.light_draw(draw);
+        let channel = plan.mask_channels[0];
+        let data = uniforms::lighting_uniforms(
+            scene,
+            &resources.frame.camera,
+            channel,
+            &light_draw.lights,
+            false,
+            0.0,
+        );
+        let uniform = scope.buffer(
+            backend,
+            &format!("{name} uniforms"),
+            BufferUsage::Uniform,
+            bytemuck::cast_slice(&data),
+        )?;
+        let bindings = resources.bind_group(uniform, resources.frame.mask_targets[0], &light_draw);
+        passes.push(RenderPass {
+            name: name.clone(),
+            color_attachments: vec![attachment(
+                resources.frame.target(&name),
+                LoadOp::Clear([0.0; 4]),
+            )],
+            depth_attachment: None,
+            viewports: vec![],
+            draws: vec![fullscreen_draw(pipeline, bindings)],
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,201 @@
+//! Checking a scene before anything reaches the GPU: every value that would otherwise turn into
+//! NaN pixels, an empty draw or a driver error is refused with a message naming the object or
+//! light at fault.
+
+use glam::DVec3;
+
+use super::{shadows, RenderError};
+use crate::scene::{Light, Object, Scene};
+
+/// Checks what would otherwise turn into NaN pixels or a driver error.
+pub fn validate(scene: &Scene) -> Result<(), RenderError> {
+    let checks = || -> Result<(), String> {
+        check_output_and_camera(scene)?;
+        for object in &scene.objects {
+            check_object(object, scene.textures.len())?;
+        }
+        for (i, light) in scene.lights.iter().enumerate() {
+            check_light(i, light)?;
+        }
+        check_environment(scene)
+    };
+    checks().map_err(|problem| RenderError::InvalidScene {
+        scene: scene.name.clone(),
+        problem,
+    })
+}
+
+fn finite3(v: DVec3) -> bool {
+    v.is_finite()
+}
+
+/// Output size, exposure, camera and ambient.
+fn check_output_and_camera(scene: &Scene) -> Result<(), String> {
+    let q = &scene.quality;
+    if q.width == 0 || q.height == 0 || q.width > 8192 || q.height > 8192 {
+        return Err(format!(
+            "output size {}x{} is outside 1..8192",
+            q.width, q.height
+        ));
+    }
+    if !(q.exposure.is_finite() && q.exposure > 0.0) {
+        return Err(format!(
+            "exposure {} must be finite and positive",
+            q.exposure
+        ));
+    }
+    let c = &scene.camera;
+    if !finite3(c.position) || !finite3(c.target) || !finite3(c.up) {
+        return Err("camera position, target and up must be finite".into());
+    }
+    let forward = c.target - c.position;
+    if forward.length() < 1e-9 || forward.normalize().cross(c.up).length() < 1e-6 {
+        return Err("camera target must differ from its position and not lie along `up`".into());
+    }
+    if !(c.fov_y_degrees > 0.0 && c.fov_y_degrees < 180.0) {
+        return Err(format!(
+            "camera fov {} must be between 0 and 180 degrees",
+            c.fov_y_degrees
+        ));
+    }
+    if !(c.near > 0.0 && c.far > c.near && c.far.is_finite()) {
+        return Err(format!(
+            "camera near {} and far {} must satisfy 0 < near < far",
+            c.near, c.far
+        ));
+    }
+    if !scene.ambient.iter().all(|a| a.is_finite() && *a >= 0.0) {
+        return Err("ambient must be finite and non-negative".into());
+    }
+    Ok(())
+}
+
+/// One object: its transform, material, texture indices and mesh.
+fn check_object(object: &Object, texture_count: usize) -> Result<(), String> {
+    let t = &object.transform;
+    if !finite3(t.translation) || !t.rotation.is_finite() || !finite3(t.scale) {
+        return Err(format!("object `{}`: transform is not finite", object.name));
+    }
+    if t.scale.abs().min_element() < 1e-12 {
+        return Err(format!(
+            "object `{}`: scale {:?} has a zero component",
+            object.name, t.scale
+        ));
+    }
+    let m = &object.material;
+    let scalars = [
+        m.roughness,
+        m.metallic,
+        m.specular,
+        m.anisotropy,
+        m.clearcoat,
+        m.clearcoat_roughness,
+        m.specular_exponent,
+    ];
+    if !m.base_color.iter().chain(&scalars).all(|v| v.is_finite()) {
+        return Err(format!(
+            "object `{}`: material has a NaN or infinite parameter",
+            object.name
+        ));
+    }
+    for index in [
+        m.base_color_map,
+        m.normal_map,
+        m.roughness_map,
+        m.metallic_map,
+        m.clearcoat_map,
+        m.specular_map,
+    ]
+    .into_iter()
+    .flatten()
+    {
+        if index >= texture_count {
+            return Err(format!(
+                "object `{}`: texture index {index} out of range ({texture_count} textures)",
+                object.name
+            ));
+        }
+    }
+    if object.mesh.indices.is_empty() {
+        return Err(format!("object `{}`: mesh has no triangles", object.name));
+    }
+    let vertex_count = object.mesh.vertices.len();
+    if object
+        .mesh
+        .indices
+        .iter()
+        .any(|&i| i as usize >= vertex_count)
+    {
+        return Err(format!(
+            "object `{}`: mesh index out of range ({vertex_count} vertices)",
+            object.name
+        ));
+    }
+    Ok(())
+}
+
+/// Light `i`: finite parameters, and shadow settings its type supports.
+fn check_light(i: usize, light: &Light) -> Result<(), String> {
+    let ok = match light {
+        Light::Directional {
+            direction,
+            color,
+            intensity,
+            angular_radius,
+            ..
+        } => {
+            direction.is_finite()
+                && direction.length() > 1e-12
+                && color.iter().all(|c| c.is_finite())
+                && intensity.is_finite()
+                && (0.0..1.5).contains(angular_radius)
+        }
+        Light::Point {
+            position,
+            color,
+            intensity,
+            radius,
+            falloff,
+            ..
+        } => {
+            position.is_finite()
+                && color.iter().all(|c| c.is_finite())
+                && intensity.is_finite()
+                && *radius > 0.0
+                && radius.is_finite()
+                && *falloff > 0.0
+                && falloff.is_finite()
+        }
+    };
+    if !ok {
+        return Err(format!(
+            "light {i}: parameters must be finite, with a non-zero direction, and radius and \
+             falloff positive"
+        ));
+    }
+    if let Some(problem) = shadows::settings_problem(light) {
+        return Err(format!("light {i}: {problem}"));
+    }
+    Ok(())
+}
+
+/// The IBL settings, and the environment's intensity, rotation and image.
+fn check_environment(scene: &Scene) -> Result<(), String> {
+    let Some(env) = &scene.environment else {
+        return Ok(());
+    };
+    if let Some(problem) = scene.quality.ibl.problem() {
+        return Err(problem);
+    }
+    if !(env.intensity.is_finite() && env.intensity >= 0.0 && env.rotation_degrees.is_finite()) {
+        return Err("environment intensity and rotation must be finite".into());
+    }
+    let image = &env.image;
+    if image.width == 0
+        || image.height == 0
+        || image.texels.len() != (image.width * image.height) as usize
+    {
+        return Err(format!("environment `{}`: bad size", image.label));
+    }
+    Ok(())
+}
