@@ -4,7 +4,7 @@
 //! - `<pass>`: each pass of the scene's plan, GPU time from timestamp queries (a point light's
 //!   six face passes count as its shadow pass), one full render per iteration;
 //! - `<pass>/floor`: that pass's floor, a trivial full-screen pass writing the same targets
-//!   (`harness::bench::Floors`), submitted alone;
+//!   (`harness::measure::bench::Floors`), submitted alone;
 //! - `frame`: every pass of the frame together.
 //!
 //! Backends without timestamps are timed by wall clock around the whole render or submit, and
@@ -17,7 +17,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Samplin
 use engine::backend::{self, Backend, BackendKind};
 use engine::plan::RenderPlan;
 use engine::scene::Scene;
-use harness::bench::{pass_time, Floors};
+use harness::measure::bench::{pass_time, Floors};
 
 /// GPU time of plan pass `pass` (every pass when `None`) in one render of `scene` (wall time
 /// of the render when the backend has no timestamps).
@@ -27,7 +27,7 @@ fn timed_render(
     plan: &RenderPlan,
     pass: Option<&str>,
 ) -> Duration {
-    harness::bench::timed_render(backend, scene, |timings| match pass {
+    harness::measure::bench::timed_render(backend, scene, |timings| match pass {
         Some(name) => plan
             .passes
             .iter()

@@ -24,7 +24,7 @@ use engine::scene::{Light, PointShadowPass, Scene, ShadowFilter};
 /// GPU time of the passes whose names start with one of `prefixes` in one render of `scene`
 /// (wall time of the render where the backend has no timestamps).
 fn timed_render(backend: &mut dyn Backend, scene: &Scene, prefixes: &[&str]) -> Duration {
-    harness::bench::timed_render(backend, scene, |timings| {
+    harness::measure::bench::timed_render(backend, scene, |timings| {
         timings
             .iter()
             .filter(|t| prefixes.iter().any(|p| t.name.starts_with(p)))

@@ -10,6 +10,7 @@
 
 pub mod assets;
 pub mod backend;
+pub mod files;
 pub mod ibl;
 pub mod image;
 pub mod lit_cube;
@@ -19,6 +20,7 @@ pub mod renderer;
 pub mod scene;
 pub mod scene_file;
 pub mod shaders;
+pub mod stats;
 
 pub use backend::{Backend, BackendKind};
 pub use image::{Image, ImageData};

@@ -4,7 +4,9 @@
 use engine::backend::{self, BackendKind, BackendStatus};
 use engine::lit_cube::{self, LitCubeImages};
 
-use crate::compare::{relative_difference, u8_difference, RelativeDifference, U8Difference};
+use crate::golden::compare::{
+    relative_difference, u8_difference, RelativeDifference, U8Difference,
+};
 
 /// Image size of the first scene.
 pub const SIZE: u32 = 128;
@@ -61,7 +63,7 @@ pub fn agreement(
     images: &LitCubeImages,
     reference: BackendKind,
     reference_images: &LitCubeImages,
-) -> Result<Agreement, crate::compare::CompareError> {
+) -> Result<Agreement, crate::golden::compare::CompareError> {
     Ok(Agreement {
         backend,
         reference,

@@ -2,7 +2,6 @@
 //! images. Every write goes to a temporary file beside the destination and is renamed into place,
 //! so a crash or a full disk never leaves a half-written image (or golden) behind.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use engine::backend::TextureFormat;
@@ -50,66 +49,24 @@ pub enum ImageFileError {
 /// renaming it over the target, so a test can kill the process mid-write.
 pub const WRITE_DELAY_ENV: &str = "HARNESS_FAULT_WRITE_DELAY_MS";
 
-/// Writes `bytes` to `path` atomically (temporary file in the same folder, fsync, rename): a
-/// reader, or a process killed at any moment, sees the old file or the new one, never a part.
-/// Temporary files of the same target left by killed processes are removed first.
+/// Writes `bytes` to `path` atomically ([`engine::files::write_atomically`]): a reader, or a
+/// process killed at any moment, sees the old file or the new one, never a part. With
+/// [`WRITE_DELAY_ENV`] set, waits that many milliseconds before the rename.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ImageFileError> {
-    let io = |error| ImageFileError::Io {
-        path: path.to_owned(),
-        error,
-    };
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(io)?;
-    }
-    let file_name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    remove_stale_temporaries(path, &file_name);
-    let temp = path.with_file_name(format!(".{file_name}.tmp{}", std::process::id()));
-    let result = (|| {
-        let mut file = std::fs::File::create(&temp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
+    let fault_delay = || {
         if let Some(ms) = std::env::var(WRITE_DELAY_ENV)
             .ok()
             .and_then(|v| v.parse::<u64>().ok())
         {
             std::thread::sleep(std::time::Duration::from_millis(ms));
         }
-        std::fs::rename(&temp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&temp);
-    }
-    result.map_err(io)
-}
-
-/// Removes `.<file_name>.tmp<pid>` siblings of `path` whose process is gone (Linux: no
-/// `/proc/<pid>`); best effort.
-fn remove_stale_temporaries(path: &Path, file_name: &str) {
-    let Some(dir) = path.parent() else { return };
-    let dir = if dir.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        dir
     };
-    let prefix = format!(".{file_name}.tmp");
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for entry in entries.flatten() {
-        let name = entry.file_name().to_string_lossy().into_owned();
-        let Some(pid) = name
-            .strip_prefix(&prefix)
-            .and_then(|p| p.parse::<u32>().ok())
-        else {
-            continue;
-        };
-        if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
-            let _ = std::fs::remove_file(entry.path());
+    engine::files::write_atomically_with(path, bytes, fault_delay).map_err(|error| {
+        ImageFileError::Io {
+            path: path.to_owned(),
+            error,
         }
-    }
+    })
 }
 
 /// How hard the PNG encoder works: goldens are kept in the repository and written once per
@@ -130,31 +87,44 @@ pub fn encode_png(
     path: &Path,
     compression: PngCompression,
 ) -> Result<Vec<u8>, ImageFileError> {
-    use image::ImageEncoder;
     let data = image.as_u8().ok_or_else(|| ImageFileError::Unsupported {
         path: path.to_owned(),
         message: format!("{:?} is a float image; write it as .exr", image.format),
     })?;
-    let mut out = Vec::new();
+    png_bytes(
+        data,
+        image.width,
+        image.height,
+        image::ExtendedColorType::Rgba8,
+        compression,
+    )
+    .map_err(|e| ImageFileError::Png {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })
+}
+
+/// PNG bytes of raw texels of any PNG colour type (`Rgba8`, `Rgb16`, `L8` ...), adaptive
+/// filtering: the one PNG encoder of the workspace (goldens, reports, generated assets).
+pub fn png_bytes(
+    data: &[u8],
+    width: u32,
+    height: u32,
+    colour: image::ExtendedColorType,
+    compression: PngCompression,
+) -> Result<Vec<u8>, image::ImageError> {
+    use image::ImageEncoder;
     let level = match compression {
         PngCompression::Smallest => image::codecs::png::CompressionType::Best,
         PngCompression::Fast => image::codecs::png::CompressionType::Fast,
     };
+    let mut out = Vec::new();
     image::codecs::png::PngEncoder::new_with_quality(
         &mut out,
         level,
         image::codecs::png::FilterType::Adaptive,
     )
-    .write_image(
-        data,
-        image.width,
-        image.height,
-        image::ExtendedColorType::Rgba8,
-    )
-    .map_err(|e| ImageFileError::Png {
-        path: path.to_owned(),
-        message: e.to_string(),
-    })?;
+    .write_image(data, width, height, colour)?;
     Ok(out)
 }
 

@@ -1,26 +1,24 @@
-//! The harness library: image comparison, cross-backend checks, and (growing) goldens, bless and
-//! reports. The `harness` binary is a thin command line over it.
+//! The harness library: renders the canonical scenes, compares every pass with its golden within
+//! measured tolerances, blesses, measures speed against error, and writes the review page. The
+//! `harness` binary is a thin command line over it.
+//!
+//! Rooms: [`golden`] (store, tolerances, metrics, suite, check, noise model, self-test),
+//! [`reference`] (CPU references in f64), [`measure`] (bench, sweeps, hard cases) and
+//! [`report`] (the HTML review page); beside them the small shared helpers ([`html`],
+//! [`images`], [`stats`]) and the scenes built in code ([`test_scenes`], [`first_scene`]).
 
-pub mod bench;
-pub mod check;
-pub mod compare;
 pub mod first_scene;
 pub mod golden;
-pub mod hard_cases;
 pub mod html;
-pub mod ibl_reference;
 pub mod images;
 pub mod inspect;
-pub mod metrics;
-pub mod noise;
+pub mod measure;
 pub mod reference;
 pub mod report;
-pub mod selftest;
-pub mod shadow_reference;
-pub mod suite;
-pub mod sweep;
 pub mod test_scenes;
-pub mod tolerance;
+
+/// Order statistics (one nearest-rank rule), shared with the engine's tests.
+pub use engine::stats;
 
 /// The workspace root (the folder holding `scenes/` and `golden/`). `HARNESS_ROOT` overrides the
 /// location compiled in, for running an installed binary against another checkout.

@@ -58,7 +58,7 @@ enum Command {
         #[arg(long)]
         write: bool,
         /// With --write: limit = margin x max(noise, resolution).
-        #[arg(long, default_value_t = harness::noise::DEFAULT_MARGIN)]
+        #[arg(long, default_value_t = harness::golden::noise::DEFAULT_MARGIN)]
         margin: f64,
         /// Print JSON.
         #[arg(long)]
@@ -361,8 +361,11 @@ fn backends(json: bool) -> anyhow::Result<ExitCode> {
 /// others. Fails only when the noise model cannot be read.
 fn load_cases_isolated(
     scenes: &[String],
-) -> anyhow::Result<(Vec<harness::suite::Case>, Vec<harness::suite::BrokenScene>)> {
-    let (cases, broken) = harness::suite::load_suite(&scenes_or_canonical(scenes))?;
+) -> anyhow::Result<(
+    Vec<harness::golden::suite::Case>,
+    Vec<harness::golden::suite::BrokenScene>,
+)> {
+    let (cases, broken) = harness::golden::suite::load_suite(&scenes_or_canonical(scenes))?;
     for case in &cases {
         print_load_warnings(&case.loaded);
     }
@@ -374,7 +377,7 @@ fn load_cases_isolated(
 
 /// The scenes named (every canonical one when none is); any that does not load fails the
 /// command (bless and noise need every scene they were asked for).
-fn load_cases(scenes: &[String]) -> anyhow::Result<Vec<harness::suite::Case>> {
+fn load_cases(scenes: &[String]) -> anyhow::Result<Vec<harness::golden::suite::Case>> {
     let (cases, broken) = load_cases_isolated(scenes)?;
     if !broken.is_empty() {
         anyhow::bail!(
@@ -411,7 +414,7 @@ fn check(
     );
     let failures = out.join("failures");
     let (run, outputs) =
-        harness::check::run(&cases, &store, backends, &failures, |done, total, what| {
+        harness::golden::check::run(&cases, &store, backends, &failures, |done, total, what| {
             bar.set_length(total as u64);
             bar.set_position(done as u64);
             bar.set_message(what.to_owned());
@@ -431,7 +434,7 @@ fn check(
         eprintln!("note: {note}");
     }
     for case in &cases {
-        use harness::suite::LimitSource;
+        use harness::golden::suite::LimitSource;
         let borrowed: Vec<&str> = case
             .limit_sources
             .iter()
@@ -448,7 +451,13 @@ fn check(
             );
         }
     }
-    let html = harness::report::html(&run, &outputs, &store, Some(out));
+    let html = harness::report::html(
+        &run,
+        &outputs,
+        &store,
+        Some(out),
+        &harness::measure::report_sections(),
+    );
     let report = out.join("report.html");
     harness::images::write_atomically(&report, html.as_bytes())?;
     if json {
@@ -577,7 +586,7 @@ fn bless(
         let mut kept = 0;
         for pass in wanted {
             let image = &frame.outputs[pass];
-            let change = harness::suite::bless_change(&store, case, pass, image);
+            let change = harness::golden::suite::bless_change(&store, case, pass, image);
             // A pass named with --pass is rewritten even when it is within tolerance.
             let write = change.changed || every_pass || passes.iter().any(|p| p == pass);
             if !write {
@@ -724,11 +733,12 @@ fn noise(
     margin: f64,
     json: bool,
 ) -> anyhow::Result<ExitCode> {
-    use harness::noise::{self, NoiseModel, MAX_NOISE_RATIO};
+    use harness::golden::noise::{NoiseModel, MAX_NOISE_RATIO};
+    use harness::golden::portability;
     let store = harness::golden::GoldenStore::workspace();
     let cases = load_cases(scenes)?;
-    let (all, missing) = noise::sources(&store);
-    let chosen = noise::select(&all, &missing, names).map_err(anyhow::Error::msg)?;
+    let (all, missing) = portability::sources(&store);
+    let chosen = portability::select(&all, &missing, names).map_err(anyhow::Error::msg)?;
     if write && (!names.is_empty() || !missing.is_empty()) {
         anyhow::bail!(
             "--write records every source; {}",
@@ -752,7 +762,7 @@ fn noise(
         .collect();
     let Some(&reference) = backends
         .iter()
-        .find(|&&k| k == harness::suite::REFERENCE_BACKEND)
+        .find(|&&k| k == harness::golden::suite::REFERENCE_BACKEND)
         .or(backends.first())
     else {
         anyhow::bail!("no backend is available; run `harness backends` for the reasons");
@@ -763,7 +773,7 @@ fn noise(
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
     );
     bar.enable_steady_tick(std::time::Duration::from_millis(200));
-    let runs = noise::measure(
+    let runs = portability::measure(
         &exe,
         &store,
         &cases,
@@ -773,11 +783,11 @@ fn noise(
         |what| bar.set_message(what.to_owned()),
     );
     bar.finish_and_clear();
-    let measurements: Vec<noise::Measurement> = runs
+    let measurements: Vec<portability::Measurement> = runs
         .iter()
         .flat_map(|(_, r)| r.measurements.iter().cloned())
         .collect();
-    let missed: Vec<noise::Missed> = runs
+    let missed: Vec<portability::Missed> = runs
         .iter()
         .flat_map(|(_, r)| r.missed.iter().cloned())
         .collect();
@@ -797,7 +807,7 @@ fn noise(
             })
             .collect();
         let previous = NoiseModel::load(&store)?;
-        let model = noise::build_model(
+        let model = portability::build_model(
             &cases,
             &measurements,
             margin,
@@ -810,16 +820,18 @@ fn noise(
         // Judge the run against the limits just written.
         cases = cases
             .iter()
-            .map(|c| harness::suite::Case::load_with(&c.loaded.path.to_string_lossy(), &model))
+            .map(|c| {
+                harness::golden::suite::Case::load_with(&c.loaded.path.to_string_lossy(), &model)
+            })
             .collect::<Result<_, _>>()?;
     }
-    let ratios = noise::ratios(&cases, &measurements);
+    let ratios = portability::ratios(&cases, &measurements);
     let names: Vec<String> = runs.iter().map(|(s, _)| s.name.clone()).collect();
-    let too_noisy: Vec<&noise::Ratio> = ratios
+    let too_noisy: Vec<&portability::Ratio> = ratios
         .iter()
         .filter(|r| r.ratio > MAX_NOISE_RATIO)
         .collect();
-    let failed_renders: Vec<&noise::Missed> = missed.iter().filter(|m| !m.known).collect();
+    let failed_renders: Vec<&portability::Missed> = missed.iter().filter(|m| !m.known).collect();
     if json {
         println!(
             "{}",
@@ -834,7 +846,7 @@ fn noise(
             }))?
         );
     } else {
-        print!("{}", noise::table(&ratios, &names));
+        print!("{}", portability::table(&ratios, &names));
         for m in &missed {
             println!(
                 "{} {} on {} {}: {}",
@@ -879,7 +891,7 @@ fn noise(
 
 fn selftest(json: bool) -> anyhow::Result<ExitCode> {
     let store = harness::golden::GoldenStore::workspace();
-    let model = harness::noise::NoiseModel::load(&store)?;
+    let model = harness::golden::noise::NoiseModel::load(&store)?;
     let (cases, broken) = load_cases_isolated(&[])?;
     let available: Vec<BackendKind> = BackendKind::ALL
         .into_iter()
@@ -891,14 +903,14 @@ fn selftest(json: bool) -> anyhow::Result<ExitCode> {
     eprintln!(
         "self-test: {} scenes x {} mutations and unchanged renders on {} ...",
         cases.len(),
-        harness::selftest::Mutation::ALL.len(),
+        harness::golden::selftest::Mutation::ALL.len(),
         available
             .iter()
             .map(|k| k.name())
             .collect::<Vec<_>>()
             .join(", ")
     );
-    let mut result = harness::selftest::run(&cases, &store, &available, &model);
+    let mut result = harness::golden::selftest::run(&cases, &store, &available, &model);
     result.errors.extend(
         broken
             .iter()
@@ -909,12 +921,12 @@ fn selftest(json: bool) -> anyhow::Result<ExitCode> {
     } else {
         println!(
             "Known changes: value / limit in the pass where each originates (at least {} to pass)",
-            harness::noise::MIN_MUTATION_RATIO
+            harness::golden::noise::MIN_MUTATION_RATIO
         );
         print!("{}", result.margin_table());
         println!(
             "\nUnchanged renders: worst value / limit over every pass (at most {} to pass)",
-            harness::noise::MAX_NOISE_RATIO
+            harness::golden::noise::MAX_NOISE_RATIO
         );
         print!("{}", result.noise_table());
         for m in result.weak_detections() {
@@ -926,7 +938,7 @@ fn selftest(json: bool) -> anyhow::Result<ExitCode> {
                 m.mutation.origin(),
                 m.origin_ratio()
                     .map_or("not golden".to_owned(), |r| format!("{r:.2}x")),
-                harness::noise::MIN_MUTATION_RATIO
+                harness::golden::noise::MIN_MUTATION_RATIO
             );
         }
         for n in result.noisy() {
@@ -959,7 +971,7 @@ fn sweep(
         replace_environment(&mut loaded.scene, path)?;
     }
     if knob == "ibl" {
-        let rows = harness::sweep::ibl_sweep(&loaded.scene, kind, repeats, |what| {
+        let rows = harness::measure::sweep::ibl_sweep(&loaded.scene, kind, repeats, |what| {
             eprintln!("  {what} ...");
         })?;
         let text = serde_json::to_string_pretty(&rows)?;
@@ -970,15 +982,15 @@ fn sweep(
             println!(
                 "ibl sweep of {} on {kind} ({repeats} renders per setting, median GPU time; error = mean relative error of r+g+b against the Monte Carlo reference, {} pixels, {} directions per strategy)",
                 loaded.scene.name,
-                harness::sweep::IBL_REFERENCE_PIXELS,
-                harness::sweep::IBL_REFERENCE_SAMPLES
+                harness::measure::sweep::IBL_REFERENCE_PIXELS,
+                harness::measure::sweep::IBL_REFERENCE_SAMPLES
             );
-            print!("{}", harness::sweep::ibl_table(&rows));
+            print!("{}", harness::measure::sweep::ibl_table(&rows));
         }
         return Ok(ExitCode::SUCCESS);
     }
     if knob == "gbuffer" {
-        let rows = harness::sweep::gbuffer_sweep(&loaded.scene, kind, repeats, |what| {
+        let rows = harness::measure::sweep::gbuffer_sweep(&loaded.scene, kind, repeats, |what| {
             eprintln!("  {what} ...");
         })?;
         let text = serde_json::to_string_pretty(&rows)?;
@@ -990,14 +1002,14 @@ fn sweep(
                 "gbuffer sweep of {} on {kind} ({repeats} renders per setting, median GPU time; error = light buffer against the scene at the origin with the default storage)",
                 loaded.scene.name
             );
-            print!("{}", harness::sweep::gbuffer_table(&rows));
+            print!("{}", harness::measure::sweep::gbuffer_table(&rows));
         }
         return Ok(ExitCode::SUCCESS);
     }
     if knob != "shadow" {
-        return Err(harness::sweep::SweepError::UnknownKnob(knob.to_owned()).into());
+        return Err(harness::measure::sweep::SweepError::UnknownKnob(knob.to_owned()).into());
     }
-    let rows = harness::sweep::shadow_sweep(&loaded.scene, kind, repeats, |what| {
+    let rows = harness::measure::sweep::shadow_sweep(&loaded.scene, kind, repeats, |what| {
         eprintln!("  {what} ...");
     })?;
     let text = serde_json::to_string_pretty(&rows)?;
@@ -1009,7 +1021,7 @@ fn sweep(
             "shadow sweep of {} on {kind} ({repeats} renders per setting, median GPU time)",
             loaded.scene.name
         );
-        print!("{}", harness::sweep::table(&rows));
+        print!("{}", harness::measure::sweep::table(&rows));
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -1036,12 +1048,12 @@ fn hard(backends: &[BackendKind], json: bool) -> anyhow::Result<ExitCode> {
     let mut rows = Vec::new();
     for kind in kinds {
         rows.extend(
-            harness::hard_cases::run(kind, |case| eprintln!("  {case} on {kind} ..."))
+            harness::measure::hard_cases::run(kind, |case| eprintln!("  {case} on {kind} ..."))
                 .map_err(|e| anyhow::anyhow!("{kind}: {e}"))?,
         );
     }
     let text = serde_json::to_string_pretty(&rows)?;
-    let path = default_out_dir().join(harness::hard_cases::RESULTS_JSON);
+    let path = default_out_dir().join(harness::measure::hard_cases::RESULTS_JSON);
     match std::fs::create_dir_all(default_out_dir())
         .map_err(|e| e.to_string())
         .and_then(|_| {
@@ -1056,7 +1068,7 @@ fn hard(backends: &[BackendKind], json: bool) -> anyhow::Result<ExitCode> {
     if json {
         println!("{text}");
     } else {
-        print!("{}", harness::hard_cases::table(&rows));
+        print!("{}", harness::measure::hard_cases::table(&rows));
     }
     Ok(if rows.iter().all(|r| r.passed) {
         ExitCode::SUCCESS
@@ -1095,7 +1107,7 @@ fn replace_environment(scene: &mut engine::scene::Scene, path: &Path) -> anyhow:
 /// Keeps a sweep's results (target/harness/sweep_<scene>_<knob>.json) for the check report; a
 /// failure to write them is a warning.
 fn save_sweep(scene: &str, knob: &str, json: &str) {
-    let path = default_out_dir().join(harness::sweep::result_file(scene, knob));
+    let path = default_out_dir().join(harness::measure::sweep::result_file(scene, knob));
     let written = std::fs::create_dir_all(default_out_dir())
         .map_err(|e| e.to_string())
         .and_then(|_| {
@@ -1139,10 +1151,10 @@ fn bench(
         }
         for scene in &loaded {
             eprintln!("timing {} on {kind} ({frames} frames) ...", scene.name);
-            match harness::bench::bench_scene(scene, kind, frames) {
+            match harness::measure::bench::bench_scene(scene, kind, frames) {
                 Ok(result) => {
                     if !json {
-                        println!("{}", harness::bench::table(&result));
+                        println!("{}", harness::measure::bench::table(&result));
                     }
                     results.push(result);
                 }
@@ -1153,7 +1165,7 @@ fn bench(
             }
         }
     }
-    let precompute = harness::bench::precompute();
+    let precompute = harness::measure::bench::precompute();
     if !json {
         println!("precomputation (apart from frames):");
         for p in &precompute {
@@ -1163,7 +1175,7 @@ fn bench(
     let text = serde_json::to_string_pretty(
         &serde_json::json!({ "precompute": precompute, "scenes": results }),
     )?;
-    save_bench_json(out, harness::bench::BENCH_JSON, &text)?;
+    save_bench_json(out, harness::measure::bench::BENCH_JSON, &text)?;
     if json {
         println!("{text}");
     }
@@ -1182,7 +1194,7 @@ fn bench_series(
     json: bool,
 ) -> anyhow::Result<ExitCode> {
     let names: Vec<String> = if names.iter().any(|n| n == "all") {
-        harness::bench::SERIES
+        harness::measure::bench::SERIES
             .iter()
             .map(|s| (*s).to_owned())
             .collect()
@@ -1193,18 +1205,18 @@ fn bench_series(
     let mut all = Vec::new();
     for kind in kinds {
         for name in &names {
-            let points = harness::bench::series(name, kind, frames, |what| {
+            let points = harness::measure::bench::series(name, kind, frames, |what| {
                 eprintln!("  {kind}: {what} ...");
             })?;
             if !json {
                 println!("{name} series on {kind} (median of {frames} frames, GPU ms)");
-                println!("{}", harness::bench::series_table(&points));
+                println!("{}", harness::measure::bench::series_table(&points));
             }
             all.push(serde_json::json!({ "backend": kind.name(), "points": points }));
         }
     }
     let text = serde_json::to_string_pretty(&all)?;
-    save_bench_json(out, harness::bench::SERIES_JSON, &text)?;
+    save_bench_json(out, harness::measure::bench::SERIES_JSON, &text)?;
     if json {
         println!("{text}");
     }
@@ -1242,12 +1254,12 @@ fn bench_breakdown(
     for kind in kinds {
         for name in &names {
             let scene = harness::load_scene(name)?.scene;
-            let passes = harness::bench::breakdown(&scene, kind, frames, |what| {
+            let passes = harness::measure::bench::breakdown(&scene, kind, frames, |what| {
                 eprintln!("  {} on {kind}: {what} ({frames} frames) ...", scene.name);
             })?;
             if !json {
                 for pass in &passes {
-                    println!("{}", harness::bench::breakdown_table(pass));
+                    println!("{}", harness::measure::bench::breakdown_table(pass));
                 }
             }
             all.extend(passes);

@@ -173,7 +173,7 @@ fn a_backend_lost_mid_run_fails_its_scene_and_the_run_goes_on() {
         return;
     };
     harness::use_ibl_cache();
-    let cases = harness::suite::canonical_cases().unwrap();
+    let cases = harness::golden::suite::canonical_cases().unwrap();
     let store = harness::golden::GoldenStore::workspace();
     let created = AtomicUsize::new(0);
     let create = |k: BackendKind| -> Result<Box<dyn Backend>> {
@@ -182,8 +182,14 @@ fn a_backend_lost_mid_run_fails_its_scene_and_the_run_goes_on() {
         Ok(Box::new(backend))
     };
     let failures = tempfile::tempdir().unwrap();
-    let (run, _) =
-        harness::check::run_with(&cases, &store, &[], failures.path(), &create, |_, _, _| {});
+    let (run, _) = harness::golden::check::run_with(
+        &cases,
+        &store,
+        &[],
+        failures.path(),
+        &create,
+        |_, _, _| {},
+    );
     assert!(!run.passed());
     assert_eq!(run.render_errors.len(), 1, "{:?}", run.render_errors);
     let (scene, backend, error) = &run.render_errors[0];

@@ -12,8 +12,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use engine::backend::{self, BackendKind};
 use engine::renderer::Frame;
+use harness::golden::suite::{self, Case, REFERENCE_BACKEND};
 use harness::golden::{self, GoldenStore};
-use harness::suite::{self, Case, REFERENCE_BACKEND};
 use libtest_mimic::{Arguments, Failed, Trial};
 
 type Rendered = Arc<OnceLock<Result<Frame, String>>>;
@@ -24,7 +24,7 @@ struct Suite {
     frames: Mutex<HashMap<(usize, BackendKind), Rendered>>,
     update: bool,
     /// Checks that did not pass, for the HTML report written at the end.
-    failures: Mutex<Vec<harness::suite::PassCheck>>,
+    failures: Mutex<Vec<harness::golden::suite::PassCheck>>,
 }
 
 impl Suite {
@@ -185,7 +185,7 @@ fn write_failure_report(suite: &Suite) {
         return;
     }
     let frames = suite.frames.lock().unwrap_or_else(|e| e.into_inner());
-    let mut outputs = harness::report::Outputs::new();
+    let mut outputs = harness::golden::check::Outputs::new();
     for check in failures.iter() {
         let Some(index) = suite.cases.iter().position(|c| c.name() == check.scene) else {
             continue;
@@ -206,7 +206,7 @@ fn write_failure_report(suite: &Suite) {
             }
         }
     }
-    let run = harness::check::CheckRun {
+    let run = harness::golden::check::CheckRun {
         backends: vec![],
         results: failures.clone(),
         render_errors: vec![],
@@ -215,7 +215,7 @@ fn write_failure_report(suite: &Suite) {
         timings: vec![],
         driver_notes: vec![],
     };
-    let html = harness::report::html(&run, &outputs, &suite.store, None);
+    let html = harness::report::html(&run, &outputs, &suite.store, None, &[]);
     match harness::images::write_atomically(&report_path(), html.as_bytes()) {
         Ok(()) => eprintln!("report of the failures: {}", report_path().display()),
         Err(e) => eprintln!("could not write the report: {e}"),

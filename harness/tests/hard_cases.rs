@@ -1,11 +1,11 @@
-//! Issue 8's hard cases ([`harness::hard_cases`]: `scenes/hard/*.toml`, and the chess scene
+//! Issue 8's hard cases ([`harness::measure::hard_cases`]: `scenes/hard/*.toml`, and the chess scene
 //! moved and scaled), each with its invariant, on every available backend: no NaN/Inf in any
 //! pass, the light buffer within fp16's safe range, and the case's own check (the lighting pass
 //! against the f64 reference at p99.9 <= 2e-3 where that is defined).
 
 mod common;
 
-use harness::hard_cases;
+use harness::measure::hard_cases;
 
 /// Every hard case holds its invariants on every available backend.
 #[test]

@@ -2,9 +2,10 @@
 //! limit derived from its figures as documented (margin x max(noise, resolution)); renders
 //! recorded on another host pass with room. None of this renders: it needs no backend.
 
+use harness::golden::noise::{self, NoiseModel, MAX_NOISE_RATIO};
+use harness::golden::portability;
+use harness::golden::suite::{self, LimitSource};
 use harness::golden::GoldenStore;
-use harness::noise::{self, NoiseModel, MAX_NOISE_RATIO};
-use harness::suite::{self, LimitSource};
 
 /// The sources every check must have figures for (`<source>/<backend>` prefixes).
 const REQUIRED_SOURCES: [&str; 7] = [
@@ -86,10 +87,10 @@ fn renders_recorded_on_another_host_pass_with_room() {
     let dir = store.root().join("evidence/host-b");
     let mut measured = 0;
     for case in &cases {
-        let (measurements, missed) = noise::measure_recorded(&store, case, "host-b", &dir);
+        let (measurements, missed) = portability::measure_recorded(&store, case, "host-b", &dir);
         assert!(missed.is_empty(), "{missed:?}");
         measured += measurements.len();
-        for ratio in noise::ratios(&cases, &measurements) {
+        for ratio in portability::ratios(&cases, &measurements) {
             assert!(
                 ratio.ratio <= MAX_NOISE_RATIO,
                 "host-b {} {} {}: {} is {:.2} of the limit {}",
@@ -113,7 +114,7 @@ fn synthetic_rounding_moves_the_final_image_by_one_step_on_many_pixels() {
     for scene in ["chess", "ibl"] {
         let light = store.load(scene, "light", false).unwrap().unwrap();
         let golden = store.load(scene, "final", true).unwrap().unwrap();
-        let requantized = noise::requantize_final(&light, engine::scene::ToneMap::Aces);
+        let requantized = portability::requantize_final(&light, engine::scene::ToneMap::Aces);
         let (a, g) = (requantized.as_u8().unwrap(), golden.as_u8().unwrap());
         let mut moved = 0;
         for (p, q) in a.chunks_exact(4).zip(g.chunks_exact(4)) {

@@ -5,9 +5,9 @@
 
 mod common;
 
+use harness::golden::noise::NoiseModel;
+use harness::golden::selftest::{self, Mutation};
 use harness::golden::GoldenStore;
-use harness::noise::NoiseModel;
-use harness::selftest::{self, Mutation};
 
 #[test]
 fn every_mutation_fails_where_it_originates_and_no_noise_source_comes_near_a_limit() {
@@ -19,7 +19,7 @@ fn every_mutation_fails_where_it_originates_and_no_noise_source_comes_near_a_lim
     harness::use_ibl_cache();
     let store = GoldenStore::workspace();
     let model = NoiseModel::load(&store).unwrap();
-    let cases = harness::suite::canonical_cases().unwrap();
+    let cases = harness::golden::suite::canonical_cases().unwrap();
     let result = selftest::run(&cases, &store, &backends, &model);
     eprintln!("{}\n{}", result.margin_table(), result.noise_table());
     assert!(

@@ -180,7 +180,7 @@ fn hard_shadows_match_the_ray_cast_reference() {
             let mut backend = engine::backend::create(kind).unwrap();
             let frame = renderer::render(backend.as_mut(), &scene, Readback::All).unwrap();
             let error =
-                harness::shadow_reference::visibility_error(&scene, &frame, light, 1e-4).unwrap();
+                harness::reference::shadows::visibility_error(&scene, &frame, light, 1e-4).unwrap();
             eprintln!("{scene_name} light {light} on {kind}: {error:?}");
             assert!(
                 error.shadowed_by_reference > 1000,
@@ -403,7 +403,7 @@ fn variance_shadow_maps_agree_with_the_ray_cast_reference() {
             .step_by(4)
             .filter(|t| **t > 0.0 && **t < 1.0)
             .count();
-        let error = harness::shadow_reference::visibility_error(&scene, &frame, 0, 1e-4).unwrap();
+        let error = harness::reference::shadows::visibility_error(&scene, &frame, 0, 1e-4).unwrap();
         eprintln!("chess VSM on {kind}: {error:?}, {fractional} fractional terms");
         assert!(
             fractional > 500,

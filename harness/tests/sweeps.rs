@@ -86,12 +86,12 @@ fn chess_shadow_sweep() {
         return;
     }
     let scene = harness::load_scene("chess").unwrap().scene;
-    let rows = harness::sweep::shadow_sweep(&scene, BackendKind::Gl, 1, |_| {}).unwrap();
+    let rows = harness::measure::sweep::shadow_sweep(&scene, BackendKind::Gl, 1, |_| {}).unwrap();
     assert!(
         rows.iter().any(|r| r.is_default),
         "the default setting is swept"
     );
-    insta::assert_snapshot!(harness::sweep::stable_table(&rows));
+    insta::assert_snapshot!(harness::measure::sweep::stable_table(&rows));
 }
 
 #[test]
@@ -100,12 +100,12 @@ fn ibl_sweep() {
         return;
     }
     let scene = harness::load_scene("ibl").unwrap().scene;
-    let rows = harness::sweep::ibl_sweep(&scene, BackendKind::Gl, 1, |_| {}).unwrap();
+    let rows = harness::measure::sweep::ibl_sweep(&scene, BackendKind::Gl, 1, |_| {}).unwrap();
     assert!(
         rows.iter().any(|r| r.is_default),
         "the default setting is swept"
     );
-    insta::assert_snapshot!(harness::sweep::stable_ibl_table(&rows));
+    insta::assert_snapshot!(harness::measure::sweep::stable_ibl_table(&rows));
     // The default's error against the Monte Carlo reference, mean and p95 per material row and
     // roughness, bounded by what it is today plus a margin.
     let default = rows.iter().find(|r| r.is_default).unwrap();
@@ -134,7 +134,7 @@ fn ibl_sweep() {
 }
 
 /// The cells of a sweep row whose mean or p95 error is over the limits of the default's.
-fn ibl_over_limits(row: &harness::sweep::IblSweepRow) -> Vec<String> {
+fn ibl_over_limits(row: &harness::measure::sweep::IblSweepRow) -> Vec<String> {
     let mut over = Vec::new();
     for &(family, roughness, mean, p95) in IBL_DEFAULT_ERROR {
         let cells = &row
@@ -171,7 +171,7 @@ fn chess_gbuffer_sweep() {
         return;
     }
     let scene = harness::load_scene("chess").unwrap().scene;
-    let rows = harness::sweep::gbuffer_sweep(&scene, BackendKind::Gl, 1, |_| {}).unwrap();
+    let rows = harness::measure::sweep::gbuffer_sweep(&scene, BackendKind::Gl, 1, |_| {}).unwrap();
     // The design's claim, measured: fp16 world positions break 10 km out (p99 error over 10%),
     // camera-relative positions do not move at all, and depth reconstruction stays within 1%.
     let at = |setting: &str, distance: f64| {
@@ -183,7 +183,7 @@ fn chess_gbuffer_sweep() {
     assert_eq!(at("camera-relative/fp16", 1e4).max_relative, 0.0);
     assert!(at("depth/fp16", 1e4).p99_relative < 0.01);
     // Every setting and distance bounded by its measured p99 plus a margin (0 stays 0).
-    eprintln!("{}", harness::sweep::stable_gbuffer_table(&rows));
+    eprintln!("{}", harness::measure::sweep::stable_gbuffer_table(&rows));
     let mut over = Vec::new();
     for &(setting, distance, measured) in GBUFFER_P99 {
         let p99 = at(setting, distance).p99_relative;

@@ -8,7 +8,6 @@
 //! trusted.
 
 use std::collections::VecDeque;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, RwLock, Weak};
 
@@ -303,7 +302,7 @@ pub fn read(directory: &Path, key: &Key) -> Option<IblMaps> {
     }
 }
 
-/// Writes the entry for `key` atomically (temporary file in the same directory, then rename).
+/// Writes the entry for `key` atomically ([`crate::files::write_atomically`]).
 pub fn write(directory: &Path, key: &Key, maps: &IblMaps) -> Result<PathBuf, CacheError> {
     let err = |path: &Path| {
         let path = path.to_path_buf();
@@ -311,22 +310,6 @@ pub fn write(directory: &Path, key: &Key, maps: &IblMaps) -> Result<PathBuf, Cac
     };
     std::fs::create_dir_all(directory).map_err(err(directory))?;
     let path = directory.join(file_name(key));
-    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-    let temporary = directory.join(format!(
-        ".{}.{}.{}.tmp",
-        file_name(key),
-        std::process::id(),
-        COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
-    ));
-    let result = (|| {
-        let mut file = std::fs::File::create(&temporary)?;
-        file.write_all(&encode(key, maps))?;
-        file.sync_all()?;
-        std::fs::rename(&temporary, &path)
-    })();
-    if let Err(source) = result {
-        let _ = std::fs::remove_file(&temporary);
-        return Err(CacheError { path, source });
-    }
+    crate::files::write_atomically(&path, &encode(key, maps)).map_err(err(&path))?;
     Ok(path)
 }

@@ -52,7 +52,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::{env, fs, io, process};
 
-use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+use harness::images::{self, PngCompression};
 use image::{ExtendedColorType, ImageEncoder};
 
 type Vec3 = [f64; 3];
@@ -1152,11 +1152,8 @@ fn byte(x: f64) -> u8 {
 
 /// PNG bytes of 8-bit `data`, compressed with fixed settings.
 fn png(size: u32, data: &[u8], colour: ExtendedColorType) -> Vec<u8> {
-    let mut out = Vec::new();
-    PngEncoder::new_with_quality(&mut out, CompressionType::Best, FilterType::Adaptive)
-        .write_image(data, size, size, colour)
-        .expect("encoding a PNG into memory cannot fail");
-    out
+    images::png_bytes(data, size, size, colour, PngCompression::Smallest)
+        .expect("encoding a PNG into memory cannot fail")
 }
 
 /// The four board textures: `(file name, PNG bytes, size)`.
@@ -1372,10 +1369,7 @@ fn crate_assets() -> Vec<(String, Vec<u8>, String)> {
     .iter()
     .flat_map(|&x| ((x * 65535.0).round().clamp(0.0, 65535.0) as u16).to_ne_bytes())
     .collect();
-    let mut png16 = Vec::new();
-    PngEncoder::new_with_quality(&mut png16, CompressionType::Best, FilterType::Adaptive)
-        .write_image(&normal, 64, 64, ExtendedColorType::Rgb16)
-        .expect("encoding a PNG into memory cannot fail");
+    let png16 = png(64, &normal, ExtendedColorType::Rgb16);
     let specular = bytes8(&crate_texels(64, 64, |u, v| {
         let s = 0.35 + 0.15 * fbm(u * 4.0, v * 4.0, 53, 3);
         vec![s * 255.0; 3]

@@ -18,7 +18,7 @@ use engine::{Image, ImageData};
 
 use std::path::Path;
 
-use crate::check::CheckRun;
+use crate::golden::check::{CheckRun, Outputs};
 use crate::golden::{GoldenStore, Outcome};
 use crate::images;
 
@@ -115,8 +115,13 @@ fn data_uri(image: &Image) -> String {
     )
 }
 
-/// Outputs of the run, by (scene, pass, backend), to show in the report.
-pub type Outputs = std::collections::BTreeMap<(String, String, String), Image>;
+/// A part of the review page contributed by something other than the golden check (the
+/// benchmarks, the sweeps, the hard cases): HTML made from the results it kept in the page's
+/// folder, empty when it kept none. The report knows nothing else of what made them.
+pub trait Section {
+    /// The section's HTML from the results kept in `dir`.
+    fn html(&self, dir: &Path) -> String;
+}
 
 /// How the viewer maps a pass's values to the screen.
 fn display_mode(image: &Image, pass: &str) -> &'static str {
@@ -257,13 +262,14 @@ fn bless_html(command: &str) -> String {
 /// Writes the report as one HTML string.
 ///
 /// `page_dir` is where the page will be written (failure images under it are linked
-/// relatively); with it, the latest `harness bench` results found there are added (pass times
-/// against floors, scaling-series plots, sweeps, hard cases).
+/// relatively); with it, each of `sections` adds what it kept there (the latest bench results,
+/// sweeps and hard cases: [`crate::measure::report_sections`]).
 pub fn html(
     run: &CheckRun,
     outputs: &Outputs,
     store: &GoldenStore,
     page_dir: Option<&Path>,
+    sections: &[&dyn Section],
 ) -> String {
     let failed = run.results.iter().filter(|r| !r.outcome.passed()).count();
     let mut out = String::new();
@@ -323,9 +329,9 @@ pub fn html(
     cases(&mut out, run, outputs, store, page_dir, &mut blobs);
     details(&mut out, run);
     if let Some(dir) = page_dir {
-        out.push_str(&crate::bench::report_sections(dir));
-        out.push_str(&crate::sweep::report_sections(dir));
-        out.push_str(&crate::hard_cases::report_section(dir));
+        for section in sections {
+            out.push_str(&section.html(dir));
+        }
     }
     out.push_str(&blobs.html());
     let _ = writeln!(out, "<script>{SCRIPT}</script></body></html>");
@@ -405,7 +411,7 @@ fn cases(
             let _ = write!(
                 out,
                 "<p>If the change is intended: {}</p>",
-                bless_html(&crate::suite::bless_command(&first.scene_argument))
+                bless_html(&crate::golden::suite::bless_command(&first.scene_argument))
             );
         }
         for r in results_of(run, scene, pass) {
@@ -480,11 +486,13 @@ fn cases(
             let actual_blob = blobs.add(&bytes);
             let golden_blob =
                 *golden_blob.get_or_insert_with(|| blobs.add(&pixel_bytes(golden_image, actual).1));
-            let criterion = r.criterion.unwrap_or(crate::tolerance::PixelCriterion {
-                threshold: if kind == "u8" { 1.0 / 255.0 } else { 1e-3 },
-                floor: None,
-                channels: crate::metrics::Channels::All,
-            });
+            let criterion = r
+                .criterion
+                .unwrap_or(crate::golden::tolerance::PixelCriterion {
+                    threshold: if kind == "u8" { 1.0 / 255.0 } else { 1e-3 },
+                    floor: None,
+                    channels: crate::golden::metrics::Channels::All,
+                });
             let _ = write!(
                 out,
                 "<div class=\"viewer\" data-label=\"{}\" data-width=\"{}\" data-height=\"{}\" \
@@ -499,7 +507,7 @@ fn cases(
                 display_mode(actual, pass),
                 criterion.threshold,
                 criterion.floor.map(|f| f.to_string()).unwrap_or_default(),
-                u8::from(criterion.channels == crate::metrics::Channels::Rgb),
+                u8::from(criterion.channels == crate::golden::metrics::Channels::Rgb),
             );
         }
         out.push_str("</section>");
@@ -535,7 +543,7 @@ fn results_of<'a>(
     run: &'a CheckRun,
     scene: &'a str,
     pass: &'a str,
-) -> impl Iterator<Item = &'a crate::suite::PassCheck> + 'a {
+) -> impl Iterator<Item = &'a crate::golden::suite::PassCheck> + 'a {
     run.results
         .iter()
         .filter(move |r| r.scene == scene && r.pass == pass)

@@ -390,10 +390,7 @@ pub fn lighting_error(scene: &Scene, frame: &Frame) -> Result<LightingError, Ref
         }
     }
     errors.sort_by(f64::total_cmp);
-    let p999 = errors
-        .get(((errors.len() as f64 * 0.999).ceil() as usize).saturating_sub(1))
-        .copied()
-        .unwrap_or(0.0);
+    let p999 = engine::stats::percentile_of_sorted(&errors, 0.999);
     Ok(LightingError {
         pixels: reference.len(),
         p999_relative: p999,

@@ -25,9 +25,10 @@ use engine::scene::{Light, LightingModel, Material, Scene};
 use engine::Image;
 use glam::DQuat;
 
+use crate::golden::noise::{NoiseModel, MAX_NOISE_RATIO, MIN_MUTATION_RATIO};
+use crate::golden::portability;
+use crate::golden::suite::{self, Case};
 use crate::golden::{self, GoldenStore, Outcome};
-use crate::noise::{self, NoiseModel, MAX_NOISE_RATIO, MIN_MUTATION_RATIO};
-use crate::suite::{self, Case};
 
 /// A known change.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
@@ -244,7 +245,7 @@ pub struct MutationResult {
     pub backend: String,
     /// Whether the mutation applies to the scene (if not, nothing was rendered).
     pub applies: bool,
-    /// `value / limit` of every golden pass's rule (see [`crate::tolerance::Verdict::ratio`]).
+    /// `value / limit` of every golden pass's rule (see [`crate::golden::tolerance::Verdict::ratio`]).
     pub ratios: BTreeMap<String, f64>,
     /// Why the render failed, if it did.
     pub error: Option<String>,
@@ -586,7 +587,7 @@ fn run_case(
                     });
                 }
                 if Some(kind) == reference {
-                    let synthetic = noise::synthetic_rounding(case, &frame.outputs);
+                    let synthetic = portability::synthetic_rounding(case, &frame.outputs);
                     for (pass, ratio) in ratios(case, &goldens, &synthetic) {
                         result.noise.push(NoiseResult {
                             source: "synthetic-rounding".to_owned(),
@@ -649,7 +650,7 @@ fn run_case(
                         scene: case.name().to_owned(),
                         backend: backend.to_owned(),
                         pass: pass.clone(),
-                        ratio: crate::tolerance::ratio(value, limit, false),
+                        ratio: crate::golden::tolerance::ratio(value, limit, false),
                         live: false,
                     });
                 }

@@ -1,4 +1,4 @@
-//! Tolerances: a small tree of rules over [`crate::metrics`], read from a scene file's
+//! Tolerances: a small tree of rules over [`crate::golden::metrics`], read from a scene file's
 //! `[tolerances.<pass>]` table.
 //!
 //! A rule is a TOML table with exactly one of:
@@ -17,7 +17,7 @@
 //! | `flip_percentile` | `percentile` | that percentile of FLIP <= `max` |
 //!
 //! 8-bit differences are in 0..1 units (one step is 1/255 = 0.00392). `floor` is absolute, in the
-//! image's units: an error is `|a - g| / max(|g|, floor)` (see [`crate::metrics`]). `channels` is
+//! image's units: an error is `|a - g| / max(|g|, floor)` (see [`crate::golden::metrics`]). `channels` is
 //! `"all"` (default, but `rgb` for `relative`) or `"rgb"` (alpha left out). Any NaN or infinity
 //! in the actual image fails every rule, whatever the tree says.
 //!
@@ -30,7 +30,7 @@ use std::fmt;
 
 use engine::Image;
 
-use crate::metrics::{flip_mean, flip_stats, Channels, MetricError, Pair};
+use crate::golden::metrics::{flip_mean, flip_stats, Channels, MetricError, Pair};
 
 /// A metric with its parameters.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,7 +46,7 @@ pub enum Metric {
     FractionOver {
         /// Per-channel error that counts a pixel as over.
         threshold: f64,
-        /// Absolute floor: with one, the error is relative (see [`crate::metrics`]).
+        /// Absolute floor: with one, the error is relative (see [`crate::golden::metrics`]).
         floor: Option<f64>,
         /// Shift radius in pixels.
         shift: u32,
@@ -518,7 +518,7 @@ pub struct Verdict {
     pub checks: Vec<CheckResult>,
     /// For a failure: the largest difference and where it is.
     #[serde(default)]
-    pub largest_difference: Option<crate::metrics::LargestDifference>,
+    pub largest_difference: Option<crate::golden::metrics::LargestDifference>,
 }
 
 #[cfg(test)]

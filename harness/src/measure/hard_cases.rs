@@ -10,7 +10,7 @@ use engine::renderer::{self, Frame, Readback};
 use engine::scene::{Light, Scene};
 use glam::DVec3;
 
-use crate::{reference, shadow_reference};
+use crate::reference::{self, shadows};
 
 /// Largest value the lighting pass writes (its fp16 clamp).
 pub const FP16_SAFE_MAX: f32 = 65000.0;
@@ -136,16 +136,12 @@ fn light(frame: &Frame) -> &[f32] {
 
 /// p99 of the relative difference of two light buffers (floor 1e-2).
 fn seed_difference(a: &Frame, b: &Frame) -> f64 {
-    let mut errors: Vec<f64> = light(a)
+    let errors: Vec<f64> = light(a)
         .iter()
         .zip(light(b))
         .map(|(x, y)| f64::from((x - y).abs() / x.abs().max(1e-2)))
         .collect();
-    errors.sort_by(f64::total_cmp);
-    errors
-        .get(errors.len() * 99 / 100)
-        .copied()
-        .unwrap_or(f64::NAN)
+    engine::stats::percentile(errors, 0.99).unwrap_or(f64::NAN)
 }
 
 /// Largest |L - 1| over the pixels of every lighting model (the furnace).
@@ -226,7 +222,7 @@ pub fn run(kind: BackendKind, mut progress: impl FnMut(&str)) -> Result<Vec<Hard
                 2e-3,
             )
         } else if case == "grazing_shadow" {
-            let error = shadow_reference::visibility_error(&scene, &frame, 0, 1e-4)?;
+            let error = shadows::visibility_error(&scene, &frame, 0, 1e-4)?;
             let value = if error.shadowed_by_reference > 2000 {
                 error.fraction
             } else {
@@ -281,7 +277,7 @@ pub fn run(kind: BackendKind, mut progress: impl FnMut(&str)) -> Result<Vec<Hard
         ("chess x1000", scaled(&chess, 1e3)),
     ] {
         let frame = render(backend.as_mut(), &moved)?;
-        let diff = crate::compare::u8_difference(
+        let diff = crate::golden::compare::u8_difference(
             reference.output("final").ok_or("no final image")?,
             frame.output("final").ok_or("no final image")?,
             1,

@@ -31,6 +31,7 @@ use engine::plan::{PassSpec, RenderPlan};
 use engine::renderer::{self, Faults, Readback};
 use engine::scene::Scene;
 use engine::shaders;
+use engine::stats::median;
 
 /// Why a benchmark could not run.
 #[derive(Debug, thiserror::Error)]
@@ -210,15 +211,6 @@ fn ibl_precompute() -> Vec<Precompute> {
         }
     }
     out
-}
-
-/// The median of some values (None when empty).
-pub fn median(mut values: Vec<f64>) -> Option<f64> {
-    if values.is_empty() {
-        return None;
-    }
-    values.sort_by(f64::total_cmp);
-    Some(values[values.len() / 2])
 }
 
 /// GPU ns of plan pass `spec` in one frame's timings: the render passes named like it (a point

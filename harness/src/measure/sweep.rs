@@ -2,13 +2,13 @@
 //!
 //! `harness sweep --scene ibl --knob ibl` varies the IBL precompute (sample count, specular
 //! size, SH9 irradiance) and measures each setting's precompute time, lighting-pass time and
-//! error against the Monte Carlo reference ([`crate::ibl_reference`]) per roughness.
+//! error against the Monte Carlo reference ([`crate::reference::ibl`]) per roughness.
 //!
 //! `harness sweep --scene chess --knob shadow` renders
 //! the scene once per setting (shadow filter x map size), times the passes from GPU timestamps
 //! (median of several renders), and measures the error of the shadow term against
 //!
-//! - exact hard visibility by ray casting ([`crate::shadow_reference`]): the fraction of
+//! - exact hard visibility by ray casting ([`crate::reference::shadows`]): the fraction of
 //!   lit-surface pixels whose term is on the wrong side of 0.5, and the mean absolute difference;
 //! - the converged soft filter (`soft-reference`, 1024 samples) for the soft filters and VSM
 //!   (directional lights only): mean absolute difference.
@@ -18,8 +18,8 @@ use engine::plan;
 use engine::renderer::{self, Frame, Readback};
 use engine::scene::{Light, Scene, ShadowFilter};
 
-use crate::bench::median;
-use crate::shadow_reference;
+use crate::reference::shadows;
+use engine::stats::median;
 
 /// One setting of the sweep.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -184,7 +184,7 @@ pub fn shadow_sweep(
                 .map(|_| render(&mutated))
                 .collect::<Result<Vec<_>, _>>()?;
             let frame = &frames[0];
-            let visibility = shadow_reference::visibility_error(&mutated, frame, light, 1e-4)
+            let visibility = shadows::visibility_error(&mutated, frame, light, 1e-4)
                 .map_err(SweepError::Render)?;
             let soft = matches!(
                 filter,
@@ -256,7 +256,7 @@ pub fn stats(mut errors: Vec<f64>) -> (f64, f64, f64) {
     }
     errors.sort_by(f64::total_cmp);
     let mean = errors.iter().sum::<f64>() / errors.len() as f64;
-    let p99 = errors[(errors.len() * 99 / 100).min(errors.len() - 1)];
+    let p99 = engine::stats::percentile_of_sorted(&errors, 0.99);
     (mean, p99, errors[errors.len() - 1])
 }
 
@@ -419,14 +419,14 @@ pub struct IblSweepRow {
     /// Median GPU time of the lighting pass, ms.
     pub lighting_ms: Option<f64>,
     /// Error of the light buffer against the Monte Carlo reference, per roughness.
-    pub by_roughness: Vec<crate::ibl_reference::RoughnessError>,
+    pub by_roughness: Vec<crate::reference::ibl::RoughnessError>,
     /// Mean relative error over every reference pixel.
     pub mean_relative: f64,
     /// 99th percentile and maximum relative error over every reference pixel.
     pub p99_max_relative: (f64, f64),
     /// Mean and 95th-percentile relative error per material family (rows) and roughness
     /// (cells).
-    pub by_family: Vec<crate::ibl_reference::FamilyRow>,
+    pub by_family: Vec<crate::reference::ibl::FamilyRow>,
     /// Whether these are the default settings.
     pub is_default: bool,
     /// Whether no other setting has both a shorter precompute and a smaller mean error.
@@ -567,7 +567,7 @@ pub fn ibl_sweep(
         if references.is_none() {
             progress("Monte Carlo reference");
             references = Some(
-                crate::ibl_reference::reference_pixels(
+                crate::reference::ibl::reference_pixels(
                     scene,
                     &frames[0],
                     IBL_REFERENCE_PIXELS,
@@ -577,9 +577,9 @@ pub fn ibl_sweep(
             );
         }
         let references = references.as_deref().unwrap_or_default();
-        let by_roughness = crate::ibl_reference::error_by_roughness(&frames[0], references);
-        let by_family = crate::ibl_reference::error_by_family(&frames[0], references);
-        let (_, p99, max) = stats(crate::ibl_reference::pixel_errors(&frames[0], references));
+        let by_roughness = crate::reference::ibl::error_by_roughness(&frames[0], references);
+        let by_family = crate::reference::ibl::error_by_family(&frames[0], references);
+        let (_, p99, max) = stats(crate::reference::ibl::pixel_errors(&frames[0], references));
         let total: usize = by_roughness.iter().map(|r| r.pixels).sum();
         let mean_relative = by_roughness
             .iter()

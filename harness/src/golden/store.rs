@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 use engine::backend::DriverInfo;
 use engine::{Image, ImageData};
 
+use crate::golden::tolerance::{Rule, Verdict};
 use crate::images::{self, ImageFileError};
-use crate::tolerance::{Rule, Verdict};
 
 /// Why a golden operation failed.
 #[derive(Debug, thiserror::Error)]
@@ -243,7 +243,7 @@ pub fn check(actual: &Image, golden: Option<&Image>, rule: &Rule) -> Outcome {
 /// A diff heatmap: per-pixel largest channel difference, scaled so that `scale` maps to full
 /// intensity, on a black-red-yellow-white ramp (RGBA8).
 pub fn diff_heatmap(actual: &Image, golden: &Image, scale: f64) -> Option<Image> {
-    let pair = crate::metrics::Pair::new(actual, golden).ok()?;
+    let pair = crate::golden::metrics::Pair::new(actual, golden).ok()?;
     let differences = pair.pixel_differences();
     let mut data = Vec::with_capacity(differences.len() * 4);
     for d in differences {

@@ -19,7 +19,7 @@
 //! - a shift radius `r` makes `max_abs` and `fraction_over` forgiving of edge jitter: each actual
 //!   pixel is compared with the best-matching golden pixel within `r` pixels.
 //!
-//! Non-finite values are counted separately and always fail (see [`crate::tolerance`]).
+//! Non-finite values are counted separately and always fail (see [`crate::golden::tolerance`]).
 
 use std::borrow::Cow;
 
@@ -381,7 +381,7 @@ impl<'a> Pair<'a> {
     /// The `percentile` (0..1) of the relative error over `channels` (see
     /// [`Pair::relative_errors`]).
     pub fn relative_percentile(&self, percentile: f64, floor: f64, channels: Channels) -> f64 {
-        percentile_of_sorted(&self.relative_errors(floor, channels), percentile)
+        engine::stats::percentile_of_sorted(&self.relative_errors(floor, channels), percentile)
     }
 
     /// FLIP error map of two 8-bit images (values 0..1 per pixel).
@@ -397,15 +397,6 @@ impl<'a> Pair<'a> {
     }
 }
 
-/// The `percentile` (0..1) of an ascending list (nearest rank).
-pub fn percentile_of_sorted(sorted: &[f64], percentile: f64) -> f64 {
-    if sorted.is_empty() {
-        return 0.0;
-    }
-    let rank = ((sorted.len() as f64 * percentile).ceil() as usize).clamp(1, sorted.len());
-    sorted[rank - 1]
-}
-
 /// Mean of a FLIP error map.
 pub fn flip_mean(map: &[f32]) -> f64 {
     map.iter().map(|&v| f64::from(v)).sum::<f64>() / map.len().max(1) as f64
@@ -416,7 +407,10 @@ pub fn flip_stats(map: &[f32], percentile: f64) -> (f64, f64) {
     let mean = flip_mean(map);
     let mut sorted: Vec<f64> = map.iter().map(|&v| f64::from(v)).collect();
     sorted.sort_by(f64::total_cmp);
-    (mean, percentile_of_sorted(&sorted, percentile))
+    (
+        mean,
+        engine::stats::percentile_of_sorted(&sorted, percentile),
+    )
 }
 
 #[cfg(test)]

@@ -437,11 +437,8 @@ pub fn error_by_roughness(frame: &Frame, references: &[PixelReference]) -> Vec<R
         .map(|(key, values)| RoughnessError {
             roughness: key as f64 / 10.0,
             pixels: values.len(),
-            median_relative: {
-                let mut e: Vec<f64> = values.iter().map(|v| v.0).collect();
-                e.sort_by(f64::total_cmp);
-                e[e.len() / 2]
-            },
+            median_relative: engine::stats::median(values.iter().map(|v| v.0).collect())
+                .unwrap_or(0.0),
             mean_relative: values.iter().map(|v| v.0).sum::<f64>() / values.len() as f64,
             max_relative: values.iter().map(|v| v.0).fold(0.0, f64::max),
             reference_noise: values.iter().map(|v| v.1).sum::<f64>() / values.len() as f64,
@@ -502,7 +499,7 @@ pub fn error_by_family(frame: &Frame, references: &[PixelReference]) -> Vec<Fami
         let cell = CellError {
             roughness: key as f64 / 10.0,
             mean: errors.iter().sum::<f64>() / errors.len() as f64,
-            p95: crate::metrics::percentile_of_sorted(&errors, 0.95),
+            p95: engine::stats::percentile_of_sorted(&errors, 0.95),
             pixels: errors.len(),
         };
         match rows.iter_mut().find(|(f, _)| f == family) {

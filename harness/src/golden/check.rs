@@ -8,9 +8,12 @@ use engine::backend::{self, BackendKind};
 use engine::renderer::Frame;
 use engine::Image;
 
+use crate::golden::metrics::Channels;
+use crate::golden::suite::{self, Case, PassCheck};
 use crate::golden::{self, GoldenStore};
-use crate::metrics::Channels;
-use crate::suite::{self, Case, PassCheck};
+
+/// Every golden pass output of a run, by (scene, pass, backend), for the review page.
+pub type Outputs = BTreeMap<(String, String, String), Image>;
 
 /// A backend's status in a check run.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
@@ -35,7 +38,7 @@ pub struct CrossBackend {
     /// Second backend.
     pub b: String,
     /// Largest channel difference (8-bit in 0..1 units).
-    #[serde(deserialize_with = "crate::tolerance::null_as_infinity")]
+    #[serde(deserialize_with = "crate::golden::tolerance::null_as_infinity")]
     pub max_abs: f64,
     /// Fraction of pixels differing by more than 2/255 (8-bit) or 1e-3 relative (float, above an
     /// absolute floor of 1e-3).
@@ -68,7 +71,7 @@ pub struct CheckRun {
     pub render_errors: Vec<(String, String, String)>,
     /// Scenes that did not load (each a failed case; the others are checked as usual).
     #[serde(default)]
-    pub load_errors: Vec<crate::suite::BrokenScene>,
+    pub load_errors: Vec<crate::golden::suite::BrokenScene>,
     /// Cross-backend comparisons.
     pub cross: Vec<CrossBackend>,
     /// GPU timings.
@@ -138,7 +141,7 @@ pub fn driver_notes(cases: &[Case], store: &GoldenStore, backends: &[BackendRun]
 
 /// Compares two backends' outputs of one pass.
 pub fn cross_compare(case: &Case, pass: &str, a: &Image, b: &Image) -> Option<(f64, f64, bool)> {
-    let pair = crate::metrics::Pair::new(a, b).ok()?;
+    let pair = crate::golden::metrics::Pair::new(a, b).ok()?;
     let fraction = if golden::is_eight_bit(a) {
         pair.fraction_over(2.0 / 255.0, 0, None, Channels::All)
     } else {
@@ -158,7 +161,7 @@ pub fn run(
     only: &[BackendKind],
     failures: &std::path::Path,
     progress: impl FnMut(usize, usize, &str),
-) -> (CheckRun, crate::report::Outputs) {
+) -> (CheckRun, Outputs) {
     run_with(
         cases,
         store,
@@ -182,11 +185,11 @@ pub fn run_with(
     failures: &std::path::Path,
     create: &BackendFactory<'_>,
     mut progress: impl FnMut(usize, usize, &str),
-) -> (CheckRun, crate::report::Outputs) {
+) -> (CheckRun, Outputs) {
     for case in cases {
         suite::clear_artifacts(failures, case.name());
     }
-    let mut outputs = crate::report::Outputs::new();
+    let mut outputs = Outputs::new();
     let mut backends = Vec::new();
     let mut available = Vec::new();
     for kind in BackendKind::ALL {

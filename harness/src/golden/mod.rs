@@ -1,0 +1,17 @@
+//! Goldens: the store of blessed images and their records ([`store`], re-exported here), the
+//! tolerances and the metrics they are measured in, the canonical suite that renders and
+//! compares, the `check` run, the noise model the limits are derived from, and the mutation
+//! self-test that proves the limits catch real changes.
+
+pub mod check;
+pub mod compare;
+pub mod metrics;
+pub mod noise;
+pub mod pass_kind;
+pub mod portability;
+pub mod selftest;
+mod store;
+pub mod suite;
+pub mod tolerance;
+
+pub use store::*;
