@@ -1,6 +1,6 @@
 //! Shadow benchmarks (`cargo bench --bench shadows`): GPU time, from timestamp queries, of
 //!
-//! - a point light's six shadow faces drawn as six passes against the seed's single pass through
+//! - a point light's six shadow faces drawn as six passes against the Quarantamaula engine's single pass through
 //!   a geometry shader (gl only), on arrow;
 //! - each shadow filter on chess's sun: the map passes (`shadow_0`, and VSM's blur), and the
 //!   filter itself, timed on the lighting shader's own lookup run for every pixel (the

@@ -180,7 +180,8 @@ fn atlas_tap(p: vec3<f32>, d: vec3<f32>) -> AtlasTap {
 }
 
 // A filtered shadow lookup: the receiver's map coordinates, and for point lights what the soft
-// filters need to offset the lookup direction instead (the seed's Listing 3), so their kernels
+// filters need to offset the lookup direction instead (Listing 3 of the Quarantamaula engine
+// document), so their kernels
 // cross cube-face edges instead of being clamped at them.
 struct ShadowLookup {
     uv: vec2<f32>,
@@ -205,9 +206,9 @@ fn soft_tap(look: ShadowLookup, o: vec2<f32>) -> f32 {
     return shadow_tap(tap.uv, tap.reference, tap.bounds);
 }
 
-// The seed's stratified soft shadows (GPU Gems 2 ch. 17): the outer ring's four samples first;
-// if they agree (all lit or all shadowed) and early-out is on, that is the answer; otherwise all
-// sixteen samples are averaged.
+// Stratified soft shadows (GPU Gems 2, ch. 17, as the Quarantamaula engine uses them): the
+// outer ring's four samples first; if they agree (all lit or all shadowed) and early-out is on,
+// that is the answer; otherwise all sixteen samples are averaged.
 fn shadow_soft(look: ShadowLookup, early_out: bool) -> f32 {
     let cell = vec2<i32>(look.pixel.x & 31, look.pixel.y & 31);
     var outer = 0.0;
@@ -242,7 +243,8 @@ fn shadow_vogel(look: ShadowLookup) -> f32 {
 }
 
 // Variance shadow maps (directional lights): Chebyshev's upper bound on the lit fraction from
-// the filtered moments, with a minimum variance and light-bleeding reduction (the r2 seed).
+// the filtered moments, with a minimum variance and light-bleeding reduction (as the io7m r2
+// renderer implements GPU Gems 3, ch. 8).
 fn shadow_vsm(look: ShadowLookup) -> f32 {
     let m = textureSampleLevel(shadow_moments, moments_sampler, look.uv, 0.0);
     let mean = m.r + m.g;

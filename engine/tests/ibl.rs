@@ -98,7 +98,7 @@ fn exact_prefilter(source: &cube::CubeLevel, n: Vec3, alpha: f32) -> [f64; 3] {
     sum.map(|s| s / weight)
 }
 
-/// Issue 7: with interior.exr (a sun near 3.4e4) the prefiltered levels >= 2 have no fireflies:
+/// With interior.exr (a sun near 3.4e4) the prefiltered levels >= 2 have no fireflies:
 /// their maximum stays below 1.25x the maximum of the exact lobe convolution at that roughness
 /// (the documented bound), and the map against the exact convolution at the sun's texel and
 /// around it is close.

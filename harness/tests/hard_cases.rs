@@ -1,4 +1,4 @@
-//! Issue 8's hard cases ([`harness::measure::hard_cases`]: `scenes/hard/*.toml`, and the chess scene
+//! The hard numerical cases ([`harness::measure::hard_cases`]: `scenes/hard/*.toml`, and the chess scene
 //! moved and scaled), each with its invariant, on every available backend: no NaN/Inf in any
 //! pass, the light buffer within fp16's safe range, and the case's own check (the lighting pass
 //! against the f64 reference at p99.9 <= 2e-3 where that is defined).

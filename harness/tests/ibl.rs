@@ -1,4 +1,4 @@
-//! Image-based lighting on every available backend: the white furnace (issue 7), and renders
+//! Image-based lighting on every available backend: the white furnace, and renders
 //! that do not depend on the prefilter's sample pattern.
 
 mod common;
@@ -34,7 +34,7 @@ fn covered(frame: &Frame) -> Vec<([f32; 3], f32)> {
         .collect()
 }
 
-/// Issue 7: under a uniform environment of radiance 1, a white Lambert-only sphere returns 1
+/// under a uniform environment of radiance 1, a white Lambert-only sphere returns 1
 /// within 1%: the Lambert model (irradiance only), and PBR with no specular (F0 = 0, where the
 /// split sum's diffuse (1 - E) and specular E add up to 1).
 #[test]
@@ -75,7 +75,7 @@ fn white_lambert_sphere_returns_one() {
     }
 }
 
-/// Issue 7: a metal with F0 = 1 at roughness 1 under the uniform environment returns its
+/// a metal with F0 = 1 at roughness 1 under the uniform environment returns its
 /// directional albedo E(NoV) = 1 - NoV ln(1 + 1/NoV) within 3%, over pixels with NoV >= 0.05
 /// (below that the DFG table's first texel center, NoV = 1/128, is extrapolated by clamping).
 #[test]
@@ -114,7 +114,7 @@ fn rough_white_metal_returns_its_directional_albedo() {
     }
 }
 
-/// Issue 7: two prefilter sample seeds give IBL renders within the ibl scene's light-buffer
+/// two prefilter sample seeds give IBL renders within the ibl scene's light-buffer
 /// tolerance of each other (relative error p99 <= 2%).
 #[test]
 fn sample_seeds_give_the_same_picture() {

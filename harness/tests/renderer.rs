@@ -1,5 +1,5 @@
 //! The deferred renderer on every available backend, against the f64 reference and the
-//! invariants of issue 3: white furnace, 10 km from the origin, five lighting models, 64 lights.
+//! renderer's invariants: white furnace, 10 km from the origin, five lighting models, 64 lights.
 
 mod common;
 
@@ -21,7 +21,7 @@ fn save(name: &str, image: &Image) {
     harness::images::write_image(image, &path, harness::images::PngCompression::Fast).unwrap();
 }
 
-/// Issue 3: the lighting pass against the f64 reference on the same G-buffer, 99.9th-percentile
+/// The lighting pass against the f64 reference on the same G-buffer, 99.9th-percentile
 /// relative error <= 2e-3 and no NaN/Inf, on a grid covering roughness 0..1, metallic 0/1,
 /// clearcoat 0/1, anisotropy -1..1, Blinn-Phong exponents 1..256 and grazing silhouettes.
 #[test]

@@ -439,7 +439,7 @@ fn variance_shadow_maps_on_a_point_light_are_refused() {
     );
 }
 
-/// The seed's single-pass point shadow (a geometry shader routing each triangle to its face's
+/// The Quarantamaula engine's single-pass point shadow (its Listing 2: a geometry shader routing each triangle to its face's
 /// viewport; gl only) fills the atlas with the same depth as six passes, bit for bit, and so
 /// gives the same light buffer; a backend without geometry shaders refuses it with an error
 /// instead of silently drawing six passes.

@@ -92,8 +92,9 @@ pub fn lookup(table: &[[f32; 2]], size: u32, n_dot_v: f32, roughness: f32) -> [f
 mod tests {
     use super::*;
 
-    /// Issue 7's reference values (DFG1 = scale, DFG2 = bias), read through the table as the
-    /// lighting pass reads it.
+    /// The split-sum DFG values listed for checking in the project's reference design
+    /// (DESIGN.md, References: Filament's BRDF, GGX with the height-correlated Smith term;
+    /// DFG1 = scale, DFG2 = bias), read through the table as the lighting pass reads it.
     #[test]
     fn table_matches_the_reference_values() {
         let t = table(SIZE, SAMPLES);

@@ -5,7 +5,7 @@
 //! Feeding both the same G-buffer isolates the lighting pass's arithmetic: what is left is f32
 //! against f64 and fp16 storage of the light buffer.
 //!
-//! Error metric (issue 3): per channel, `|gpu - ref| / max(|ref|, 1e-3 * max(ref))` over every
+//! Error metric: per channel, `|gpu - ref| / max(|ref|, 1e-3 * max(ref))` over every
 //! pixel some lighting model covers; the 99.9th percentile must stay under 2e-3.
 
 use std::f64::consts::PI;
@@ -363,7 +363,7 @@ pub fn reference_light_buffer(
     Ok(out)
 }
 
-/// Compares the frame's light buffer with the reference (issue 3's metric).
+/// Compares the frame's light buffer with the reference (the metric of the module docs).
 pub fn lighting_error(scene: &Scene, frame: &Frame) -> Result<LightingError, ReferenceError> {
     let light = f32_image(frame, plan::LIGHT)?;
     let reference = reference_light_buffer(scene, frame)?;
