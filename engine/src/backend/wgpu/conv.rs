@@ -3,6 +3,7 @@
 use crate::backend::desc::*;
 use ::wgpu;
 
+/// A texture format.
 pub(super) fn format(f: TextureFormat) -> wgpu::TextureFormat {
     match f {
         TextureFormat::Rgba8Unorm => wgpu::TextureFormat::Rgba8Unorm,
@@ -14,6 +15,7 @@ pub(super) fn format(f: TextureFormat) -> wgpu::TextureFormat {
     }
 }
 
+/// A magnification or minification filter.
 pub(super) fn filter(f: FilterMode) -> wgpu::FilterMode {
     match f {
         FilterMode::Nearest => wgpu::FilterMode::Nearest,
@@ -21,6 +23,7 @@ pub(super) fn filter(f: FilterMode) -> wgpu::FilterMode {
     }
 }
 
+/// The filter between mip levels.
 pub(super) fn mipmap_filter(f: FilterMode) -> wgpu::MipmapFilterMode {
     match f {
         FilterMode::Nearest => wgpu::MipmapFilterMode::Nearest,
@@ -28,6 +31,7 @@ pub(super) fn mipmap_filter(f: FilterMode) -> wgpu::MipmapFilterMode {
     }
 }
 
+/// An address (wrap) mode.
 pub(super) fn address(a: AddressMode) -> wgpu::AddressMode {
     match a {
         AddressMode::ClampToEdge => wgpu::AddressMode::ClampToEdge,
@@ -36,6 +40,7 @@ pub(super) fn address(a: AddressMode) -> wgpu::AddressMode {
     }
 }
 
+/// A depth or sampler comparison.
 pub(super) fn compare(c: CompareFunction) -> wgpu::CompareFunction {
     match c {
         CompareFunction::Never => wgpu::CompareFunction::Never,
@@ -49,6 +54,7 @@ pub(super) fn compare(c: CompareFunction) -> wgpu::CompareFunction {
     }
 }
 
+/// A vertex attribute format.
 pub(super) fn vertex_format(f: VertexFormat) -> wgpu::VertexFormat {
     match f {
         VertexFormat::Float32 => wgpu::VertexFormat::Float32,
@@ -58,6 +64,7 @@ pub(super) fn vertex_format(f: VertexFormat) -> wgpu::VertexFormat {
     }
 }
 
+/// The dimension a texture binding is viewed with.
 pub(super) fn view_dimension(v: TextureViewKind) -> wgpu::TextureViewDimension {
     match v {
         TextureViewKind::D2 => wgpu::TextureViewDimension::D2,
@@ -66,6 +73,7 @@ pub(super) fn view_dimension(v: TextureViewKind) -> wgpu::TextureViewDimension {
     }
 }
 
+/// What a bind group slot holds.
 pub(super) fn binding_type(kind: BindingKind) -> wgpu::BindingType {
     match kind {
         BindingKind::UniformBuffer => wgpu::BindingType::Buffer {
@@ -97,6 +105,7 @@ pub(super) fn binding_type(kind: BindingKind) -> wgpu::BindingType {
     }
 }
 
+/// A blend factor.
 fn blend_factor(f: BlendFactor) -> wgpu::BlendFactor {
     match f {
         BlendFactor::Zero => wgpu::BlendFactor::Zero,
@@ -108,6 +117,7 @@ fn blend_factor(f: BlendFactor) -> wgpu::BlendFactor {
     }
 }
 
+/// The blend equation of the color or the alpha channel.
 fn blend_component(c: BlendComponent) -> wgpu::BlendComponent {
     wgpu::BlendComponent {
         src_factor: blend_factor(c.src),
@@ -122,6 +132,7 @@ fn blend_component(c: BlendComponent) -> wgpu::BlendComponent {
     }
 }
 
+/// Color and alpha blending.
 pub(super) fn blend(b: BlendState) -> wgpu::BlendState {
     wgpu::BlendState {
         color: blend_component(b.color),
@@ -129,6 +140,7 @@ pub(super) fn blend(b: BlendState) -> wgpu::BlendState {
     }
 }
 
+/// A primitive topology.
 pub(super) fn topology(t: Topology) -> wgpu::PrimitiveTopology {
     match t {
         Topology::TriangleList => wgpu::PrimitiveTopology::TriangleList,
@@ -137,6 +149,7 @@ pub(super) fn topology(t: Topology) -> wgpu::PrimitiveTopology {
     }
 }
 
+/// The faces culled (`None` culls nothing).
 pub(super) fn cull(c: CullMode) -> Option<wgpu::Face> {
     match c {
         CullMode::None => None,
@@ -145,6 +158,7 @@ pub(super) fn cull(c: CullMode) -> Option<wgpu::Face> {
     }
 }
 
+/// A buffer's usage, always with `COPY_DST` so that it can be written.
 pub(super) fn buffer_usage(u: BufferUsage) -> wgpu::BufferUsages {
     wgpu::BufferUsages::COPY_DST
         | match u {
@@ -155,9 +169,87 @@ pub(super) fn buffer_usage(u: BufferUsage) -> wgpu::BufferUsages {
         }
 }
 
+/// An index element width.
 pub(super) fn index_format(f: IndexFormat) -> wgpu::IndexFormat {
     match f {
         IndexFormat::U16 => wgpu::IndexFormat::Uint16,
         IndexFormat::U32 => wgpu::IndexFormat::Uint32,
+    }
+}
+
+/// The load operation of a color attachment.
+pub(super) fn color_load(op: LoadOp<[f32; 4]>) -> wgpu::LoadOp<wgpu::Color> {
+    match op {
+        LoadOp::Clear([r, g, b, a]) => wgpu::LoadOp::Clear(wgpu::Color {
+            r: r as f64,
+            g: g as f64,
+            b: b as f64,
+            a: a as f64,
+        }),
+        LoadOp::Load => wgpu::LoadOp::Load,
+    }
+}
+
+/// The load operation of a depth attachment.
+pub(super) fn depth_load(op: LoadOp<f32>) -> wgpu::LoadOp<f32> {
+    match op {
+        LoadOp::Clear(v) => wgpu::LoadOp::Clear(v),
+        LoadOp::Load => wgpu::LoadOp::Load,
+    }
+}
+
+/// A slot of a pipeline's bind group 0, visible to the vertex and fragment stages.
+pub(super) fn bind_group_layout_entry(b: &BindingLayout) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding: b.binding,
+        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+        ty: binding_type(b.kind),
+        count: None,
+    }
+}
+
+/// The attributes read from one vertex buffer.
+pub(super) fn vertex_attributes(layout: &VertexBufferLayout) -> Vec<wgpu::VertexAttribute> {
+    layout
+        .attributes
+        .iter()
+        .map(|a| wgpu::VertexAttribute {
+            format: vertex_format(a.format),
+            offset: a.offset as u64,
+            shader_location: a.location,
+        })
+        .collect()
+}
+
+/// A color output, written to every channel.
+pub(super) fn color_target(t: &ColorTarget) -> wgpu::ColorTargetState {
+    wgpu::ColorTargetState {
+        format: format(t.format),
+        blend: t.blend.map(blend),
+        write_mask: wgpu::ColorWrites::ALL,
+    }
+}
+
+/// Filled, counter-clockwise-front primitives of a topology and cull mode.
+pub(super) fn primitive(t: Topology, c: CullMode) -> wgpu::PrimitiveState {
+    wgpu::PrimitiveState {
+        topology: topology(t),
+        strip_index_format: None,
+        front_face: wgpu::FrontFace::Ccw,
+        cull_mode: cull(c),
+        unclipped_depth: false,
+        polygon_mode: wgpu::PolygonMode::Fill,
+        conservative: false,
+    }
+}
+
+/// Depth test and write, without stencil or bias.
+pub(super) fn depth_stencil(d: DepthState) -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: format(d.format),
+        depth_write_enabled: Some(d.write),
+        depth_compare: Some(compare(d.compare)),
+        stencil: Default::default(),
+        bias: Default::default(),
     }
 }
