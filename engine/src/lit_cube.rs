@@ -9,7 +9,7 @@ use glam::{Mat4, Vec3};
 
 use crate::backend::*;
 use crate::image::Image;
-use crate::shaders;
+use crate::{mesh, shaders};
 
 /// What one render of the lit cube produces.
 pub struct LitCubeImages {
@@ -26,42 +26,17 @@ pub struct LitCubeImages {
 /// Interleaved vertex: position, normal, uv.
 const VERTEX_FLOATS: usize = 8;
 
-/// A unit cube (-1..1) with outward normals, counter-clockwise faces and per-face UVs.
+/// A unit cube (-1..1) with outward normals, counter-clockwise faces and per-face UVs:
+/// [`mesh::cube`] in this scene's interleaved layout, with `v` flipped to grow downwards as WGSL
+/// samples (texel row 0 at `v = 0`).
 pub fn cube_mesh() -> (Vec<f32>, Vec<u16>) {
-    let faces = [
-        Vec3::X,
-        Vec3::NEG_X,
-        Vec3::Y,
-        Vec3::NEG_Y,
-        Vec3::Z,
-        Vec3::NEG_Z,
-    ];
-    let mut vertices = Vec::with_capacity(24 * VERTEX_FLOATS);
-    let mut indices = Vec::with_capacity(36);
-    for (face, n) in faces.into_iter().enumerate() {
-        let v = if n.y.abs() > 0.5 {
-            Vec3::new(0.0, 0.0, -n.y)
-        } else {
-            Vec3::Y
-        };
-        let u = v.cross(n);
-        let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
-        for (a, b) in corners {
-            let p = n + u * a + v * b;
-            vertices.extend_from_slice(&[
-                p.x,
-                p.y,
-                p.z,
-                n.x,
-                n.y,
-                n.z,
-                (a + 1.0) / 2.0,
-                (1.0 - b) / 2.0,
-            ]);
-        }
-        let base = face as u16 * 4;
-        indices.extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+    let cube = mesh::cube();
+    let mut vertices = Vec::with_capacity(cube.vertices.len() * VERTEX_FLOATS);
+    for v in &cube.vertices {
+        let ([px, py, pz], [nx, ny, nz], [tu, tv]) = (v.position, v.normal, v.uv);
+        vertices.extend_from_slice(&[px, py, pz, nx, ny, nz, tu, 1.0 - tv]);
     }
+    let indices = cube.indices.iter().map(|&i| i as u16).collect();
     (vertices, indices)
 }
 
@@ -112,6 +87,16 @@ pub fn render(backend: &mut dyn Backend, size: u32) -> Result<LitCubeImages> {
     result
 }
 
+/// The render targets of the pass.
+struct Targets {
+    /// Linear radiance, RGBA16F.
+    hdr: Handle<Texture>,
+    /// Tone-mapped sRGB, RGBA8.
+    ldr: Handle<Texture>,
+    /// D32F depth.
+    depth: Handle<Texture>,
+}
+
 fn render_with(
     backend: &mut dyn Backend,
     size: u32,
@@ -136,7 +121,44 @@ fn render_with(
         BufferUsage::Uniform,
         bytemuck::cast_slice(&globals()),
     )?;
+    let (albedo, sampler) = create_checker(backend, scope)?;
+    let targets = create_targets(backend, size, scope)?;
+    let pipeline = create_pipeline(backend, scope)?;
 
+    let draw = Draw {
+        pipeline,
+        bindings: vec![
+            Binding {
+                binding: 0,
+                resource: BindingResource::Buffer(uniforms),
+            },
+            Binding {
+                binding: 1,
+                resource: BindingResource::Texture(albedo),
+            },
+            Binding {
+                binding: 2,
+                resource: BindingResource::Sampler(sampler),
+            },
+        ],
+        vertex_buffers: vec![vertex_buffer],
+        index_buffer: Some((index_buffer, IndexFormat::U16)),
+        count: indices.len() as u32,
+    };
+    let timings = backend.submit(&[render_pass(&targets, draw)])?;
+    Ok(LitCubeImages {
+        hdr: backend.read_texture(targets.hdr, Subresource::default())?,
+        ldr: backend.read_texture(targets.ldr, Subresource::default())?,
+        depth: backend.read_texture(targets.depth, Subresource::default())?,
+        timings,
+    })
+}
+
+/// Creates and uploads the checkerboard albedo texture and its repeating sampler.
+fn create_checker(
+    backend: &mut dyn Backend,
+    scope: &mut ResourceScope,
+) -> Result<(Handle<Texture>, Handle<Sampler>)> {
     let (tex_size, texels) = checker_texture();
     let albedo = scope.texture(
         backend,
@@ -147,7 +169,15 @@ fn render_with(
         backend,
         &SamplerDesc::linear("checker", AddressMode::Repeat),
     )?;
+    Ok((albedo, sampler))
+}
 
+/// Creates the `size` x `size` HDR, LDR and depth targets.
+fn create_targets(
+    backend: &mut dyn Backend,
+    size: u32,
+    scope: &mut ResourceScope,
+) -> Result<Targets> {
     let hdr = scope.texture(
         backend,
         &TextureDesc::d2("hdr", size, size, TextureFormat::Rgba16Float),
@@ -160,7 +190,14 @@ fn render_with(
         backend,
         &TextureDesc::d2("depth", size, size, TextureFormat::Depth32Float),
     )?;
+    Ok(Targets { hdr, ldr, depth })
+}
 
+/// Creates the `lit_cube.wgsl` shader module and the pipeline drawing the cube with it.
+fn create_pipeline(
+    backend: &mut dyn Backend,
+    scope: &mut ResourceScope,
+) -> Result<Handle<Pipeline>> {
     let shader = scope.shader(
         backend,
         &ShaderDesc {
@@ -168,113 +205,94 @@ fn render_with(
             wgsl: shaders::LIT_CUBE.wgsl.to_owned(),
         },
     )?;
+    scope.pipeline(backend, &pipeline_desc(shader))
+}
+
+/// The lit cube's pipeline: [`cube_mesh`]'s vertex layout, globals + albedo + sampler bindings,
+/// HDR and LDR color outputs, depth test and back-face culling.
+fn pipeline_desc(shader: Handle<Shader>) -> PipelineDesc {
     let float = |location, format, offset| VertexAttribute {
         location,
         format,
         offset,
     };
-    let pipeline = scope.pipeline(
-        backend,
-        &PipelineDesc {
-            label: "lit cube".to_owned(),
-            shader,
-            vertex_entry: "vs_main".to_owned(),
-            fragment_entry: Some("fs_main".to_owned()),
-            vertex_buffers: vec![VertexBufferLayout {
-                stride: (VERTEX_FLOATS * 4) as u32,
-                attributes: vec![
-                    float(0, VertexFormat::Float32x3, 0),
-                    float(1, VertexFormat::Float32x3, 12),
-                    float(2, VertexFormat::Float32x2, 24),
-                ],
-            }],
-            bindings: vec![
-                BindingLayout {
-                    binding: 0,
-                    kind: BindingKind::UniformBuffer,
-                },
-                BindingLayout {
-                    binding: 1,
-                    kind: BindingKind::Texture {
-                        sample_type: TextureSampleType::Float,
-                        view: TextureViewKind::D2,
-                    },
-                },
-                BindingLayout {
-                    binding: 2,
-                    kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
-                },
+    PipelineDesc {
+        label: "lit cube".to_owned(),
+        shader,
+        vertex_entry: "vs_main".to_owned(),
+        fragment_entry: Some("fs_main".to_owned()),
+        vertex_buffers: vec![VertexBufferLayout {
+            stride: (VERTEX_FLOATS * 4) as u32,
+            attributes: vec![
+                float(0, VertexFormat::Float32x3, 0),
+                float(1, VertexFormat::Float32x3, 12),
+                float(2, VertexFormat::Float32x2, 24),
             ],
-            color_targets: vec![
-                ColorTarget {
-                    format: TextureFormat::Rgba16Float,
-                    blend: None,
+        }],
+        bindings: vec![
+            BindingLayout {
+                binding: 0,
+                kind: BindingKind::UniformBuffer,
+            },
+            BindingLayout {
+                binding: 1,
+                kind: BindingKind::Texture {
+                    sample_type: TextureSampleType::Float,
+                    view: TextureViewKind::D2,
                 },
-                ColorTarget {
-                    format: TextureFormat::Rgba8UnormSrgb,
-                    blend: None,
-                },
-            ],
-            depth: Some(DepthState {
-                format: TextureFormat::Depth32Float,
-                write: true,
-                compare: CompareFunction::Less,
-            }),
-            topology: Topology::TriangleList,
-            cull: CullMode::Back,
-            geometry: None,
-            constants: vec![],
-        },
-    )?;
+            },
+            BindingLayout {
+                binding: 2,
+                kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
+            },
+        ],
+        color_targets: vec![
+            ColorTarget {
+                format: TextureFormat::Rgba16Float,
+                blend: None,
+            },
+            ColorTarget {
+                format: TextureFormat::Rgba8UnormSrgb,
+                blend: None,
+            },
+        ],
+        depth: Some(DepthState {
+            format: TextureFormat::Depth32Float,
+            write: true,
+            compare: CompareFunction::Less,
+        }),
+        topology: Topology::TriangleList,
+        cull: CullMode::Back,
+        geometry: None,
+        constants: vec![],
+    }
+}
 
+/// The one pass: clears all three targets and runs `draw`.
+fn render_pass(targets: &Targets, draw: Draw) -> RenderPass {
     let background = [0.02, 0.02, 0.03, 1.0];
-    let timings = backend.submit(&[RenderPass {
+    RenderPass {
         name: "lit_cube".to_owned(),
         color_attachments: vec![
             ColorAttachment {
-                texture: hdr,
+                texture: targets.hdr,
                 subresource: Subresource::default(),
                 load: LoadOp::Clear(background),
             },
             ColorAttachment {
-                texture: ldr,
+                texture: targets.ldr,
                 subresource: Subresource::default(),
                 load: LoadOp::Clear(background),
             },
         ],
         depth_attachment: Some(DepthAttachment {
-            texture: depth,
+            texture: targets.depth,
             subresource: Subresource::default(),
             load: LoadOp::Clear(1.0),
         }),
         viewports: vec![],
-        draws: vec![Draw {
-            pipeline,
-            bindings: vec![
-                Binding {
-                    binding: 0,
-                    resource: BindingResource::Buffer(uniforms),
-                },
-                Binding {
-                    binding: 1,
-                    resource: BindingResource::Texture(albedo),
-                },
-                Binding {
-                    binding: 2,
-                    resource: BindingResource::Sampler(sampler),
-                },
-            ],
-            vertex_buffers: vec![vertex_buffer],
-            index_buffer: Some((index_buffer, IndexFormat::U16)),
-            count: indices.len() as u32,
-        }],
-    }])?;
-    Ok(LitCubeImages {
-        hdr: backend.read_texture(hdr, Subresource::default())?,
-        ldr: backend.read_texture(ldr, Subresource::default())?,
-        depth: backend.read_texture(depth, Subresource::default())?,
-        timings,
-    })
+        draws: vec![draw],
+    }
 }
 
 #[cfg(test)]

@@ -25,17 +25,20 @@
 mod environment;
 mod error;
 mod limits;
-mod mesh;
 mod mtl;
 mod obj;
 mod summary;
 mod text;
 mod texture;
 
+// The mesh types the loaders build are defined in `crate::mesh` (with `MeshData::from_triangles`
+// and its normal, UV and tangent processing); `super::mesh` in the loaders refers to it.
+use crate::mesh;
+
+pub use crate::mesh::{Aabb, MeshData, Vertex};
 pub use environment::{load_environment, radiance, Environment, MAX_ENVIRONMENT_TEXELS};
 pub use error::AssetError;
 pub use limits::{Budget, Limits};
-pub use mesh::{Aabb, MeshData, Vertex};
 pub use obj::{load_mtl, load_obj, MaterialData, MaterialMaps, Model};
 pub use summary::{EnvironmentSummary, MaterialSummary, MeshSummary, ModelSummary, TextureSummary};
 pub use texture::{

@@ -1,6 +1,6 @@
 //! Wavefront OBJ loading.
 //!
-//! The file is read once as bytes and pre-scanned line by line (`tobj` errors
+//! The file is read once as bytes and pre-scanned line by line (`prescan.rs`: `tobj` errors
 //! carry no line numbers and `tobj` can overflow/panic on absurd indices), so
 //! every syntax or range problem is reported as `file:line: problem` before
 //! anything is allocated from an index value. The pre-scan also produces a
@@ -19,10 +19,13 @@ use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
 use super::error::AssetError;
-use super::mesh::MeshData;
 use super::mtl::{parse_mtl_file, MapSlot, ParsedMtl};
-use super::text::LossyLines;
 use super::texture::{TextureCache, TextureId};
+use crate::mesh::MeshData;
+
+mod prescan;
+
+use prescan::{prescan, Scan, NO_MATERIAL};
 
 /// A loaded OBJ file: meshes, their materials and any load warnings.
 #[derive(Clone, Debug)]
@@ -184,16 +187,8 @@ pub fn load_obj(path: &Path, textures: &mut TextureCache) -> Result<Model, Asset
     let mut meshes = Vec::new();
     for (i, m) in models.iter().enumerate() {
         let mesh = &m.mesh;
-        let positions: Vec<[f32; 3]> = mesh
-            .positions
-            .chunks_exact(3)
-            .map(|c| [c.first(), c.get(1), c.get(2)].map(|v| v.copied().unwrap_or(0.0)))
-            .collect();
-        let normals: Vec<[f32; 3]> = mesh
-            .normals
-            .chunks_exact(3)
-            .map(|c| [c.first(), c.get(1), c.get(2)].map(|v| v.copied().unwrap_or(0.0)))
-            .collect();
+        let positions = triples(&mesh.positions);
+        let normals = triples(&mesh.normals);
         let uvs: Vec<[f32; 2]> = mesh
             .texcoords
             .chunks_exact(2)
@@ -237,6 +232,13 @@ pub fn load_obj(path: &Path, textures: &mut TextureCache) -> Result<Model, Asset
         materials,
         warnings,
     })
+}
+
+/// `tobj`'s flat `x, y, z, x, y, z, ...` array as triples (a trailing partial triple is dropped).
+fn triples(flat: &[f32]) -> Vec<[f32; 3]> {
+    flat.chunks_exact(3)
+        .map(|c| [c.first(), c.get(1), c.get(2)].map(|v| v.copied().unwrap_or(0.0)))
+        .collect()
 }
 
 /// Records a warning. It is logged at debug level only: callers report the list they get back
@@ -355,282 +357,4 @@ pub fn load_mtl(
     let lib = parse_mtl_file(path, path, None)?;
     let materials = resolve_materials(&lib, textures)?;
     Ok((materials, lib.warnings))
-}
-
-/// Result of the byte-level pre-scan.
-#[derive(Debug, Default)]
-struct Scan {
-    /// Normalized OBJ text for `tobj`.
-    normalized: String,
-    /// Line of each `mtllib` statement, in order.
-    mtllibs: Vec<usize>,
-    /// `usemtl` names with their lines.
-    usemtls: Vec<(String, usize)>,
-    positions: usize,
-    texcoords: usize,
-    normals: usize,
-    faces: usize,
-    points: usize,
-    lines: usize,
-    warnings: Vec<String>,
-}
-
-/// The material name a nameless `usemtl` is given for `tobj`: no MTL material answers to it
-/// (see `load_mtllib`), so its faces take the default material.
-const NO_MATERIAL: &str = "\u{fffd}no material\u{fffd}";
-
-/// Statements that are valid OBJ but not supported (free-form geometry etc.).
-const SILENTLY_IGNORED: &[&str] = &[
-    "s",
-    "mg",
-    "lod",
-    "shadow_obj",
-    "trace_obj",
-    "bevel",
-    "c_interp",
-    "d_interp",
-];
-
-fn prescan(path: &Path, bytes: &[u8]) -> Result<Scan, AssetError> {
-    let mut scan = Scan {
-        normalized: String::with_capacity(bytes.len()),
-        ..Default::default()
-    };
-    let (mut first_skipped, mut polygons, mut colors) = (None, 0usize, 0usize);
-    let (mut unsupported, mut first_unsupported) = (0usize, None);
-    let mut text = LossyLines::default();
-    // Statements skipped because they name nothing (`usemtl` or `mtllib` alone).
-    let mut unnamed: Vec<(String, usize)> = Vec::new();
-    for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
-        let lineno = i + 1;
-        let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
-        let decoded = text.decode(lineno, raw);
-        let mut line = decoded.trim();
-        // Inline comments on element lines (names and file paths may contain '#').
-        if matches!(
-            line.split_whitespace().next(),
-            Some("v" | "vt" | "vn" | "f" | "l" | "p")
-        ) {
-            line = line
-                .split_once('#')
-                .map_or(line, |(before, _)| before)
-                .trim_end();
-        }
-        let mut toks = line.split_whitespace();
-        let Some(key) = toks.next() else { continue };
-        let rest = line.get(key.len()..).unwrap_or("").trim();
-        let err = |msg: String| AssetError::parse(path, lineno, msg);
-        match key {
-            k if k.starts_with('#') => {}
-            "v" => {
-                let vals: Vec<&str> = toks.take(8).collect();
-                if vals.len() < 3 {
-                    return Err(err(format!(
-                        "vertex has {} coordinates, need 3",
-                        vals.len()
-                    )));
-                }
-                let mut out = String::from("v");
-                for (j, t) in vals.iter().enumerate() {
-                    let is_w = vals.len() == 4 && j == 3;
-                    if j >= 3 && !is_w {
-                        colors += 1;
-                        break;
-                    }
-                    let v = parse_finite(t).map_err(|m| err(format!("vertex {m}")))?;
-                    if is_w && v == 0.0 {
-                        return Err(err("vertex w is zero".to_string()));
-                    }
-                    out.push(' ');
-                    out.push_str(t);
-                }
-                push_line(&mut scan.normalized, &out);
-                scan.positions += 1;
-            }
-            "vt" => {
-                let vals: Vec<&str> = toks.take(3).collect();
-                let Some(u) = vals.first() else {
-                    return Err(err("texture coordinate has no values".to_string()));
-                };
-                let v = vals.get(1).copied().unwrap_or("0");
-                for t in [*u, v] {
-                    parse_finite(t).map_err(|m| err(format!("texture coordinate {m}")))?;
-                }
-                push_line(&mut scan.normalized, &format!("vt {u} {v}"));
-                scan.texcoords += 1;
-            }
-            "vn" => {
-                let vals: Vec<&str> = toks.take(4).collect();
-                if vals.len() < 3 {
-                    return Err(err(format!("normal has {} components, need 3", vals.len())));
-                }
-                let mut out = String::from("vn");
-                for t in vals.iter().take(3) {
-                    parse_finite(t).map_err(|m| err(format!("normal {m}")))?;
-                    out.push(' ');
-                    out.push_str(t);
-                }
-                push_line(&mut scan.normalized, &out);
-                scan.normals += 1;
-            }
-            "f" => {
-                let mut count = 0usize;
-                for t in toks {
-                    check_face_vertex(t, [scan.positions, scan.texcoords, scan.normals])
-                        .map_err(&err)?;
-                    count += 1;
-                }
-                if count < 3 {
-                    return Err(err(format!("face has {count} vertices, need at least 3")));
-                }
-                if count > 3 {
-                    polygons += 1;
-                }
-                scan.faces += 1;
-                push_line(&mut scan.normalized, &format!("f {rest}"));
-            }
-            "l" | "p" => {
-                if key == "l" {
-                    scan.lines += 1;
-                } else {
-                    scan.points += 1;
-                }
-                first_skipped.get_or_insert(lineno);
-            }
-            "o" | "g" => push_line(&mut scan.normalized, &format!("{key} {rest}")),
-            "usemtl" | "mtllib" => {
-                if rest.is_empty() {
-                    unnamed.push((key.to_string(), lineno));
-                    if key == "usemtl" {
-                        // The faces after it take the default material, as after a name that
-                        // no MTL defines.
-                        push_line(&mut scan.normalized, &format!("usemtl {NO_MATERIAL}"));
-                    }
-                    continue;
-                }
-                if key == "usemtl" {
-                    scan.usemtls.push((rest.to_string(), lineno));
-                } else {
-                    scan.mtllibs.push(lineno);
-                }
-                push_line(&mut scan.normalized, &format!("{key} {rest}"));
-            }
-            k if SILENTLY_IGNORED.contains(&k) => {}
-            k => {
-                unsupported += 1;
-                first_unsupported.get_or_insert((k.to_string(), lineno));
-            }
-        }
-    }
-    let p = path.display();
-    let mut notes = Vec::new();
-    notes.extend(text.warning(path));
-    for (key, line) in unnamed {
-        let what = if key == "usemtl" {
-            "the faces after it use the default material"
-        } else {
-            "ignored"
-        };
-        notes.push(format!("{p}:{line}: `{key}` without a name; {what}"));
-    }
-    if let Some(line) = first_skipped {
-        notes.push(format!(
-            "{p}:{line}: skipped {} point (p) and {} line (l) elements (only faces are rendered)",
-            scan.points, scan.lines
-        ));
-    }
-    if polygons > 0 {
-        notes.push(format!(
-            "{p}: triangulated {polygons} polygons with more than 3 vertices"
-        ));
-    }
-    if colors > 0 {
-        notes.push(format!("{p}: ignored vertex colours on {colors} vertices"));
-    }
-    if let Some((k, line)) = first_unsupported {
-        notes.push(format!(
-            "{p}:{line}: ignored {unsupported} unsupported statements (first: `{k}`)"
-        ));
-    }
-    for msg in notes {
-        warn(&mut scan.warnings, msg);
-    }
-    Ok(scan)
-}
-
-fn push_line(out: &mut String, line: &str) {
-    out.push_str(line);
-    out.push('\n');
-}
-
-fn parse_finite(t: &str) -> Result<f32, String> {
-    let v: f32 = t.parse().map_err(|_| format!("has invalid number `{t}`"))?;
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(format!("has non-finite value `{t}`"))
-    }
-}
-
-const INDEX_KINDS: [(&str, &str); 3] = [
-    ("face index", "positions"),
-    ("texture coordinate index", "texture coordinates"),
-    ("normal index", "normals"),
-];
-
-/// Checks one `v`, `v/vt`, `v//vn` or `v/vt/vn` face vertex against the
-/// element counts seen so far. Never allocates based on an index value.
-fn check_face_vertex(tok: &str, counts: [usize; 3]) -> Result<(), String> {
-    for (k, part) in tok.split('/').enumerate() {
-        let (Some((kind, plural)), Some(&count)) = (INDEX_KINDS.get(k), counts.get(k)) else {
-            return Err(format!("face vertex `{tok}` has more than 3 components"));
-        };
-        if part.is_empty() {
-            if k == 0 {
-                return Err(format!("face vertex `{tok}` has no position index"));
-            }
-            continue;
-        }
-        let count_u = count as u64;
-        match part.parse::<i64>() {
-            Ok(0) => return Err(format!("{kind} 0 is invalid (OBJ indices start at 1)")),
-            Ok(x) if x > 0 && x.unsigned_abs() > count_u => {
-                return Err(format!("{kind} {x} out of range ({count} {plural})"))
-            }
-            Ok(x) if x < 0 && x.unsigned_abs() > count_u => {
-                return Err(format!(
-                    "relative {kind} {x} out of range ({count} {plural})"
-                ))
-            }
-            Ok(_) => {}
-            Err(_) => {
-                let digits = part.strip_prefix(['-', '+']).unwrap_or(part);
-                if !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) {
-                    return Err(format!("{kind} {part} out of range ({count} {plural})"));
-                }
-                return Err(format!("invalid {kind} `{part}`"));
-            }
-        }
-    }
-    Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn face_vertex_checks() {
-        let c = [3, 2, 1];
-        assert_eq!(check_face_vertex("1", c), Ok(()));
-        assert_eq!(check_face_vertex("-3/-2/-1", c), Ok(()));
-        assert_eq!(check_face_vertex("3//1", c), Ok(()));
-        assert!(check_face_vertex("4", c).is_err_and(|e| e.contains("4 out of range")));
-        assert!(check_face_vertex("1/3", c).is_err_and(|e| e.contains("texture coordinate")));
-        assert!(check_face_vertex("1/1/2", c).is_err_and(|e| e.contains("normal index 2")));
-        assert!(check_face_vertex("1/1/1/1", c).is_err_and(|e| e.contains("more than 3")));
-        assert!(check_face_vertex("/1", c).is_err_and(|e| e.contains("no position")));
-        assert!(check_face_vertex("x", c).is_err_and(|e| e.contains("invalid face index")));
-        assert!(check_face_vertex("-9223372036854775808", c).is_err());
-    }
 }
