@@ -1,0 +1,424 @@
+//! [`RenderPlan::new`], stage by stage: the screen-sized targets, each shadowed light's maps and
+//! passes, geometry and shader mask, the environment's passes, one lighting pass per model, the
+//! shadow-term debug outputs, then tone mapping and gizmos.
+
+use crate::backend::TextureFormat;
+use crate::scene::{Light, LightingModel, Scene, ShadowFilter, ShadowSettings};
+
+use super::lighting::{lighting_passes, LightingPass};
+use super::target_names::{
+    mask_target_name, shadow_blur_target_name, shadow_moments_target_name, shadow_target_name,
+    shadow_term_target_name, DEPTH, FINAL, GBUFFER_TARGETS, LIGHT, ROUTE,
+};
+use super::{MaskChannel, PassKind, PassSpec, RenderPlan, TargetSpec};
+
+impl RenderPlan {
+    /// Builds the plan for a scene.
+    pub fn new(scene: &Scene) -> Self {
+        let models = scene.lighting_models();
+        let mask_channels = mask_channels(&models);
+        let mask_targets = models.len().div_ceil(4);
+        let mut targets = screen_targets(scene, &models, &mask_channels, mask_targets);
+        let casters = scene.objects.iter().filter(|o| o.casts_shadows).count();
+        let ShadowStage {
+            targets: shadow_targets,
+            passes: shadow_passes,
+            lights: shadowed,
+            maps: shadow_maps,
+        } = ShadowStage::new(scene, casters);
+        targets.extend(shadow_targets);
+
+        let masks: Vec<String> = (0..mask_targets).map(mask_target_name).collect();
+        let gbuffer: Vec<String> = GBUFFER_TARGETS.iter().map(|s| (*s).to_owned()).collect();
+        let mut passes = shadow_passes;
+        passes.push(geometry_pass(scene, &gbuffer));
+        passes.push(mask_pass(&models, &masks));
+        passes.extend(environment_passes(scene, &masks));
+        let lighting = lighting_passes(scene, &models, casters > 0);
+        passes.extend(lighting_pass_specs(
+            scene,
+            &mask_channels,
+            &lighting,
+            &gbuffer,
+            &shadow_maps,
+        ));
+        if scene.quality.debug_shadow_terms {
+            for &light in &shadowed {
+                let (target, pass) = shadow_term_output(scene, light, &gbuffer, &shadow_maps);
+                targets.push(target);
+                passes.push(pass);
+            }
+        }
+        passes.extend(output_passes(scene));
+        Self {
+            scene: scene.name.clone(),
+            width: scene.quality.width,
+            height: scene.quality.height,
+            targets,
+            passes,
+            mask_channels,
+            lighting,
+        }
+    }
+}
+
+/// Each used lighting model's mask channel: four to a mask target, in the models' order.
+fn mask_channels(models: &[LightingModel]) -> Vec<MaskChannel> {
+    models
+        .iter()
+        .enumerate()
+        .map(|(i, &model)| MaskChannel {
+            model,
+            target: i / 4,
+            channel: i % 4,
+        })
+        .collect()
+}
+
+/// The targets of the output's size: G-buffer, depth, masks, the lighting passes' routing depth
+/// (when any model is used), the light buffer and the final image.
+fn screen_targets(
+    scene: &Scene,
+    models: &[LightingModel],
+    mask_channels: &[MaskChannel],
+    mask_targets: usize,
+) -> Vec<TargetSpec> {
+    let gbuffer_contents = [
+        "xyz camera-relative position, w roughness",
+        "xyz normal (normal-mapped), w specular",
+        "xyz tangent, w handedness",
+        "rgb base color, a anisotropy",
+        "r metallic, g clearcoat, b clearcoat roughness, a specular exponent",
+    ];
+    let mut targets: Vec<TargetSpec> = GBUFFER_TARGETS
+        .iter()
+        .zip(gbuffer_contents)
+        .map(|(name, contents)| TargetSpec {
+            name: (*name).to_owned(),
+            format: TextureFormat::Rgba16Float,
+            width: scene.quality.width,
+            height: scene.quality.height,
+            contents: contents.to_owned(),
+        })
+        .collect();
+    targets.push(TargetSpec {
+        name: DEPTH.to_owned(),
+        format: TextureFormat::Depth32Float,
+        width: scene.quality.width,
+        height: scene.quality.height,
+        contents: "depth, 0 near .. 1 far".to_owned(),
+    });
+    for index in 0..mask_targets {
+        let channels: Vec<String> = mask_channels
+            .iter()
+            .filter(|c| c.target == index)
+            .map(|c| format!("{} {}", ["r", "g", "b", "a"][c.channel], c.model))
+            .collect();
+        targets.push(TargetSpec {
+            name: mask_target_name(index),
+            format: TextureFormat::Rgba8Unorm,
+            width: scene.quality.width,
+            height: scene.quality.height,
+            contents: channels.join(", "),
+        });
+    }
+    if !models.is_empty() {
+        targets.push(TargetSpec {
+            name: ROUTE.to_owned(),
+            format: TextureFormat::Depth32Float,
+            width: scene.quality.width,
+            height: scene.quality.height,
+            contents: "lighting routing: 0 where the last lighting pass's model shades, else 1"
+                .to_owned(),
+        });
+    }
+    targets.push(TargetSpec {
+        name: LIGHT.to_owned(),
+        format: TextureFormat::Rgba16Float,
+        width: scene.quality.width,
+        height: scene.quality.height,
+        contents: format!("exposed radiance (exposure {})", scene.quality.exposure),
+    });
+    targets.push(TargetSpec {
+        name: FINAL.to_owned(),
+        format: TextureFormat::Rgba8UnormSrgb,
+        width: scene.quality.width,
+        height: scene.quality.height,
+        contents: format!("{} tone-mapped, sRGB", scene.quality.tone_map.name()),
+    });
+    targets
+}
+
+/// The shadow maps' part of a plan.
+struct ShadowStage {
+    /// Each shadowed light's map, VSM moments and VSM blur intermediate.
+    targets: Vec<TargetSpec>,
+    /// Their caster and blur passes, light by light.
+    passes: Vec<PassSpec>,
+    /// The shadowed lights.
+    lights: Vec<usize>,
+    /// The maps the lighting passes read.
+    maps: Vec<String>,
+}
+
+impl ShadowStage {
+    /// The maps and passes of every light with shadow settings (none when nothing casts).
+    fn new(scene: &Scene, casters: usize) -> Self {
+        let mut stage = Self {
+            targets: Vec::new(),
+            passes: Vec::new(),
+            lights: Vec::new(),
+            maps: Vec::new(),
+        };
+        for (index, light) in scene.lights.iter().enumerate() {
+            let (settings, point) = match light {
+                Light::Directional { shadow, .. } => (shadow, false),
+                Light::Point { shadow, .. } => (shadow, true),
+            };
+            let Some(settings) = settings.filter(|_| casters > 0) else {
+                continue;
+            };
+            stage.add_light(scene, index, settings, point, casters);
+        }
+        stage
+    }
+
+    /// Light `index`'s map (a point light's six-face atlas), its VSM moments, and the caster
+    /// pass that writes them, then the VSM blur.
+    fn add_light(
+        &mut self,
+        scene: &Scene,
+        index: usize,
+        settings: ShadowSettings,
+        point: bool,
+        casters: usize,
+    ) {
+        let n = settings.map_size;
+        let name = shadow_target_name(index);
+        self.targets.push(TargetSpec {
+            name: name.clone(),
+            format: TextureFormat::Depth32Float,
+            width: if point { 3 * n } else { n },
+            height: if point { 2 * n } else { n },
+            contents: if point {
+                format!("point light {index}: six {n}x{n} faces (+X -X +Y / -Y +Z -Z), perspective depth")
+            } else {
+                format!("directional light {index}: orthographic depth fitted to the casters")
+            },
+        });
+        self.lights.push(index);
+        self.maps.push(name.clone());
+        let mut writes = vec![name.clone()];
+        let vsm = settings.filter == ShadowFilter::Vsm;
+        if vsm {
+            let moments = shadow_moments_target_name(index);
+            self.targets.push(TargetSpec {
+                name: moments.clone(),
+                format: TextureFormat::Rgba16Float,
+                width: n,
+                height: n,
+                contents: format!(
+                    "light {index} VSM moments: depth (r + g), depth^2 (b + a), blurred"
+                ),
+            });
+            writes.push(moments.clone());
+            self.maps.push(moments);
+        }
+        self.passes.push(PassSpec {
+            name: name.clone(),
+            kind: PassKind::Shadow { light: index },
+            reads: vec![],
+            writes,
+            detail: format!(
+                "{casters} casters{}, filter {}, bias {} m, slope {} texels, normal offset {} texels",
+                if point {
+                    format!(" x 6 faces ({})", scene.quality.point_shadows.name())
+                } else {
+                    String::new()
+                },
+                settings.filter.name(),
+                settings.bias,
+                settings.slope_bias,
+                settings.normal_offset
+            ),
+        });
+        if vsm && settings.vsm_blur_radius > 0 {
+            self.add_vsm_blur(index, &name, settings);
+        }
+    }
+
+    /// The separable Gaussian blur of light `index`'s VSM moments: along x into the blur
+    /// target, then along y back into the moments.
+    fn add_vsm_blur(&mut self, index: usize, name: &str, settings: ShadowSettings) {
+        let n = settings.map_size;
+        let moments = shadow_moments_target_name(index);
+        let blur = shadow_blur_target_name(index);
+        self.targets.push(TargetSpec {
+            name: blur.clone(),
+            format: TextureFormat::Rgba16Float,
+            width: n,
+            height: n,
+            contents: format!("light {index} VSM moments blurred along x"),
+        });
+        let radius = settings.vsm_blur_radius;
+        for (axis, reads, writes) in [("x", &moments, &blur), ("y", &blur, &moments)] {
+            self.passes.push(PassSpec {
+                name: format!("{name}_blur_{axis}"),
+                kind: PassKind::ShadowBlur { light: index },
+                reads: vec![reads.clone()],
+                writes: vec![writes.clone()],
+                detail: format!("Gaussian along {axis}, radius {radius} texels"),
+            });
+        }
+    }
+}
+
+/// Every object into the G-buffer and depth.
+fn geometry_pass(scene: &Scene, gbuffer: &[String]) -> PassSpec {
+    let objects = scene.objects.len();
+    let triangles: usize = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
+    PassSpec {
+        name: "geometry".to_owned(),
+        kind: PassKind::Geometry,
+        reads: vec![],
+        writes: gbuffer.iter().cloned().chain([DEPTH.to_owned()]).collect(),
+        detail: format!("{objects} objects, {triangles} triangles"),
+    }
+}
+
+/// Every object's lighting-model channel into the mask targets.
+fn mask_pass(models: &[LightingModel], masks: &[String]) -> PassSpec {
+    PassSpec {
+        name: "mask".to_owned(),
+        kind: PassKind::ShaderMask,
+        reads: vec![DEPTH.to_owned()],
+        writes: masks.to_vec(),
+        detail: format!(
+            "{} models: {}",
+            models.len(),
+            models
+                .iter()
+                .map(|m| m.name())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// With an environment: the IBL precompute on the CPU and the skybox; none without.
+fn environment_passes(scene: &Scene, masks: &[String]) -> Vec<PassSpec> {
+    let Some(environment) = &scene.environment else {
+        return Vec::new();
+    };
+    vec![
+        PassSpec {
+            name: "ibl_precompute".to_owned(),
+            kind: PassKind::IblPrecompute,
+            reads: vec![],
+            writes: vec![],
+            detail: format!("CPU, cached: {}", scene.quality.ibl.describe()),
+        },
+        PassSpec {
+            name: "skybox".to_owned(),
+            kind: PassKind::Skybox,
+            reads: masks.to_vec(),
+            writes: vec![LIGHT.to_owned()],
+            detail: format!(
+                "{}x{} equirectangular, rotation {} deg, intensity {}",
+                environment.image.width,
+                environment.image.height,
+                environment.rotation_degrees,
+                environment.intensity
+            ),
+        },
+    ]
+}
+
+/// One lighting pass per used model, in mask-channel order; every model but unlit reads the
+/// shadow maps.
+fn lighting_pass_specs(
+    scene: &Scene,
+    mask_channels: &[MaskChannel],
+    lighting: &[LightingPass],
+    gbuffer: &[String],
+    shadow_maps: &[String],
+) -> Vec<PassSpec> {
+    mask_channels
+        .iter()
+        .zip(lighting)
+        .map(|(channel, pass)| {
+            let mut reads = gbuffer.to_vec();
+            reads.push(mask_target_name(channel.target));
+            if channel.model != LightingModel::Unlit {
+                reads.extend(shadow_maps.iter().cloned());
+            }
+            PassSpec {
+                name: format!("lighting_{}", channel.model.name().replace('-', "_")),
+                kind: PassKind::Lighting(channel.model),
+                reads,
+                writes: vec![ROUTE.to_owned(), LIGHT.to_owned()],
+                detail: if channel.model == LightingModel::Unlit {
+                    "1 draw, no lights, routed by depth test".to_owned()
+                } else {
+                    format!(
+                        "{} light(s) in {} draw(s), additive, routed by depth test",
+                        scene.lights.len(),
+                        pass.draws.len()
+                    )
+                },
+            }
+        })
+        .collect()
+}
+
+/// Debug: the target and pass that write shadowed light `light`'s shadow term per pixel.
+fn shadow_term_output(
+    scene: &Scene,
+    light: usize,
+    gbuffer: &[String],
+    shadow_maps: &[String],
+) -> (TargetSpec, PassSpec) {
+    let name = shadow_term_target_name(light);
+    let target = TargetSpec {
+        name: name.clone(),
+        format: TextureFormat::Rgba16Float,
+        width: scene.quality.width,
+        height: scene.quality.height,
+        contents: format!("debug: light {light}'s shadow term (1 = lit)"),
+    };
+    let mut reads = gbuffer.to_vec();
+    reads.push(shadow_target_name(light));
+    let moments = shadow_moments_target_name(light);
+    if shadow_maps.contains(&moments) {
+        reads.push(moments);
+    }
+    let pass = PassSpec {
+        name: name.clone(),
+        kind: PassKind::ShadowTerm { light },
+        reads,
+        writes: vec![name],
+        detail: "debug output of the lighting pass's shadow lookup".to_owned(),
+    };
+    (target, pass)
+}
+
+/// Tone mapping into the final image, then the gizmos over it when the quality settings ask.
+fn output_passes(scene: &Scene) -> Vec<PassSpec> {
+    let mut passes = vec![PassSpec {
+        name: "tonemap".to_owned(),
+        kind: PassKind::ToneMap,
+        reads: vec![LIGHT.to_owned()],
+        writes: vec![FINAL.to_owned()],
+        detail: scene.quality.tone_map.name().to_owned(),
+    }];
+    if scene.quality.gizmos {
+        passes.push(PassSpec {
+            name: "gizmos".to_owned(),
+            kind: PassKind::Gizmos,
+            reads: vec![],
+            writes: vec![FINAL.to_owned()],
+            detail: "axes, light directions, point-light markers; no depth test".to_owned(),
+        });
+    }
+    passes
+}

@@ -1,0 +1,107 @@
+//! The plan as text: the `Display` of [`RenderPlan`] (what the insta snapshots hold) and of
+//! [`LightingVariant`] (one line per lighting draw).
+
+use std::fmt;
+
+use crate::backend::TextureFormat;
+use crate::scene::ShadowFilter;
+
+use super::{LightingVariant, PassKind, RenderPlan, ShadowKind};
+
+fn format_name(format: TextureFormat) -> &'static str {
+    match format {
+        TextureFormat::Rgba8Unorm => "rgba8",
+        TextureFormat::Rgba8UnormSrgb => "rgba8-srgb",
+        TextureFormat::Rgba16Float => "rgba16f",
+        TextureFormat::Rgba32Float => "rgba32f",
+        TextureFormat::R32Float => "r32f",
+        TextureFormat::Depth32Float => "depth32f",
+    }
+}
+
+impl fmt::Display for RenderPlan {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "scene {} at {}x{}", self.scene, self.width, self.height)?;
+        writeln!(f, "targets:")?;
+        for t in &self.targets {
+            writeln!(
+                f,
+                "  {:<17} {:<10} {:<9} {}",
+                t.name,
+                format_name(t.format),
+                format!("{}x{}", t.width, t.height),
+                t.contents
+            )?;
+        }
+        writeln!(f, "passes:")?;
+        for (i, p) in self.passes.iter().enumerate() {
+            writeln!(f, "  {}. {:<21} {}", i + 1, p.name, p.detail)?;
+            if let PassKind::Lighting(model) = p.kind {
+                if let Some(r) = self
+                    .lighting
+                    .iter()
+                    .find(|l| l.model == model)
+                    .and_then(|l| l.rect)
+                {
+                    writeln!(
+                        f,
+                        "       pixels {}..{} x {}..{} (its objects' screen bounds)",
+                        r.x,
+                        r.x + r.width,
+                        r.y,
+                        r.y + r.height
+                    )?;
+                }
+                for (d, draw) in self.lighting_draws(model).iter().enumerate() {
+                    writeln!(f, "       draw {}: {}", d + 1, draw.variant)?;
+                }
+            }
+            if !p.reads.is_empty() {
+                writeln!(f, "       reads  {}", p.reads.join(", "))?;
+            }
+            if !p.writes.is_empty() {
+                writeln!(f, "       writes {}", p.writes.join(", "))?;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl fmt::Display for LightingVariant {
+    /// e.g. `1 directional, shadow directional pcf3, clearcoat, gbuffer camera-relative/fp16`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let types = match (self.directional, self.point) {
+            (true, true) => " directional+point",
+            (true, false) => " directional",
+            (false, true) => " point",
+            (false, false) => "",
+        };
+        write!(f, "{}{types} light(s)", self.lights)?;
+        if let Some((kind, filter)) = self.shadow {
+            let kind = match kind {
+                ShadowKind::Directional => "directional",
+                ShadowKind::Point => "point",
+            };
+            write!(f, ", shadow {kind} {}", filter.name())?;
+            if self.vogel_samples > 0 && filter == ShadowFilter::Vogel {
+                write!(f, " ({} samples)", self.vogel_samples)?;
+            }
+        }
+        if self.ibl && self.ibl_samples > 0 {
+            write!(f, ", ibl ({} samples)", self.ibl_samples)?;
+        }
+        for (on, name) in [
+            (self.sun_disc, "sun disc"),
+            (self.ibl && self.ibl_samples == 0, "ibl"),
+            (self.clearcoat, "clearcoat"),
+            (self.anisotropy, "anisotropy"),
+            (self.input_floor, "input floor"),
+            (self.keep_inputs, "keep inputs"),
+        ] {
+            if on {
+                write!(f, ", {name}")?;
+            }
+        }
+        write!(f, ", gbuffer {}", self.gbuffer.name())
+    }
+}
