@@ -1,0 +1,166 @@
+//! `harness bench`: GPU timings of every pass against its floor, scaling series, and the
+//! breakdown of the lighting passes, kept for the check report.
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use engine::backend::BackendKind;
+
+use super::scenes_or_canonical;
+
+/// `harness bench`: times every pass of each scene asked for (every canonical one by default)
+/// on each backend (every one by default) and keeps bench.json in `out`; exits 1 when a
+/// backend asked for is missing or a scene fails to render.
+pub(crate) fn pass_table(
+    scenes: &[String],
+    backends: &[BackendKind],
+    frames: usize,
+    out: &Path,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    let names = scenes_or_canonical(scenes);
+    let loaded = names
+        .iter()
+        .map(|n| harness::load_scene(n).map(|l| l.scene))
+        .collect::<Result<Vec<_>, _>>()?;
+    let kinds: Vec<BackendKind> = if backends.is_empty() {
+        BackendKind::ALL.to_vec()
+    } else {
+        backends.to_vec()
+    };
+    let mut results = Vec::new();
+    let mut failed = false;
+    for kind in kinds {
+        if let Err(e) = engine::backend::create(kind) {
+            eprintln!("skipping {kind}: {e}");
+            if !backends.is_empty() {
+                failed = true;
+            }
+            continue;
+        }
+        for scene in &loaded {
+            eprintln!("timing {} on {kind} ({frames} frames) ...", scene.name);
+            match harness::measure::bench::bench_scene(scene, kind, frames) {
+                Ok(result) => {
+                    if !json {
+                        println!("{}", harness::measure::bench::table(&result));
+                    }
+                    results.push(result);
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    failed = true;
+                }
+            }
+        }
+    }
+    let precompute = harness::measure::bench::precompute();
+    if !json {
+        println!("precomputation (apart from frames):");
+        for p in &precompute {
+            println!("  {:<44} {:>8.3} ms  ({})", p.what, p.ms, p.on);
+        }
+    }
+    let text = serde_json::to_string_pretty(
+        &serde_json::json!({ "precompute": precompute, "scenes": results }),
+    )?;
+    save_bench_json(out, harness::measure::bench::BENCH_JSON, &text)?;
+    if json {
+        println!("{text}");
+    }
+    Ok(if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// `harness bench --series`: the scaling series named (`all` for every one) on each backend
+/// asked for (gl by default), kept as bench_series.json in `out`.
+pub(crate) fn series(
+    names: &[String],
+    backends: &[BackendKind],
+    frames: usize,
+    out: &Path,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    let names: Vec<String> = if names.iter().any(|n| n == "all") {
+        harness::measure::bench::SERIES
+            .iter()
+            .map(|s| (*s).to_owned())
+            .collect()
+    } else {
+        names.to_vec()
+    };
+    let kinds = backends_or_gl(backends);
+    let mut all = Vec::new();
+    for kind in kinds {
+        for name in &names {
+            let points = harness::measure::bench::series(name, kind, frames, |what| {
+                eprintln!("  {kind}: {what} ...");
+            })?;
+            if !json {
+                println!("{name} series on {kind} (median of {frames} frames, GPU ms)");
+                println!("{}", harness::measure::bench::series_table(&points));
+            }
+            all.push(serde_json::json!({ "backend": kind.name(), "points": points }));
+        }
+    }
+    let text = serde_json::to_string_pretty(&all)?;
+    save_bench_json(out, harness::measure::bench::SERIES_JSON, &text)?;
+    if json {
+        println!("{text}");
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `harness bench --breakdown`: each lighting pass's cost, part by part.
+pub(crate) fn breakdown(
+    scenes: &[String],
+    backends: &[BackendKind],
+    frames: usize,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    let names = scenes_or_canonical(scenes);
+    let kinds = backends_or_gl(backends);
+    let mut all = Vec::new();
+    for kind in kinds {
+        for name in &names {
+            let scene = harness::load_scene(name)?.scene;
+            let passes = harness::measure::bench::breakdown(&scene, kind, frames, |what| {
+                eprintln!("  {} on {kind}: {what} ({frames} frames) ...", scene.name);
+            })?;
+            if !json {
+                for pass in &passes {
+                    println!("{}", harness::measure::bench::breakdown_table(pass));
+                }
+            }
+            all.extend(passes);
+        }
+    }
+    if json {
+        println!("{}", serde_json::to_string_pretty(&all)?);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The backends asked for, or gl.
+fn backends_or_gl(backends: &[BackendKind]) -> Vec<BackendKind> {
+    if backends.is_empty() {
+        vec![BackendKind::Gl]
+    } else {
+        backends.to_vec()
+    }
+}
+
+/// Keeps the latest bench results (in target/harness/ by default) for the check report.
+fn save_bench_json(dir: &Path, name: &str, text: &str) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    let path = dir.join(name);
+    harness::images::write_atomically(&path, text.as_bytes())?;
+    eprintln!(
+        "wrote {} (shown in the next `harness check` report)",
+        path.display()
+    );
+    Ok(())
+}

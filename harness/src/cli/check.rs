@@ -1,0 +1,172 @@
+//! `harness check`, the default command: every scene's passes against their goldens and the
+//! backends against each other, as a table (or JSON) and the HTML report.
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use engine::backend::BackendKind;
+
+use harness::golden::check::CheckRun;
+use harness::golden::suite::{Case, LimitSource};
+
+use super::load_cases_isolated;
+
+/// Runs the check on the scenes and backends asked for (all by default), writes report.html
+/// and the failure images under `out` and prints the results; exits 1 on any failure.
+pub(crate) fn run(
+    out: &Path,
+    scenes: &[String],
+    backends: &[BackendKind],
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    let (cases, broken) = load_cases_isolated(scenes)?;
+    let store = harness::golden::GoldenStore::workspace();
+    let bar = indicatif::ProgressBar::new(0).with_style(
+        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} renders  {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let failures = out.join("failures");
+    let (run, outputs) =
+        harness::golden::check::run(&cases, &store, backends, &failures, |done, total, what| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+            bar.set_message(what.to_owned());
+        });
+    bar.finish_and_clear();
+    let mut run = run;
+    run.load_errors = broken;
+    for b in &run.backends {
+        if let Some(reason) = &b.unavailable {
+            eprintln!("note: {} unavailable: {reason}", b.backend);
+        }
+    }
+    if run.backends.iter().all(|b| b.unavailable.is_some()) {
+        anyhow::bail!("no backend is available; run `harness backends` for the reasons");
+    }
+    for note in &run.driver_notes {
+        eprintln!("note: {note}");
+    }
+    note_borrowed_limits(&cases);
+    let html = harness::report::html(
+        &run,
+        &outputs,
+        &store,
+        Some(out),
+        &harness::measure::report_sections(),
+    );
+    let report = out.join("report.html");
+    harness::images::write_atomically(&report, html.as_bytes())?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&run)?);
+    } else {
+        print_table(&run, &report, &failures);
+    }
+    Ok(if run.passed() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}
+
+/// Notes on stderr each scene whose limits are borrowed from the canonical scenes (or a
+/// fallback) because golden/noise.toml has no figures for it, and how to measure its own.
+fn note_borrowed_limits(cases: &[Case]) {
+    for case in cases {
+        let borrowed: Vec<&str> = case
+            .limit_sources
+            .iter()
+            .filter(|(_, s)| matches!(s, LimitSource::Borrowed | LimitSource::Fallback))
+            .map(|(p, _)| p.as_str())
+            .collect();
+        if !borrowed.is_empty() {
+            eprintln!(
+                "note: golden/noise.toml has no figures for {} ({}): its limits are the \
+                 canonical scenes' largest; measure its own with `harness noise --scene {} --write`",
+                case.name(),
+                borrowed.join(", "),
+                case.loaded.path.display()
+            );
+        }
+    }
+}
+
+/// The results table on stdout: a line per scene, pass and backend, then the renders and
+/// scenes that failed, the backends that disagree, a summary line, and on a failure where the
+/// images are and the bless commands.
+fn print_table(run: &CheckRun, report: &Path, failures: &Path) {
+    println!(
+        "{:<8} {:<17} {:<12} {:<8} worst metric",
+        "scene", "pass", "backend", "result"
+    );
+    for r in &run.results {
+        let (label, worst) = match &r.outcome {
+            harness::golden::Outcome::Passed(v) | harness::golden::Outcome::Failed(v) => (
+                if r.outcome.passed() { "ok" } else { "FAILED" },
+                // The check closest to (or furthest past) its limit, and for a failure
+                // where the largest difference is.
+                v.checks
+                    .iter()
+                    .max_by(|a, b| a.ratio().total_cmp(&b.ratio()))
+                    .map(ToString::to_string)
+                    .unwrap_or_default()
+                    + &v.largest_difference
+                        .map(|l| format!("; {l}"))
+                        .unwrap_or_default(),
+            ),
+            harness::golden::Outcome::MissingGolden => (
+                "MISSING",
+                format!("no golden at {}", r.golden_path.display()),
+            ),
+            harness::golden::Outcome::Incomparable(why) => ("FAILED", why.clone()),
+        };
+        println!(
+            "{:<8} {:<17} {:<12} {:<8} {worst}",
+            r.scene, r.pass, r.backend, label
+        );
+    }
+    for (scene, backend, error) in &run.render_errors {
+        println!(
+            "{scene:<8} {:<17} {backend:<12} FAILED   render: {error}",
+            "-"
+        );
+    }
+    for b in &run.load_errors {
+        println!(
+            "{:<8} {:<17} {:<12} FAILED   load: {}",
+            b.scene, "-", "-", b.error
+        );
+    }
+    let worst_cross = run
+        .cross
+        .iter()
+        .filter(|c| !c.within_tolerance)
+        .map(|c| format!("{}/{} {} vs {}", c.scene, c.pass, c.a, c.b))
+        .collect::<Vec<_>>();
+    if !worst_cross.is_empty() {
+        println!(
+            "backends disagree beyond tolerance on: {}",
+            worst_cross.join(", ")
+        );
+    }
+    let failed = run.results.iter().filter(|r| !r.outcome.passed()).count();
+    let unloaded = if run.load_errors.is_empty() {
+        String::new()
+    } else {
+        format!(", {} scene(s) did not load", run.load_errors.len())
+    };
+    println!(
+        "{} checks, {failed} failed{unloaded}; report: {}",
+        run.results.len(),
+        report.display()
+    );
+    if failed > 0 {
+        println!("failure images: {}", failures.display());
+        println!(
+            "after reviewing the report, bless what changed on purpose (one command per \
+             scene; it rewrites only the passes outside tolerance or without a golden):"
+        );
+        for command in run.bless_commands() {
+            println!("  {command}");
+        }
+    }
+}

@@ -1,0 +1,124 @@
+//! `harness sweep`: speed against error for a quality knob (shadow, ibl or gbuffer), kept for
+//! the check report.
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use engine::backend::BackendKind;
+
+use super::default_out_dir;
+
+/// Sweeps `knob` over its settings on `scene` (lit by `environment` when one is given) and
+/// prints the table (or JSON); an unknown knob is an error.
+pub(crate) fn run(
+    scene: &str,
+    knob: &str,
+    kind: BackendKind,
+    repeats: usize,
+    environment: Option<&Path>,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    let mut loaded = harness::load_scene(scene)?;
+    if let Some(path) = environment {
+        replace_environment(&mut loaded.scene, path)?;
+    }
+    if knob == "ibl" {
+        let rows = harness::measure::sweep::ibl_sweep(&loaded.scene, kind, repeats, |what| {
+            eprintln!("  {what} ...");
+        })?;
+        let text = serde_json::to_string_pretty(&rows)?;
+        save_sweep(&loaded.scene.name, "ibl", &text);
+        if json {
+            println!("{text}");
+        } else {
+            println!(
+                "ibl sweep of {} on {kind} ({repeats} renders per setting, median GPU time; error = mean relative error of r+g+b against the Monte Carlo reference, {} pixels, {} directions per strategy)",
+                loaded.scene.name,
+                harness::measure::sweep::IBL_REFERENCE_PIXELS,
+                harness::measure::sweep::IBL_REFERENCE_SAMPLES
+            );
+            print!("{}", harness::measure::sweep::ibl_table(&rows));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    if knob == "gbuffer" {
+        let rows = harness::measure::sweep::gbuffer_sweep(&loaded.scene, kind, repeats, |what| {
+            eprintln!("  {what} ...");
+        })?;
+        let text = serde_json::to_string_pretty(&rows)?;
+        save_sweep(&loaded.scene.name, "gbuffer", &text);
+        if json {
+            println!("{text}");
+        } else {
+            println!(
+                "gbuffer sweep of {} on {kind} ({repeats} renders per setting, median GPU time; error = light buffer against the scene at the origin with the default storage)",
+                loaded.scene.name
+            );
+            print!("{}", harness::measure::sweep::gbuffer_table(&rows));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    if knob != "shadow" {
+        return Err(harness::measure::sweep::SweepError::UnknownKnob(knob.to_owned()).into());
+    }
+    let rows = harness::measure::sweep::shadow_sweep(&loaded.scene, kind, repeats, |what| {
+        eprintln!("  {what} ...");
+    })?;
+    let text = serde_json::to_string_pretty(&rows)?;
+    save_sweep(&loaded.scene.name, "shadow", &text);
+    if json {
+        println!("{text}");
+    } else {
+        println!(
+            "shadow sweep of {} on {kind} ({repeats} renders per setting, median GPU time)",
+            loaded.scene.name
+        );
+        print!("{}", harness::measure::sweep::table(&rows));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Lights `scene` with the environment at `path` (its rotation and intensity kept, or none and
+/// 1 where it had no environment) and names it `<scene>-<file stem>`, so that the sweep's
+/// results are kept apart from the scene's own.
+fn replace_environment(scene: &mut engine::scene::Scene, path: &Path) -> anyhow::Result<()> {
+    let loaded = engine::assets::load_environment(path)?;
+    let (rotation_degrees, intensity) = scene
+        .environment
+        .as_ref()
+        .map_or((0.0, 1.0), |e| (e.rotation_degrees, e.intensity));
+    scene.environment = Some(engine::scene::Environment {
+        image: std::sync::Arc::new(engine::scene::EnvironmentImage {
+            label: path.display().to_string(),
+            width: loaded.width,
+            height: loaded.height,
+            texels: loaded.texels,
+        }),
+        rotation_degrees,
+        intensity,
+    });
+    let stem = path.file_stem().map_or_else(
+        || "environment".to_owned(),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    scene.name = format!("{}-{stem}", scene.name);
+    Ok(())
+}
+
+/// Keeps a sweep's results (target/harness/sweep_<scene>_<knob>.json) for the check report; a
+/// failure to write them is a warning.
+fn save_sweep(scene: &str, knob: &str, json: &str) {
+    let path = default_out_dir().join(harness::measure::sweep::result_file(scene, knob));
+    let written = std::fs::create_dir_all(default_out_dir())
+        .map_err(|e| e.to_string())
+        .and_then(|_| {
+            harness::images::write_atomically(&path, json.as_bytes()).map_err(|e| e.to_string())
+        });
+    match written {
+        Ok(()) => eprintln!(
+            "wrote {} (shown in the next `harness check` report)",
+            path.display()
+        ),
+        Err(e) => eprintln!("warning: sweep results not kept: {e}"),
+    }
+}
