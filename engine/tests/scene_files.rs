@@ -96,55 +96,60 @@ fn paths_are_relative_to_the_scene_file_and_shared_textures_load_once() {
     assert_eq!(scene.quality.width, 64);
 }
 
+/// Writes `text` to `dir/name` and loads it as a scene file, which must fail: the error.
+fn load_error(dir: &Path, name: &str, text: &str) -> SceneFileError {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    scene_file::load(&path).err().unwrap()
+}
+
+/// A point light with a VSM shadow filter, which only directional lights have.
+const POINT_LIGHT_WITH_VSM: &str = concat!(
+    "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\nradius = 5\n",
+    "shadow = { filter = \"vsm\" }\n",
+);
+
 #[test]
 fn bad_values_and_missing_assets_are_errors_naming_the_file() {
-    let dir = tempfile::tempdir().unwrap();
-    let write = |name: &str, text: &str| {
-        let path = dir.path().join(name);
-        std::fs::write(&path, text).unwrap();
-        path
-    };
-    let path = write(
+    let temp = tempfile::tempdir().unwrap();
+    let dir = temp.path();
+    let e = load_error(
+        dir,
         "radius.toml",
         &format!("{CAMERA}[[lights]]\ntype = \"point\"\nposition = [0, 0, 0]\nradius = -1\n"),
     );
-    let e = scene_file::load(&path).err().unwrap();
     assert!(matches!(e, SceneFileError::Invalid { .. }), "{e}");
     assert!(e.to_string().contains("radius.toml"), "{e}");
-    let path = write(
+    let e = load_error(
+        dir,
         "missing.toml",
         &format!("{CAMERA}[[objects]]\nmesh = \"nowhere.obj\"\n"),
-    );
-    let e = scene_file::load(&path).err().unwrap().to_string();
+    )
+    .to_string();
     assert!(
         e.contains("missing.toml") && e.contains("nowhere.obj"),
         "{e}"
     );
-    let path = write(
+    let e = load_error(
+        dir,
         "env.toml",
         &format!("{CAMERA}[environment]\npath = \"sky.exr\"\n"),
-    );
-    let e = scene_file::load(&path).err().unwrap().to_string();
+    )
+    .to_string();
     assert!(e.contains("sky.exr"), "{e}");
-    let path = write(
+    let e = load_error(
+        dir,
         "nan.toml",
         "[camera]\nposition = [nan, 0, 1]\ntarget = [0, 0, 0]\n",
-    );
-    let e = scene_file::load(&path).err().unwrap().to_string();
+    )
+    .to_string();
     assert!(e.contains("nan.toml") && e.contains("finite"), "{e}");
-    let path = write(
-        "vsm.toml",
-        &format!(
-            "{CAMERA}[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\nradius = 5\n\
-             shadow = {{ filter = \"vsm\" }}\n"
-        ),
-    );
-    let e = scene_file::load(&path).err().unwrap().to_string();
+    let e = load_error(dir, "vsm.toml", &format!("{CAMERA}{POINT_LIGHT_WITH_VSM}")).to_string();
     assert!(
         e.contains("vsm.toml") && e.contains("light 0") && e.contains("directional"),
         "{e}"
     );
-    let e = scene_file::load(&dir.path().join("absent.toml"))
+    let e = scene_file::load(&dir.join("absent.toml"))
         .err()
         .unwrap()
         .to_string();

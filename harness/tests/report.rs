@@ -273,19 +273,10 @@ fn exr(path: &Path) -> engine::Image {
     harness::images::read_exr(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
-#[test]
-fn the_review_page_finds_the_change_in_a_real_browser() {
-    let Some(executable) = chromium() else {
-        if std::env::var("REQUIRE_CHROMIUM").as_deref() == Ok("1") {
-            panic!("REQUIRE_CHROMIUM=1 but no Chromium found (apt-get install -y chromium)");
-        }
-        eprintln!("note: no Chromium; review page test skipped (apt-get install -y chromium)");
-        return;
-    };
-    if !common::gl_available() {
-        return;
-    }
-    // A brighter light: the arrow scene's light buffer and final image change, nothing else.
+/// Brightens the arrow scene's light in a temporary workspace (its light buffer and final image
+/// change, nothing else) and runs `harness check` on it, which must fail. Returns the workspace
+/// and the `--out` folder holding report.html and the failure images.
+fn check_after_a_light_change() -> (tempfile::TempDir, PathBuf) {
     let root = common::temp_workspace();
     let scene = root.path().join("scenes/arrow.toml");
     let text = std::fs::read_to_string(&scene).unwrap();
@@ -299,14 +290,11 @@ fn the_review_page_finds_the_change_in_a_real_browser() {
         .unwrap();
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert_eq!(output.status.code(), Some(1), "{stdout}");
-    let report: PathBuf = out.join("report.html");
+    (root, out)
+}
 
-    let mut browser = Browser::launch(executable);
-    browser.open(&format!("file://{}", report.display()));
-    let ready = browser.eval("window.reviewReady.then(() => true)");
-    assert_eq!(ready, json!(true));
-
-    // Failures first.
+/// The summary table lists the two failed rows before every passing one.
+fn assert_failures_come_first(browser: &mut Browser) {
     let classes = browser.eval(
         "Array.from(document.querySelectorAll('table.summary tr.failed, table.summary \
          tr.passed'), r => r.className)",
@@ -324,8 +312,10 @@ fn the_review_page_finds_the_change_in_a_real_browser() {
         "{classes:?}"
     );
     assert!(classes.len() > failed);
+}
 
-    // The failures-only filter, clicked, hides every passing row and thumbnail.
+/// The failures-only filter, clicked, hides every passing row and thumbnail.
+fn assert_failures_only_hides_the_passing_rows(browser: &mut Browser) {
     let visible = "Array.from(document.querySelectorAll('table.summary tr.passed, \
                    section.passing')).filter(e => e.getClientRects().length > 0).length";
     assert!(browser.eval(visible).as_u64().unwrap() > 0);
@@ -338,8 +328,10 @@ fn the_review_page_finds_the_change_in_a_real_browser() {
     let failing_rows = "Array.from(document.querySelectorAll('table.summary tr.failed'))\
                         .filter(e => e.getClientRects().length > 0).length";
     assert_eq!(browser.eval(failing_rows), json!(2));
+}
 
-    // The summary row links to its case.
+/// The summary row links to its case.
+fn assert_the_summary_row_links_to_its_case(browser: &mut Browser) {
     let href =
         browser.eval("document.querySelector('table.summary tr.failed a').getAttribute('href')");
     let href = href.as_str().unwrap().to_owned();
@@ -350,9 +342,11 @@ fn the_review_page_finds_the_change_in_a_real_browser() {
             .unwrap(),
         "{href}"
     );
+}
 
-    // The light buffer's viewer: swipe mode, then the slider clicked at a quarter of its width.
-    let viewer = "#case-arrow-light .viewer";
+/// In `viewer`: swipe mode, then the slider clicked at a quarter of its width moves there and
+/// clips the actual image at that position.
+fn assert_the_swipe_slider_moves(browser: &mut Browser, viewer: &str) {
     browser.click_on(&format!("{viewer} button[data-mode=swipe]"));
     assert!(browser
         .eval(&format!(
@@ -373,13 +367,16 @@ fn the_review_page_finds_the_change_in_a_real_browser() {
         format!("{viewer} .swipe canvas.actual")
     ));
     assert_eq!(clip, json!(format!("inset(0px 0px 0px {position}%)")));
+}
 
-    // Back to side by side; the inspector at the pixel that changed most prints the fp16 values
-    // stored in the golden and in the output.
-    browser.click_on(&format!("{viewer} button[data-mode=side]"));
-    let golden_light = exr(&root.path().join("golden/arrow/light.exr"));
-    let actual_light = exr(&out.join("failures/arrow/gl/light_actual.exr"));
-    let (px, py) = (356, 372);
+/// The inspector of `viewer` at pixel (px, py) prints the fp16 values stored in the golden and
+/// in the output, which differ there. Returns what it printed.
+fn assert_the_inspector_prints_the_stored_values(
+    browser: &mut Browser,
+    viewer: &str,
+    (golden_light, actual_light): (&engine::Image, &engine::Image),
+    (px, py): (u32, u32),
+) -> String {
     let text = browser.inspect(viewer, "actual", 1.0, px, py);
     assert!(text.starts_with(&format!("pixel ({px}, {py})")), "{text}");
     assert_values(
@@ -393,8 +390,17 @@ fn the_review_page_finds_the_change_in_a_real_browser() {
         "actual",
     );
     assert_ne!(golden_light.pixel(px, py), actual_light.pixel(px, py));
+    text
+}
 
-    // At 4x zoom the same pixel is four times further in, and reads the same.
+/// At 4x zoom pixel (px, py) of `viewer` is four times further in, and the inspector reads
+/// `text` there again.
+fn assert_zoom_keeps_the_pixel(
+    browser: &mut Browser,
+    viewer: &str,
+    (px, py): (u32, u32),
+    text: &str,
+) {
     browser.eval(&format!(
         "(() => {{ const z = document.querySelector({:?}); z.value = '4'; \
          z.dispatchEvent(new Event('change')); }})()",
@@ -402,8 +408,16 @@ fn the_review_page_finds_the_change_in_a_real_browser() {
     ));
     let zoomed = browser.inspect(viewer, "actual", 4.0, px, py);
     assert_eq!(zoomed, text);
+}
 
-    // Exposure +2 EV: the golden canvas shows the stored value times 4, clamped, sRGB-encoded.
+/// Exposure +2 EV: the golden canvas of `viewer` shows the stored value times 4, clamped,
+/// sRGB-encoded.
+fn assert_exposure_scales_the_hdr_pass(
+    browser: &mut Browser,
+    viewer: &str,
+    golden_light: &engine::Image,
+    (px, py): (u32, u32),
+) {
     browser.eval(&format!(
         "(() => {{ const e = document.querySelector({:?}); e.value = '2'; \
          e.dispatchEvent(new Event('input')); }})()",
@@ -430,8 +444,11 @@ fn the_review_page_finds_the_change_in_a_real_browser() {
             "{shown} vs {golden_pixel:?}"
         );
     }
+}
 
-    // The final image is 8-bit: the inspector prints its stored bytes.
+/// The final image is 8-bit: the inspector prints its stored bytes. And the diff legend is
+/// there, scaled to the pass's threshold.
+fn assert_the_final_image_shows_its_bytes_and_legend(browser: &mut Browser, out: &Path) {
     let final_actual =
         harness::images::read_png(&out.join("failures/arrow/gl/final_actual.png")).unwrap();
     let final_viewer = "#case-arrow-final .viewer";
@@ -441,7 +458,6 @@ fn the_review_page_finds_the_change_in_a_real_browser() {
         &final_actual.pixel(200, 300),
         "final actual",
     );
-    // And the diff legend is there, scaled to the pass's threshold.
     let legend = browser.eval(&format!(
         "document.querySelector({:?}).textContent",
         format!("{final_viewer} .legend")
@@ -450,4 +466,49 @@ fn the_review_page_finds_the_change_in_a_real_browser() {
         legend.as_str().unwrap().contains("threshold 0.006"),
         "{legend}"
     );
+}
+
+#[test]
+fn the_review_page_finds_the_change_in_a_real_browser() {
+    let Some(executable) = chromium() else {
+        if std::env::var("REQUIRE_CHROMIUM").as_deref() == Ok("1") {
+            panic!("REQUIRE_CHROMIUM=1 but no Chromium found (apt-get install -y chromium)");
+        }
+        eprintln!("note: no Chromium; review page test skipped (apt-get install -y chromium)");
+        return;
+    };
+    if !common::gl_available() {
+        return;
+    }
+    let (root, out) = check_after_a_light_change();
+    let report: PathBuf = out.join("report.html");
+
+    let mut browser = Browser::launch(executable);
+    browser.open(&format!("file://{}", report.display()));
+    let ready = browser.eval("window.reviewReady.then(() => true)");
+    assert_eq!(ready, json!(true));
+
+    assert_failures_come_first(&mut browser);
+    assert_failures_only_hides_the_passing_rows(&mut browser);
+    assert_the_summary_row_links_to_its_case(&mut browser);
+
+    // The light buffer's viewer.
+    let viewer = "#case-arrow-light .viewer";
+    assert_the_swipe_slider_moves(&mut browser, viewer);
+
+    // Back to side by side; the inspector at the pixel that changed most.
+    browser.click_on(&format!("{viewer} button[data-mode=side]"));
+    let golden_light = exr(&root.path().join("golden/arrow/light.exr"));
+    let actual_light = exr(&out.join("failures/arrow/gl/light_actual.exr"));
+    let pixel = (356, 372);
+    let text = assert_the_inspector_prints_the_stored_values(
+        &mut browser,
+        viewer,
+        (&golden_light, &actual_light),
+        pixel,
+    );
+    assert_zoom_keeps_the_pixel(&mut browser, viewer, pixel, &text);
+    assert_exposure_scales_the_hdr_pass(&mut browser, viewer, &golden_light, pixel);
+
+    assert_the_final_image_shows_its_bytes_and_legend(&mut browser, &out);
 }

@@ -4,6 +4,8 @@
 // Each test binary uses some of these helpers.
 #![allow(dead_code)]
 
+pub mod cli;
+
 use engine::backend::{self, BackendKind};
 
 /// Backends available here. A backend named in `REQUIRE_BACKENDS` (comma-separated; CI sets

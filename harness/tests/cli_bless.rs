@@ -1,0 +1,192 @@
+//! `harness bless`: it rewrites only the named goldens, or only the passes a change reaches,
+//! and refuses without a scene.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+fn snapshot(dir: &Path) -> std::collections::BTreeMap<PathBuf, (Vec<u8>, std::time::SystemTime)> {
+    let mut out = std::collections::BTreeMap::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let entry = entry.unwrap();
+        if entry.file_type().unwrap().is_dir() {
+            out.extend(snapshot(&entry.path()));
+        } else {
+            let meta = entry.metadata().unwrap();
+            out.insert(
+                entry.path(),
+                (
+                    std::fs::read(entry.path()).unwrap(),
+                    meta.modified().unwrap(),
+                ),
+            );
+        }
+    }
+    out
+}
+
+/// Runs `harness bless ARGS` against the workspace copy at `root`; fails the test unless it
+/// succeeds. Returns its stdout.
+fn bless_in(root: &Path, args: &[&str]) -> String {
+    let output = common::harness_command()
+        .arg("bless")
+        .args(args)
+        .env("HARNESS_ROOT", root)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(
+        output.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    stdout
+}
+
+/// The files under `dir` that differ between two snapshots (new ones too), relative to `dir`.
+fn changed_files(
+    dir: &Path,
+    before: &std::collections::BTreeMap<PathBuf, (Vec<u8>, std::time::SystemTime)>,
+    after: &std::collections::BTreeMap<PathBuf, (Vec<u8>, std::time::SystemTime)>,
+) -> Vec<String> {
+    after
+        .iter()
+        .filter(|(path, state)| before.get(*path) != Some(*state))
+        .map(|(path, _)| path.strip_prefix(dir).unwrap().display().to_string())
+        .collect()
+}
+
+/// `bless --scene chess --pass final` rewrites that golden and chess's blessed.toml, and nothing
+/// else (run against a temporary copy of scenes/ and golden/ through HARNESS_ROOT).
+#[test]
+fn bless_rewrites_only_the_named_golden() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    let golden = root.path().join("golden");
+    let before = snapshot(&golden);
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    let stdout = bless_in(root.path(), &["--scene", "chess", "--pass", "final"]);
+    assert!(
+        stdout.contains("chess/final: within tolerance vs old golden"),
+        "{stdout}"
+    );
+    let after = snapshot(&golden);
+    assert_eq!(
+        before.keys().collect::<Vec<_>>(),
+        after.keys().collect::<Vec<_>>()
+    );
+    assert_eq!(
+        changed_files(&golden, &before, &after),
+        ["chess/blessed.toml", "chess/final.png"]
+    );
+    let record = std::fs::read_to_string(golden.join("chess/blessed.toml")).unwrap();
+    assert!(
+        record.contains("[passes.final]") && record.contains("driver = "),
+        "{record}"
+    );
+
+    // Without --scene or --all, bless refuses.
+    let output = common::harness_command()
+        .arg("bless")
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(1));
+}
+
+/// After a change to one light's intensity, `bless --scene arrow` rewrites only the passes that
+/// light reaches (light and final) and their blessed.toml entries; the G-buffer, shadow and mask
+/// goldens and their records stay as they were. A scene given by path gets a bless suggestion
+/// with its path, which works.
+#[test]
+fn bless_after_a_light_change_rewrites_only_the_changed_passes() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    let scene = root.path().join("scenes/arrow.toml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(text.contains("intensity = 2.5"));
+    std::fs::write(&scene, text.replace("intensity = 2.5", "intensity = 3.0")).unwrap();
+    let golden = root.path().join("golden");
+    let records_before = std::fs::read_to_string(golden.join("arrow/blessed.toml")).unwrap();
+    let before = snapshot(&golden);
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    let stdout = bless_in(root.path(), &["--scene", "arrow"]);
+    let after = snapshot(&golden);
+    assert_eq!(
+        changed_files(&golden, &before, &after),
+        ["arrow/blessed.toml", "arrow/final.png", "arrow/light.exr"],
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("arrow/light: CHANGED vs old golden"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("arrow/mask: within tolerance vs old golden"),
+        "{stdout}"
+    );
+    // The records of the passes kept are the same lines as before.
+    let records_after = std::fs::read_to_string(golden.join("arrow/blessed.toml")).unwrap();
+    let section = |text: &str, pass: &str| {
+        let start = text.find(&format!("[passes.{pass}]")).unwrap();
+        let rest = &text[start..];
+        let end = rest[1..].find("\n[").map_or(rest.len(), |e| e + 1);
+        rest[..end].to_owned()
+    };
+    for pass in [
+        "mask",
+        "depth",
+        "gbuffer_albedo",
+        "shadow_0",
+        "shadow_term_0",
+    ] {
+        assert_eq!(
+            section(&records_before, pass),
+            section(&records_after, pass),
+            "{pass}"
+        );
+    }
+    assert_ne!(
+        section(&records_before, "light"),
+        section(&records_after, "light")
+    );
+
+    // A second bless finds nothing to rewrite.
+    let again = snapshot(&golden);
+    bless_in(root.path(), &["--scene", "arrow"]);
+    assert_eq!(snapshot(&golden), again);
+
+    // A copy of the scene given by path: check suggests blessing it by path, and that works.
+    let copy = root.path().join("elsewhere/arrow.toml");
+    std::fs::create_dir_all(copy.parent().unwrap()).unwrap();
+    let text = std::fs::read_to_string(&scene).unwrap();
+    // Relative asset paths resolve against the scene file: point them back at scenes/. The
+    // copy's light differs from the blessed one, so its light and final passes fail.
+    let moved = text
+        .replace("\"assets/", "\"../scenes/assets/")
+        .replace("intensity = 3.0", "intensity = 2.0");
+    std::fs::write(&copy, moved).unwrap();
+    let output = common::harness_command()
+        .args([
+            "check",
+            "--backend",
+            "gl",
+            "--scene",
+            copy.to_str().unwrap(),
+            "--out",
+            root.path().join("out").to_str().unwrap(),
+        ])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let suggestion = format!(
+        "  cargo run --release -p harness -- bless --scene {}",
+        copy.display()
+    );
+    assert!(stdout.lines().any(|l| l == suggestion), "{stdout}");
+}

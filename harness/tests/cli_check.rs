@@ -1,0 +1,201 @@
+//! `harness check`: a scene that does not load, failures with their images and the bless
+//! command, and a note when the driver differs from the blessing one.
+
+mod common;
+
+use common::cli::darken;
+
+/// A scene in scenes/ whose mesh does not load is one failed case: `check` reports it with its
+/// error (once), checks every other scene as usual, writes the report, and exits 1.
+#[test]
+fn a_broken_scene_is_one_failed_case_and_the_others_are_checked() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    std::fs::write(
+        root.path().join("scenes/broken.toml"),
+        "[camera]\nposition = [0, 0, 1]\ntarget = [0, 0, 0]\n[[objects]]\nmesh = \"assets/gone.obj\"\n",
+    )
+    .unwrap();
+    let out = root.path().join("out");
+    // An earlier run's failure image of a checked scene, which this run must remove.
+    let stale = out.join("failures/arrow/gl/final_diff.png");
+    std::fs::create_dir_all(stale.parent().unwrap()).unwrap();
+    std::fs::write(&stale, b"old").unwrap();
+    let output = common::harness_command()
+        .args(["check", "--backend", "gl", "--out", out.to_str().unwrap()])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stdout}\n{stderr}");
+    let load_lines: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.contains("FAILED   load:"))
+        .collect();
+    assert_eq!(load_lines.len(), 1, "{stdout}");
+    assert!(
+        load_lines[0].starts_with("broken") && load_lines[0].contains("gone.obj: cannot read file"),
+        "{}",
+        load_lines[0]
+    );
+    assert_eq!(
+        load_lines[0].matches("os error 2").count(),
+        1,
+        "{}",
+        load_lines[0]
+    );
+    for scene in ["arrow", "chess", "ibl"] {
+        let rows: Vec<&str> = stdout
+            .lines()
+            .filter(|l| l.starts_with(scene) && l.contains(" gl "))
+            .collect();
+        assert!(rows.len() >= 8, "{scene} was not checked:\n{stdout}");
+        assert!(
+            rows.iter().all(|r| r.contains(" ok ")),
+            "{scene}:\n{stdout}"
+        );
+    }
+    assert!(stdout.contains("1 scene(s) did not load"), "{stdout}");
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(report.contains("scene broken did not load"));
+    // The canonical scenes pass: the review page shows them as thumbnails and stays small
+    // (the thumbnails are per scene and pass, so more backends add only table rows).
+    assert!(
+        report.len() < 5_000_000,
+        "report.html is {} bytes",
+        report.len()
+    );
+    assert!(
+        !stale.exists(),
+        "the earlier run's failure image is still there"
+    );
+    // `harness scenes` does not list it as fine.
+    let output = common::harness_command()
+        .arg("scenes")
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout
+            .lines()
+            .any(|l| l.starts_with("broken") && l.contains("DOES NOT LOAD")),
+        "{stdout}"
+    );
+}
+
+/// A changed golden fails `check` with the metrics and leaves actual, golden, diff and the HTML
+/// report on disk; a missing golden fails with the exact bless command.
+#[test]
+fn check_reports_failures_with_images_and_the_bless_command() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    // Darken the golden final image of `arrow` by 3/255: a change the tolerance must catch.
+    darken(&root.path().join("golden/arrow/final.png"), 3);
+    std::fs::remove_file(root.path().join("golden/arrow/light.exr")).unwrap();
+    let out = root.path().join("out");
+    let output = common::harness_command()
+        .args(["check", "--scene", "arrow", "--out", out.to_str().unwrap()])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(1), "{stdout}");
+    let line = |pass: &str| {
+        stdout
+            .lines()
+            .find(|l| l.starts_with("arrow") && l.contains(pass) && l.contains(" gl "))
+            .unwrap_or_default()
+            .to_owned()
+    };
+    assert!(
+        line("final").contains("FAILED") && line("final").contains("fraction_over"),
+        "{stdout}"
+    );
+    // The failing check's value / limit, the pixels over its threshold, and where the largest
+    // difference is (3/255 darker: a difference of 1.1765e-2 in 0..1 units).
+    assert!(
+        line("final").contains("px over")
+            && line("final").contains("px differ, the most 1.1765e-2 at (")
+            && line("final").contains("x) FAILED"),
+        "{stdout}"
+    );
+    assert!(
+        line("light").contains("MISSING") && line("light").contains("no golden at "),
+        "{stdout}"
+    );
+    // One bless suggestion for the scene, not one per pass.
+    let suggestions: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.contains("harness -- bless"))
+        .collect();
+    assert_eq!(
+        suggestions,
+        ["  cargo run --release -p harness -- bless --scene arrow"],
+        "{stdout}"
+    );
+    assert!(line("mask").contains(" ok "), "{stdout}");
+    // Under --out, not the workspace's target/.
+    let failures = out.join("failures/arrow/gl");
+    for file in [
+        "final_actual.png",
+        "final_golden.png",
+        "final_diff.png",
+        "light_actual.exr",
+    ] {
+        assert!(failures.join(file).is_file(), "{file} not written");
+    }
+    assert!(!root.path().join("target/harness/failures").exists());
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(report.contains("data:image/png;base64,") && report.contains("FAILED"));
+}
+
+/// When the driver differs from the one the goldens were blessed with, `check` says so, as
+/// information: the run still passes.
+#[test]
+fn check_notes_a_driver_other_than_the_blessing_one() {
+    if !common::available_backends().contains(&engine::BackendKind::Gl) {
+        return;
+    }
+    let root = common::temp_workspace();
+    let record = root.path().join("golden/arrow/blessed.toml");
+    let text = std::fs::read_to_string(&record).unwrap();
+    let moved: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("driver = ") {
+                "driver = \"OpenGL 4.6 | some other GPU | Mesa 99.0\"".to_owned()
+            } else {
+                l.to_owned()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(&record, moved).unwrap();
+    let out = root.path().join("out");
+    let output = common::harness_command()
+        .args(["check", "--scene", "arrow", "--backend", "gl", "--out"])
+        .arg(&out)
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(
+        stderr.contains(
+            "note: goldens of arrow were blessed on gl with `OpenGL 4.6 | some other GPU"
+        ) && stderr.contains("are not failures"),
+        "{stderr}"
+    );
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        report.contains("some other GPU"),
+        "the report does not say it"
+    );
+}

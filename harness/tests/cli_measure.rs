@@ -1,0 +1,182 @@
+//! `harness bench` (pass times, their ratio to the floor, the lighting breakdown) and
+//! `harness noise` (sources measured and judged against the limits).
+
+mod common;
+
+use common::cli::{darken, harness};
+
+/// `harness bench --json`: for each scene, backend and pass, the median GPU time and its ratio
+/// to the floor (a trivial pass writing the same targets), kept for the check report.
+#[test]
+fn bench_json_gives_each_pass_its_time_and_ratio_to_the_floor() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let (code, stdout, stderr) = harness(&[
+        "bench",
+        "--scene",
+        "arrow",
+        "--backend",
+        "gl",
+        "--frames",
+        "1",
+        "--json",
+        "--out",
+        out,
+    ]);
+    if code != 0 && stderr.contains("unavailable") && !common::required(engine::BackendKind::Gl) {
+        eprintln!("skipping: gl unavailable: {stderr}");
+        return;
+    }
+    assert_eq!(code, 0, "{stderr}");
+    let json: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let scenes = json["scenes"].as_array().unwrap();
+    assert_eq!(scenes.len(), 1);
+    let arrow = &scenes[0];
+    assert_eq!(arrow["backend"], "gl");
+    let passes = arrow["passes"].as_array().unwrap();
+    let names: Vec<&str> = passes.iter().map(|p| p["pass"].as_str().unwrap()).collect();
+    assert_eq!(
+        names,
+        [
+            "shadow_0",
+            "geometry",
+            "mask",
+            "lighting_pbr",
+            "lighting_blinn_phong",
+            "tonemap"
+        ]
+    );
+    for p in passes {
+        let (ms, floor, ratio) = (
+            p["median_ms"].as_f64().unwrap(),
+            p["floor_ms"].as_f64().unwrap(),
+            p["ratio"].as_f64().unwrap(),
+        );
+        assert!(ms > 0.0 && floor > 0.0, "{p}");
+        assert!((ratio - ms / floor).abs() < 1e-9 * ratio, "{p}");
+    }
+    assert!(json["precompute"][0]["ms"].as_f64().unwrap() >= 0.0);
+    assert!(dir.path().join("bench.json").is_file());
+}
+
+/// `harness bench --breakdown --json`: a row per part of each lighting pass (input floor,
+/// setup, each light, and the parts of those), their sum and the pass as it is. Times vary;
+/// only the shape and that every figure is a time are checked here.
+#[test]
+fn bench_breakdown_lists_the_parts_of_each_lighting_pass() {
+    let (code, stdout, stderr) = harness(&[
+        "bench",
+        "--breakdown",
+        "--scene",
+        "arrow",
+        "--backend",
+        "gl",
+        "--frames",
+        "1",
+        "--json",
+    ]);
+    if code != 0 && stderr.contains("unavailable") && !common::required(engine::BackendKind::Gl) {
+        eprintln!("skipping: gl unavailable: {stderr}");
+        return;
+    }
+    assert_eq!(code, 0, "{stderr}");
+    let passes: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let names: Vec<&str> = passes
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["pass"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["lighting_pbr", "lighting_blinn_phong"]);
+    for pass in passes.as_array().unwrap() {
+        let rows: Vec<&str> = pass["rows"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r["what"].as_str().unwrap())
+            .collect();
+        assert_eq!(
+            rows,
+            [
+                "G-buffer reads (input floor)",
+                "per-pixel setup (view vector, ambient, output)",
+                "light 0 (point, shadow pcf3)",
+                "  of which shadow lookups",
+            ]
+            .into_iter()
+            .chain((pass["pass"] == "lighting_pbr").then_some("  of which clearcoat"))
+            .collect::<Vec<_>>(),
+            "{pass}"
+        );
+        for key in ["total_ms", "sum_ms", "sum_to_total"] {
+            assert!(pass[key].as_f64().unwrap().is_finite(), "{key}: {pass}");
+        }
+    }
+}
+
+/// `harness noise` measures a source in child processes (`check --json` per scene and backend)
+/// and renders recorded on another host, and judges both against the limits; a golden that no
+/// longer matches makes it exit 1. Refuses unknown sources and a partial `--write`.
+#[test]
+fn noise_measures_sources_and_fails_when_a_golden_moved() {
+    let backends = common::available_backends();
+    assert!(!backends.is_empty(), "no backend available");
+    let (code, stdout, stderr) = harness(&[
+        "noise",
+        "--source",
+        "cpu-sse4.1",
+        "--source",
+        "host-b",
+        "--scene",
+        "ibl",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    let json: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let names: Vec<&str> = json["sources"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["cpu-sse4.1", "host-b"]);
+    let measurements = json["measurements"].as_array().unwrap();
+    for backend in &backends {
+        assert!(
+            measurements
+                .iter()
+                .any(|m| m["source"] == "cpu-sse4.1" && m["backend"] == backend.name()),
+            "no cpu-sse4.1 measurement on {backend}"
+        );
+    }
+    assert!(measurements
+        .iter()
+        .any(|m| m["source"] == "host-b" && m["pass"] == "final"));
+    for ratio in json["ratios"].as_array().unwrap() {
+        assert!(ratio["ratio"].as_f64().unwrap() <= 0.5, "{ratio}");
+    }
+
+    let (code, _, stderr) = harness(&["noise", "--source", "nope"]);
+    assert_eq!(code, 1);
+    assert!(stderr.contains("unknown source `nope`"), "{stderr}");
+    let (code, _, stderr) = harness(&["noise", "--source", "drivers", "--write"]);
+    assert_eq!(code, 1);
+    assert!(stderr.contains("--write records every source"), "{stderr}");
+
+    // A golden darkened by 2/255 is no noise: the drivers source fails against it.
+    let root = common::temp_workspace();
+    darken(&root.path().join("golden/ibl/final.png"), 2);
+    let output = common::harness_command()
+        .args(["noise", "--source", "drivers", "--scene", "ibl"])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout
+            .lines()
+            .any(|l| l.starts_with("FAILED: drivers ibl final")),
+        "{stdout}"
+    );
+}

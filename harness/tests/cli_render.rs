@@ -1,0 +1,99 @@
+//! `harness render`: load warnings printed once, unknown passes refused before rendering, and
+//! every pass of a scene file written.
+
+mod common;
+
+use std::path::Path;
+
+use common::cli::harness;
+
+/// `harness render` of a scene with untidy assets prints each load warning once on stderr; a
+/// canonical scene has none.
+#[test]
+fn render_prints_each_load_warning_once() {
+    if !common::gl_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/models/crate.toml");
+    let out = dir.path().join("crate.png");
+    let (code, stdout, stderr) = harness(&[
+        "render",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    assert!(out.is_file());
+    for needle in [
+        "crate.obj:2: not UTF-8",
+        "crate.mtl:1: not UTF-8",
+        "crate.obj:30: `usemtl` without a name",
+        "usemtl `shipping_label` names no material",
+    ] {
+        let lines: Vec<&str> = stderr.lines().filter(|l| l.contains(needle)).collect();
+        assert_eq!(lines.len(), 1, "`{needle}` once in\n{stderr}");
+        assert!(lines[0].starts_with("warning: "), "{}", lines[0]);
+    }
+    let chess = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/chess.toml");
+    let (code, stdout, _) = harness(&["inspect", "--json", chess.to_str().unwrap()]);
+    assert_eq!(code, 0);
+    let value: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(
+        value["warnings"],
+        serde_json::json!([]),
+        "the canonical assets are tidy"
+    );
+}
+
+/// A misspelt pass is refused before anything is rendered, with the scene's outputs listed.
+#[test]
+fn render_rejects_an_unknown_pass_before_rendering() {
+    let (code, stdout, stderr) = harness(&["render", "--scene", "arrow", "--pass", "finall"]);
+    assert_eq!(code, 1, "{stdout}\n{stderr}");
+    assert!(
+        stderr.contains("no pass output `finall`") && stderr.contains("final"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("rendering"), "rendered first:\n{stderr}");
+}
+
+/// `render` takes a scene file path as well as a name, and writes every pass with `--pass all`
+/// (PNG for 8-bit outputs, EXR for float ones).
+#[test]
+fn render_writes_every_pass_of_a_scene_file() {
+    if !common::gl_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/arrow.toml");
+    let (code, stdout, stderr) = harness(&[
+        "render",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--backend",
+        "gl",
+        "--pass",
+        "all",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    for file in [
+        "final.png",
+        "mask.png",
+        "light.exr",
+        "depth.exr",
+        "gbuffer_position.exr",
+        "gbuffer_normal.exr",
+        "gbuffer_tangent.exr",
+        "gbuffer_albedo.exr",
+        "gbuffer_material.exr",
+    ] {
+        assert!(dir.path().join(file).is_file(), "{file} missing:\n{stdout}");
+    }
+    let (code, _, stderr) = harness(&["render", "--scene", "arrow", "--pass", "shadow"]);
+    assert_eq!(code, 1);
+    assert!(stderr.contains("no pass output `shadow`"), "{stderr}");
+}

@@ -1,0 +1,57 @@
+//! The harness in its workspace: a private runtime directory when XDG_RUNTIME_DIR is unset,
+//! unknown scene names answered with the canonical ones, and scene assets that regenerate
+//! byte for byte.
+
+mod common;
+
+use std::path::Path;
+use std::process::Command;
+
+use common::cli::harness;
+
+/// Without XDG_RUNTIME_DIR the drivers' window-system probes are not left to complain: the
+/// harness gives itself a private runtime directory.
+#[test]
+fn no_runtime_dir_complaints_without_xdg_runtime_dir() {
+    let output = common::harness_command()
+        .arg("backends")
+        .env_remove("XDG_RUNTIME_DIR")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(!stderr.contains("XDG_RUNTIME_DIR"), "{stderr}");
+}
+
+#[test]
+fn unknown_scene_names_list_the_canonical_scenes() {
+    let (code, _, stderr) = harness(&["plan", "--scene", "chesss"]);
+    assert_eq!(code, 1);
+    assert!(stderr.contains("chess"), "{stderr}");
+}
+
+/// The committed scene assets are exactly what the generator writes, so they can be regenerated.
+#[test]
+fn scene_assets_regenerate_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let status = Command::new(env!("CARGO_BIN_EXE_make_scene_assets"))
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(status.status.success(), "{status:?}");
+    let committed = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/assets");
+    let mut compared = 0;
+    for entry in std::fs::read_dir(dir.path()).unwrap() {
+        let entry = entry.unwrap();
+        let name = entry.file_name();
+        let fresh = std::fs::read(entry.path()).unwrap();
+        let old = std::fs::read(committed.join(&name))
+            .unwrap_or_else(|e| panic!("{name:?} is generated but not committed: {e}"));
+        assert!(
+            fresh == old,
+            "{name:?} differs from the generator's output; run make_scene_assets"
+        );
+        compared += 1;
+    }
+    assert!(compared >= 12, "only {compared} files generated");
+}
