@@ -1,4 +1,4 @@
-//! Issue 8's hard cases: the scene files in `scenes/hard/` and the chess scene moved and
+//! The hard numerical cases: the scene files in `scenes/hard/` and the chess scene moved and
 //! scaled, each rendered and checked against its invariant. `harness hard` prints the table and
 //! keeps it for the check report; `tests/hard_cases.rs` asserts every row on every backend.
 //!
@@ -28,7 +28,7 @@ pub const SCENE_CASES: [&str; 8] = [
 ];
 
 /// Cases lit only by analytic lights without shadows, where the f64 reference of the lighting
-/// pass is defined (issue 8: p99.9 <= 2e-3 relative).
+/// pass is defined; each must match it within p99.9 <= 2e-3 relative.
 pub const REFERENCE_CASES: [&str; 5] = [
     "degenerate",
     "grazing",
