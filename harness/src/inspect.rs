@@ -5,7 +5,7 @@ use std::path::Path;
 
 use engine::assets::{self, ColorSpace, TextureCache};
 use engine::plan::RenderPlan;
-use engine::scene::Light;
+use engine::scene::{Light, Object};
 use engine::scene_file;
 use serde_json::{json, Value};
 
@@ -31,164 +31,179 @@ pub fn inspect(path: &Path) -> Result<Value, InspectError> {
         .unwrap_or("")
         .to_ascii_lowercase();
     match extension.as_str() {
-        "obj" => {
-            let mut textures = TextureCache::new();
-            let model = assets::load_obj(path, &mut textures)?;
-            let summary = serde_json::to_value(model.summary(&textures)).unwrap_or(Value::Null);
-            Ok(json!({ "kind": "obj", "model": summary }))
-        }
-        "mtl" => {
-            let mut textures = TextureCache::new();
-            let (materials, warnings) = assets::load_mtl(path, &mut textures)?;
-            let texture_path = |id| {
-                textures
-                    .get(id)
-                    .map(|t| t.path.display().to_string())
-                    .unwrap_or_default()
-            };
-            let materials: Vec<Value> = materials
-                .iter()
-                .map(|m| {
-                    json!({
-                        "name": m.name,
-                        "diffuse": m.diffuse,
-                        "specular": m.specular,
-                        "shininess": m.shininess,
-                        "maps": m.maps.iter().map(|(slot, id)| json!({"slot": slot, "path": texture_path(id)})).collect::<Vec<_>>(),
-                    })
-                })
-                .collect();
-            let textures: Vec<Value> = textures
-                .iter()
-                .map(|(_, t)| {
-                    texture_json(
-                        &t.path.display().to_string(),
-                        t.width,
-                        t.height,
-                        t.mips.len(),
-                        t.color_space,
-                    )
-                })
-                .collect();
-            Ok(
-                json!({ "kind": "mtl", "path": path.display().to_string(), "materials": materials, "textures": textures, "warnings": warnings }),
-            )
-        }
-        "png" | "jpg" | "jpeg" | "tga" | "bmp" => {
-            let texture = assets::load_texture(path, ColorSpace::Srgb)?;
-            let mut described = texture_json(
-                &path.display().to_string(),
-                texture.width,
-                texture.height,
-                texture.mips.len(),
-                ColorSpace::Srgb,
-            );
-            described["bits"] = json!(texture.bits());
-            Ok(json!({ "kind": "texture", "texture": described }))
-        }
-        "exr" | "hdr" => {
-            let environment = assets::load_environment(path)?;
-            let summary = serde_json::to_value(environment.summary()).unwrap_or(Value::Null);
-            Ok(json!({ "kind": "environment", "environment": summary }))
-        }
-        "toml" => {
-            let loaded = scene_file::load(path)?;
-            let scene = &loaded.scene;
-            let objects: Vec<Value> = scene
-                .objects
-                .iter()
-                .map(|o| {
-                    let m = &o.material;
-                    let maps: Vec<&str> = [
-                        ("base_color", m.base_color_map),
-                        ("normal", m.normal_map),
-                        ("roughness", m.roughness_map),
-                        ("metallic", m.metallic_map),
-                        ("clearcoat", m.clearcoat_map),
-                        ("specular", m.specular_map),
-                    ]
-                    .into_iter()
-                    .filter_map(|(name, map)| map.map(|_| name))
-                    .collect();
-                    json!({
-                        "name": o.name,
-                        "mesh": o.mesh.name,
-                        "vertices": o.mesh.vertices.len(),
-                        "triangles": o.mesh.triangle_count(),
-                        "bounds": o.mesh.bounds,
-                        "lighting": o.lighting.name(),
-                        "base_color": m.base_color,
-                        "roughness": m.roughness,
-                        "metallic": m.metallic,
-                        "clearcoat": m.clearcoat,
-                        "anisotropy": m.anisotropy,
-                        "maps": maps,
-                    })
-                })
-                .collect();
-            let lights: Vec<Value> = scene
-                .lights
-                .iter()
-                .map(|l| match l {
-                    Light::Directional {
-                        direction,
-                        color,
-                        intensity,
-                        angular_radius,
-                        shadow,
-                    } => json!({
-                        "type": "directional", "direction": direction.to_array(), "color": color,
-                        "intensity": intensity, "angular_radius": angular_radius,
-                        "shadow_map": shadow.map(|s| s.map_size),
-                    }),
-                    Light::Point {
-                        position,
-                        color,
-                        intensity,
-                        radius,
-                        falloff,
-                        shadow,
-                    } => json!({
-                        "type": "point", "position": position.to_array(), "color": color,
-                        "intensity": intensity, "radius": radius, "falloff": falloff,
-                        "shadow_map": shadow.map(|s| s.map_size),
-                    }),
-                })
-                .collect();
-            let textures: Vec<Value> = scene
-                .textures
-                .iter()
-                .map(|t| {
-                    let space = if t.srgb {
-                        ColorSpace::Srgb
-                    } else {
-                        ColorSpace::Linear
-                    };
-                    texture_json(&t.label, t.width, t.height, t.mips.len(), space)
-                })
-                .collect();
-            let environment = scene.environment.as_ref().map(|e| {
-                json!({
-                    "path": e.image.label, "width": e.image.width, "height": e.image.height,
-                    "rotation_degrees": e.rotation_degrees, "intensity": e.intensity,
-                })
-            });
-            Ok(json!({
-                "kind": "scene",
-                "path": path.display().to_string(),
-                "name": scene.name,
-                "description": loaded.description,
-                "size": [scene.quality.width, scene.quality.height],
-                "objects": objects,
-                "lights": lights,
-                "environment": environment,
-                "textures": textures,
-                "textures_decoded": loaded.textures_decoded,
-                "warnings": loaded.warnings,
-                "plan": RenderPlan::new(scene).to_string(),
-            }))
-        }
+        "obj" => inspect_obj(path),
+        "mtl" => inspect_mtl(path),
+        "png" | "jpg" | "jpeg" | "tga" | "bmp" => inspect_texture(path),
+        "exr" | "hdr" => inspect_environment(path),
+        "toml" => inspect_scene(path),
         _ => Err(InspectError::UnknownKind(path.display().to_string())),
+    }
+}
+
+/// An OBJ model: its meshes, materials and textures.
+fn inspect_obj(path: &Path) -> Result<Value, InspectError> {
+    let mut textures = TextureCache::new();
+    let model = assets::load_obj(path, &mut textures)?;
+    let summary = serde_json::to_value(model.summary(&textures)).unwrap_or(Value::Null);
+    Ok(json!({ "kind": "obj", "model": summary }))
+}
+
+/// An MTL library: its materials and the textures they use.
+fn inspect_mtl(path: &Path) -> Result<Value, InspectError> {
+    let mut textures = TextureCache::new();
+    let (materials, warnings) = assets::load_mtl(path, &mut textures)?;
+    let texture_path = |id| {
+        textures
+            .get(id)
+            .map(|t| t.path.display().to_string())
+            .unwrap_or_default()
+    };
+    let materials: Vec<Value> = materials
+        .iter()
+        .map(|m| {
+            json!({
+                "name": m.name,
+                "diffuse": m.diffuse,
+                "specular": m.specular,
+                "shininess": m.shininess,
+                "maps": m.maps.iter().map(|(slot, id)| json!({"slot": slot, "path": texture_path(id)})).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    let textures: Vec<Value> = textures
+        .iter()
+        .map(|(_, t)| {
+            texture_json(
+                &t.path.display().to_string(),
+                t.width,
+                t.height,
+                t.mips.len(),
+                t.color_space,
+            )
+        })
+        .collect();
+    Ok(
+        json!({ "kind": "mtl", "path": path.display().to_string(), "materials": materials, "textures": textures, "warnings": warnings }),
+    )
+}
+
+/// A texture, decoded as sRGB.
+fn inspect_texture(path: &Path) -> Result<Value, InspectError> {
+    let texture = assets::load_texture(path, ColorSpace::Srgb)?;
+    let mut described = texture_json(
+        &path.display().to_string(),
+        texture.width,
+        texture.height,
+        texture.mips.len(),
+        ColorSpace::Srgb,
+    );
+    described["bits"] = json!(texture.bits());
+    Ok(json!({ "kind": "texture", "texture": described }))
+}
+
+/// An environment map.
+fn inspect_environment(path: &Path) -> Result<Value, InspectError> {
+    let environment = assets::load_environment(path)?;
+    let summary = serde_json::to_value(environment.summary()).unwrap_or(Value::Null);
+    Ok(json!({ "kind": "environment", "environment": summary }))
+}
+
+/// A scene file: its objects, lights, environment, textures and render plan.
+fn inspect_scene(path: &Path) -> Result<Value, InspectError> {
+    let loaded = scene_file::load(path)?;
+    let scene = &loaded.scene;
+    let objects: Vec<Value> = scene.objects.iter().map(object_json).collect();
+    let lights: Vec<Value> = scene.lights.iter().map(light_json).collect();
+    let textures: Vec<Value> = scene
+        .textures
+        .iter()
+        .map(|t| {
+            let space = if t.srgb {
+                ColorSpace::Srgb
+            } else {
+                ColorSpace::Linear
+            };
+            texture_json(&t.label, t.width, t.height, t.mips.len(), space)
+        })
+        .collect();
+    let environment = scene.environment.as_ref().map(|e| {
+        json!({
+            "path": e.image.label, "width": e.image.width, "height": e.image.height,
+            "rotation_degrees": e.rotation_degrees, "intensity": e.intensity,
+        })
+    });
+    Ok(json!({
+        "kind": "scene",
+        "path": path.display().to_string(),
+        "name": scene.name,
+        "description": loaded.description,
+        "size": [scene.quality.width, scene.quality.height],
+        "objects": objects,
+        "lights": lights,
+        "environment": environment,
+        "textures": textures,
+        "textures_decoded": loaded.textures_decoded,
+        "warnings": loaded.warnings,
+        "plan": RenderPlan::new(scene).to_string(),
+    }))
+}
+
+/// One object of a scene: its mesh, lighting model and material.
+fn object_json(o: &Object) -> Value {
+    let m = &o.material;
+    let maps: Vec<&str> = [
+        ("base_color", m.base_color_map),
+        ("normal", m.normal_map),
+        ("roughness", m.roughness_map),
+        ("metallic", m.metallic_map),
+        ("clearcoat", m.clearcoat_map),
+        ("specular", m.specular_map),
+    ]
+    .into_iter()
+    .filter_map(|(name, map)| map.map(|_| name))
+    .collect();
+    json!({
+        "name": o.name,
+        "mesh": o.mesh.name,
+        "vertices": o.mesh.vertices.len(),
+        "triangles": o.mesh.triangle_count(),
+        "bounds": o.mesh.bounds,
+        "lighting": o.lighting.name(),
+        "base_color": m.base_color,
+        "roughness": m.roughness,
+        "metallic": m.metallic,
+        "clearcoat": m.clearcoat,
+        "anisotropy": m.anisotropy,
+        "maps": maps,
+    })
+}
+
+/// One light of a scene.
+fn light_json(l: &Light) -> Value {
+    match l {
+        Light::Directional {
+            direction,
+            color,
+            intensity,
+            angular_radius,
+            shadow,
+        } => json!({
+            "type": "directional", "direction": direction.to_array(), "color": color,
+            "intensity": intensity, "angular_radius": angular_radius,
+            "shadow_map": shadow.map(|s| s.map_size),
+        }),
+        Light::Point {
+            position,
+            color,
+            intensity,
+            radius,
+            falloff,
+            shadow,
+        } => json!({
+            "type": "point", "position": position.to_array(), "color": color,
+            "intensity": intensity, "radius": radius, "falloff": falloff,
+            "shadow_map": shadow.map(|s| s.map_size),
+        }),
     }
 }
 

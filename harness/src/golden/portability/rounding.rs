@@ -1,0 +1,199 @@
+//! Synthetic host rounding: 8-bit outputs re-quantized from an exact f64 tone mapping of the
+//! light buffer, float outputs moved by ±1 ulp of their storage, as another host's arithmetic
+//! could round them.
+
+use std::collections::BTreeMap;
+
+use engine::assets::linear_to_srgb_u8;
+use engine::ibl::splitmix64;
+use engine::scene::ToneMap;
+use engine::{Image, ImageData};
+
+use crate::golden::suite::Case;
+
+/// Synthetic host rounding of a frame's golden outputs (see
+/// [`SourceKind::SyntheticRounding`](super::SourceKind::SyntheticRounding)):
+/// 8-bit outputs that are a tone mapping of the light buffer are re-quantized from an f64
+/// evaluation of it; float outputs move by ±1 ulp of their storage. The mask (exact one-hot
+/// values, no arithmetic to round) and outputs drawn over by gizmos are left out.
+pub fn synthetic_rounding(
+    case: &Case,
+    outputs: &BTreeMap<String, Image>,
+) -> BTreeMap<String, Image> {
+    let quality = &case.loaded.scene.quality;
+    let mut out = BTreeMap::new();
+    for (seed, (pass, image)) in outputs.iter().enumerate() {
+        match &image.data {
+            ImageData::F32(_) => {
+                out.insert(pass.clone(), ulp_noise(image, seed as u64));
+            }
+            ImageData::U8(_) if pass == engine::plan::FINAL && !quality.gizmos => {
+                if let Some(light) = outputs.get(engine::plan::LIGHT) {
+                    out.insert(pass.clone(), requantize_final(light, quality.tone_map));
+                }
+            }
+            ImageData::U8(_) => {}
+        }
+    }
+    out
+}
+
+/// The tone-mapping pass's curve, in f64 (engine/shaders/tonemap.wgsl).
+pub fn tone_map(x: f64, operator: ToneMap) -> f64 {
+    let x = x.max(0.0);
+    match operator {
+        ToneMap::Aces => (x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14),
+        ToneMap::Reinhard => x / (1.0 + x),
+        ToneMap::Clamp => x,
+    }
+    .clamp(0.0, 1.0)
+}
+
+/// The final image as an exact f64 evaluation of the tone mapping and sRGB encoding of `light`,
+/// rounded to 8 bits: where the GPU's f32 arithmetic lands near a rounding boundary, this rounds
+/// the other way, as another host's would.
+pub fn requantize_final(light: &Image, operator: ToneMap) -> Image {
+    let values = light.as_f32().unwrap_or(&[]);
+    let channels = light.channels();
+    let mut data = Vec::with_capacity(light.width as usize * light.height as usize * 4);
+    for pixel in values.chunks_exact(channels) {
+        for c in 0..3 {
+            let v = f64::from(pixel[c.min(channels - 1)]);
+            data.push(linear_to_srgb_u8(tone_map(v, operator)));
+        }
+        data.push(255);
+    }
+    Image {
+        width: light.width,
+        height: light.height,
+        format: engine::backend::TextureFormat::Rgba8UnormSrgb,
+        data: ImageData::U8(data),
+    }
+}
+
+/// Moves `x` by `steps` representable values of its storage: fp16 for RGBA16F outputs, f32
+/// otherwise. Infinities and NaN stay as they are; zero moves to the smallest subnormal.
+pub fn step_ulps(x: f32, steps: i32, fp16: bool) -> f32 {
+    if !x.is_finite() {
+        return x;
+    }
+    // Map the bits to integers that order like the values (negative values below zero).
+    if fp16 {
+        let bits = i32::from(half::f16::from_f32(x).to_bits());
+        let ordered = if bits & 0x8000 != 0 {
+            -(bits & 0x7fff)
+        } else {
+            bits
+        };
+        let moved = (ordered + steps).clamp(-0x7bff, 0x7bff);
+        let bits = if moved < 0 { (-moved) | 0x8000 } else { moved };
+        half::f16::from_bits(bits as u16).to_f32()
+    } else {
+        let bits = i64::from(x.to_bits());
+        let ordered = if bits & 0x8000_0000 != 0 {
+            -(bits & 0x7fff_ffff)
+        } else {
+            bits
+        };
+        let moved = (ordered + i64::from(steps)).clamp(-0x7f7f_ffff, 0x7f7f_ffff);
+        let bits = if moved < 0 {
+            (-moved) | 0x8000_0000
+        } else {
+            moved
+        };
+        f32::from_bits(bits as u32)
+    }
+}
+
+/// Every value moved by -1, 0 or +1 ulp of its storage, chosen by a hash of `seed` and its index.
+pub fn ulp_noise(image: &Image, seed: u64) -> Image {
+    let fp16 = image.format == engine::backend::TextureFormat::Rgba16Float;
+    let mut out = image.clone();
+    if let ImageData::F32(values) = &mut out.data {
+        for (i, v) in values.iter_mut().enumerate() {
+            let step = (splitmix64(seed.wrapping_mul(0x1_0000_0001) ^ i as u64) % 3) as i32 - 1;
+            *v = step_ulps(*v, step, fp16);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ulp_steps_move_by_one_representable_value() {
+        for fp16 in [true, false] {
+            for x in [0.0f32, 1.0, -1.0, 0.1, 123.4, -7e-3] {
+                let up = step_ulps(x, 1, fp16);
+                let down = step_ulps(x, -1, fp16);
+                assert!(up > x && down < x, "{x}: {down} {up} (fp16 {fp16})");
+                if fp16 {
+                    let h = half::f16::from_f32(x).to_f32();
+                    assert_eq!(step_ulps(up, -1, true), h, "{x}");
+                    assert!(((up - h) / h.abs().max(1e-4)).abs() < 2e-3, "{x}: {up}");
+                } else {
+                    assert_eq!(step_ulps(up, -1, false), x);
+                    if x > 0.0 {
+                        assert_eq!(up, f32::from_bits(x.to_bits() + 1));
+                    }
+                }
+            }
+        }
+        assert_eq!(step_ulps(0.0, 1, false), f32::from_bits(1));
+        assert_eq!(step_ulps(0.0, -1, false), -f32::from_bits(1));
+        assert!(step_ulps(f32::NAN, 1, true).is_nan());
+        assert_eq!(step_ulps(65504.0, 1, true), 65504.0);
+    }
+
+    #[test]
+    fn ulp_noise_is_seeded_and_moves_about_two_thirds_of_the_values() {
+        let image = Image {
+            width: 64,
+            height: 64,
+            format: engine::backend::TextureFormat::Rgba16Float,
+            data: ImageData::F32(vec![0.75; 64 * 64 * 4]),
+        };
+        let a = ulp_noise(&image, 7);
+        assert_eq!(a, ulp_noise(&image, 7));
+        assert_ne!(a, ulp_noise(&image, 8));
+        let values = a.as_f32().unwrap();
+        let moved = values.iter().filter(|&&v| v != 0.75).count() as f64 / values.len() as f64;
+        assert!((moved - 2.0 / 3.0).abs() < 0.03, "{moved}");
+        assert!(values
+            .iter()
+            .all(|&v| ((v - 0.75) / 0.75).abs() <= 2f32.powi(-11) * 1.34));
+    }
+
+    #[test]
+    fn requantized_final_follows_the_exact_curve() {
+        // A gradient through the whole ACES range: the f64 evaluation rounds exactly.
+        let n = 4096;
+        let light = Image {
+            width: n as u32,
+            height: 1,
+            format: engine::backend::TextureFormat::Rgba16Float,
+            data: ImageData::F32((0..n).flat_map(|i| [i as f32 / 256.0; 4]).collect()),
+        };
+        let f = requantize_final(&light, ToneMap::Aces);
+        let values = f.as_u8().unwrap();
+        assert_eq!(values[0], 0);
+        assert_eq!(values[(n - 1) * 4], 255);
+        // Mid-grey 0.18 -> ACES 0.26690 -> sRGB 0.55346 -> 141.13 -> 141.
+        assert!((tone_map(0.18, ToneMap::Aces) - 0.266_899).abs() < 1e-6);
+        // sRGB 0.553457 x 255 = 141.13.
+        assert_eq!(linear_to_srgb_u8(0.266_899), 141);
+        let grey = requantize_final(
+            &Image {
+                width: 1,
+                height: 1,
+                format: engine::backend::TextureFormat::Rgba16Float,
+                data: ImageData::F32(vec![0.18, 0.18, 0.18, 1.0]),
+            },
+            ToneMap::Aces,
+        );
+        // 0.18 in fp16 storage is 0.17993, still 141.
+        assert_eq!(grey.as_u8().unwrap(), [141, 141, 141, 255]);
+    }
+}

@@ -1,0 +1,221 @@
+//! The known changes of the self-test: what each is, the pass where it must be caught, and how
+//! it changes a scene (or the renderer, through an injected fault).
+
+use engine::plan;
+use engine::renderer::Faults;
+use engine::scene::{Light, LightingModel, Material, Scene};
+use glam::DQuat;
+
+/// A known change.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
+pub enum Mutation {
+    /// Every light's intensity x1.02.
+    LightIntensity,
+    /// Exposure x1.03.
+    Exposure,
+    /// The first point light moved 1 cm along +X.
+    PointLightMoved,
+    /// Environment intensity x1.02.
+    EnvironmentIntensity,
+    /// Environment rotated 2 degrees.
+    EnvironmentRotation,
+    /// Every shadow's constant and slope-scaled bias x4.
+    ShadowBias,
+    /// Roughness ±0.05 (down where up would pass 1) on the first PBR object whose roughness is a
+    /// scalar.
+    Roughness,
+    /// Metallic ±0.05 on the first PBR object whose metallic is a scalar.
+    Metallic,
+    /// Clearcoat ±0.05 on the first PBR object whose clearcoat is a scalar.
+    Clearcoat,
+    /// Specular ±0.05 on the first PBR object whose specular is a scalar.
+    Specular,
+    /// Base color x0.97 on the first PBR object whose base color is a scalar.
+    BaseColor,
+    /// Albedo red and blue swapped in the G-buffer (an injected fault).
+    GbufferChannelSwap,
+    /// Camera turned 0.25 degrees about its up axis.
+    CameraYaw,
+    /// The last object drawn with another lighting model (PBR <-> Lambert).
+    LightingModel,
+    /// The tone-mapping pass scales its input by 1.03 (an injected fault: the light buffer is
+    /// untouched).
+    ToneCurve,
+}
+
+impl Mutation {
+    /// Every mutation.
+    pub const ALL: [Mutation; 15] = [
+        Mutation::LightIntensity,
+        Mutation::Exposure,
+        Mutation::PointLightMoved,
+        Mutation::EnvironmentIntensity,
+        Mutation::EnvironmentRotation,
+        Mutation::ShadowBias,
+        Mutation::Roughness,
+        Mutation::Metallic,
+        Mutation::Clearcoat,
+        Mutation::Specular,
+        Mutation::BaseColor,
+        Mutation::GbufferChannelSwap,
+        Mutation::CameraYaw,
+        Mutation::LightingModel,
+        Mutation::ToneCurve,
+    ];
+
+    /// Short description.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Mutation::LightIntensity => "light intensity x1.02",
+            Mutation::Exposure => "exposure x1.03",
+            Mutation::PointLightMoved => "point light moved 1 cm",
+            Mutation::EnvironmentIntensity => "environment intensity x1.02",
+            Mutation::EnvironmentRotation => "environment rotated 2 deg",
+            Mutation::ShadowBias => "shadow bias x4",
+            Mutation::Roughness => "roughness ±0.05 on one material",
+            Mutation::Metallic => "metallic ±0.05 on one material",
+            Mutation::Clearcoat => "clearcoat ±0.05 on one material",
+            Mutation::Specular => "specular ±0.05 on one material",
+            Mutation::BaseColor => "base color x0.97 on one material",
+            Mutation::GbufferChannelSwap => "G-buffer albedo R<->B swapped",
+            Mutation::CameraYaw => "camera yaw 0.25 deg",
+            Mutation::LightingModel => "one object's lighting model",
+            Mutation::ToneCurve => "tone-map input x1.03",
+        }
+    }
+
+    /// The golden pass where the change first shows, and so must be caught: lighting changes in
+    /// the light buffer, material changes in the G-buffer target that holds them, geometry in
+    /// depth, the lighting model in the mask, tone mapping in the final image.
+    pub fn origin(self) -> &'static str {
+        match self {
+            Mutation::LightIntensity
+            | Mutation::Exposure
+            | Mutation::PointLightMoved
+            | Mutation::EnvironmentIntensity
+            | Mutation::EnvironmentRotation
+            | Mutation::ShadowBias => plan::LIGHT,
+            Mutation::Roughness => "gbuffer_position",
+            Mutation::Metallic | Mutation::Clearcoat => "gbuffer_material",
+            Mutation::Specular => "gbuffer_normal",
+            Mutation::BaseColor | Mutation::GbufferChannelSwap => "gbuffer_albedo",
+            Mutation::CameraYaw => plan::DEPTH,
+            Mutation::LightingModel => "mask",
+            Mutation::ToneCurve => plan::FINAL,
+        }
+    }
+
+    /// Applies the mutation; `None` when the scene has nothing it could change (no lights, no
+    /// environment, no shadow-casting light, no scalar material parameter, ...).
+    pub fn apply(self, scene: &Scene) -> Option<(Scene, Faults)> {
+        let mut s = scene.clone();
+        let mut faults = Faults::default();
+        match self {
+            Mutation::LightIntensity => {
+                if s.lights.is_empty() {
+                    return None;
+                }
+                for light in &mut s.lights {
+                    match light {
+                        Light::Directional { intensity, .. } | Light::Point { intensity, .. } => {
+                            *intensity *= 1.02
+                        }
+                    }
+                }
+            }
+            Mutation::Exposure => s.quality.exposure *= 1.03,
+            Mutation::PointLightMoved => {
+                let position = s.lights.iter_mut().find_map(|l| match l {
+                    Light::Point { position, .. } => Some(position),
+                    Light::Directional { .. } => None,
+                })?;
+                position.x += 0.01;
+            }
+            Mutation::EnvironmentIntensity => s.environment.as_mut()?.intensity *= 1.02,
+            Mutation::EnvironmentRotation => {
+                s.environment.as_mut()?.rotation_degrees += 2.0;
+            }
+            Mutation::ShadowBias => {
+                let mut any = false;
+                for light in &mut s.lights {
+                    match light {
+                        Light::Directional { shadow, .. } | Light::Point { shadow, .. } => {
+                            if let Some(shadow) = shadow {
+                                shadow.bias *= 4.0;
+                                shadow.slope_bias *= 4.0;
+                                any = true;
+                            }
+                        }
+                    }
+                }
+                if !any {
+                    return None;
+                }
+            }
+            Mutation::Roughness => {
+                let m = scalar_material(&mut s, |m| m.roughness_map.is_none())?;
+                m.roughness = nudge(m.roughness);
+            }
+            Mutation::Metallic => {
+                let m = scalar_material(&mut s, |m| m.metallic_map.is_none())?;
+                m.metallic = nudge(m.metallic);
+            }
+            Mutation::Clearcoat => {
+                let m = scalar_material(&mut s, |m| m.clearcoat_map.is_none())?;
+                m.clearcoat = nudge(m.clearcoat);
+            }
+            Mutation::Specular => {
+                let m = scalar_material(&mut s, |m| m.specular_map.is_none())?;
+                m.specular = nudge(m.specular);
+            }
+            Mutation::BaseColor => {
+                let m = scalar_material(&mut s, |m| m.base_color_map.is_none())?;
+                m.base_color = m.base_color.map(|c| c * 0.97);
+            }
+            Mutation::GbufferChannelSwap => faults.swap_albedo_red_blue = true,
+            Mutation::CameraYaw => {
+                let c = &mut s.camera;
+                let rotation = DQuat::from_axis_angle(c.up.normalize(), 0.25f64.to_radians());
+                c.target = c.position + rotation * (c.target - c.position);
+            }
+            Mutation::LightingModel => {
+                let object = s.objects.last_mut()?;
+                object.lighting = if object.lighting == LightingModel::Pbr {
+                    LightingModel::Lambert
+                } else {
+                    LightingModel::Pbr
+                };
+            }
+            Mutation::ToneCurve => faults.tonemap_input_scale = Some(1.03),
+        }
+        Some((s, faults))
+    }
+}
+
+/// A 0..1 material parameter moved by 0.05: up, or down where up would leave the range.
+fn nudge(value: f32) -> f32 {
+    if value <= 0.95 {
+        value + 0.05
+    } else {
+        value - 0.05
+    }
+}
+
+/// The material of the first PBR object for which `scalar` holds (the parameter is not a map).
+fn scalar_material(scene: &mut Scene, scalar: impl Fn(&Material) -> bool) -> Option<&mut Material> {
+    scene
+        .objects
+        .iter_mut()
+        .find(|o| o.lighting == LightingModel::Pbr && scalar(&o.material))
+        .map(|o| &mut o.material)
+}
+
+impl Mutation {
+    /// Whether `pass` is where this mutation originates (any shadow term, for the shadow bias).
+    pub fn is_origin(self, pass: &str) -> bool {
+        match self {
+            Mutation::ShadowBias => pass.starts_with("shadow_term_"),
+            _ => pass == self.origin(),
+        }
+    }
+}

@@ -1,0 +1,236 @@
+//! Running the self-test: per scene (in parallel) and backend, an unchanged render, synthetic
+//! rounding of the reference backend's render, and every mutation, each against the goldens;
+//! then the figures golden/noise.toml recorded for the sources this run does not produce.
+
+use std::collections::BTreeMap;
+
+use engine::backend::{self, BackendKind};
+use engine::renderer::{self, Faults, Readback};
+use engine::scene::Scene;
+use engine::Image;
+
+use super::{Mutation, MutationResult, NoiseResult, SelfTest};
+use crate::golden::noise::NoiseModel;
+use crate::golden::portability;
+use crate::golden::suite::{self, Case};
+use crate::golden::{self, GoldenStore, Outcome};
+
+/// The golden of every pass of a case, by pass (`None` where there is none).
+type Goldens = BTreeMap<String, Option<Image>>;
+
+/// Ratios of every golden pass of `outputs` against the goldens.
+fn ratios(
+    case: &Case,
+    goldens: &Goldens,
+    outputs: &BTreeMap<String, Image>,
+) -> BTreeMap<String, f64> {
+    let mut out = BTreeMap::new();
+    for pass in &case.passes {
+        let (Some(actual), Some(golden)) = (outputs.get(pass), goldens.get(pass)) else {
+            continue;
+        };
+        let ratio = match golden::check(actual, golden.as_ref(), &case.rules[pass]) {
+            Outcome::Passed(v) | Outcome::Failed(v) => v.ratio,
+            Outcome::MissingGolden | Outcome::Incomparable(_) => f64::INFINITY,
+        };
+        out.insert(pass.clone(), ratio);
+    }
+    out
+}
+
+/// Runs the self-test on `backends`: every mutation and an unchanged render on each, synthetic
+/// rounding of the reference backend's render, and the figures `model` recorded for the sources
+/// this run does not produce (CPU code paths, another Mesa, recorded hosts). Scenes run in
+/// parallel, one thread each, each with its own backends.
+pub fn run(
+    cases: &[Case],
+    store: &GoldenStore,
+    backends: &[BackendKind],
+    model: &NoiseModel,
+) -> SelfTest {
+    let parts: Vec<SelfTest> = std::thread::scope(|scope| {
+        let handles: Vec<_> = cases
+            .iter()
+            .map(|case| scope.spawn(move || run_case(case, store, backends, model)))
+            .collect();
+        handles
+            .into_iter()
+            .zip(cases)
+            .map(|(handle, case)| {
+                handle.join().unwrap_or_else(|_| SelfTest {
+                    mutations: vec![],
+                    noise: vec![],
+                    errors: vec![format!("{}: self-test thread panicked", case.name())],
+                })
+            })
+            .collect()
+    });
+    let mut result = SelfTest {
+        mutations: vec![],
+        noise: vec![],
+        errors: vec![],
+    };
+    for part in parts {
+        result.mutations.extend(part.mutations);
+        result.noise.extend(part.noise);
+        result.errors.extend(part.errors);
+    }
+    result
+}
+
+/// The self-test of one scene on every backend.
+fn run_case(
+    case: &Case,
+    store: &GoldenStore,
+    backends: &[BackendKind],
+    model: &NoiseModel,
+) -> SelfTest {
+    let mut result = SelfTest {
+        mutations: vec![],
+        noise: vec![],
+        errors: vec![],
+    };
+    let goldens: Goldens = case
+        .passes
+        .iter()
+        .map(|pass| {
+            let golden = store.load(case.name(), pass, case.is_eight_bit(pass));
+            (pass.clone(), golden.ok().flatten())
+        })
+        .collect();
+    let reference = backends
+        .iter()
+        .copied()
+        .find(|&k| k == suite::REFERENCE_BACKEND)
+        .or(backends.first().copied());
+    for &kind in backends {
+        run_backend(case, kind, Some(kind) == reference, &goldens, &mut result);
+    }
+    // The sources this run does not produce, from the figures golden/noise.toml recorded.
+    recorded_noise(case, model, &mut result.noise);
+    result
+}
+
+/// One scene on one backend: the unchanged render (and its synthetic rounding, on the
+/// `reference` backend), then every mutation.
+fn run_backend(
+    case: &Case,
+    kind: BackendKind,
+    reference: bool,
+    goldens: &Goldens,
+    result: &mut SelfTest,
+) {
+    let scene = &case.loaded.scene;
+    let wanted: Vec<&str> = case.passes.iter().map(String::as_str).collect();
+    let mut backend = match backend::create(kind) {
+        Ok(backend) => backend,
+        Err(e) => {
+            result
+                .errors
+                .push(format!("{} on {kind}: {e}", case.name()));
+            return;
+        }
+    };
+    let mut render = |scene: &Scene, faults: &Faults| {
+        renderer::render_with_faults(backend.as_mut(), scene, Readback::Only(&wanted), faults)
+            .map_err(|e| e.to_string())
+    };
+    match render(scene, &Faults::default()) {
+        Ok(frame) => unchanged_noise(case, kind, reference, goldens, &frame.outputs, result),
+        Err(e) => result
+            .errors
+            .push(format!("unchanged {} on {kind}: {e}", case.name())),
+    }
+    for mutation in Mutation::ALL {
+        let mut entry = MutationResult {
+            scene: case.name().to_owned(),
+            mutation,
+            backend: kind.name().to_owned(),
+            applies: false,
+            ratios: BTreeMap::new(),
+            error: None,
+        };
+        if let Some((mutated, faults)) = mutation.apply(scene) {
+            entry.applies = true;
+            match render(&mutated, &faults) {
+                Ok(frame) => entry.ratios = ratios(case, goldens, &frame.outputs),
+                Err(e) => {
+                    result.errors.push(format!(
+                        "{} on {kind} with `{}`: {e}",
+                        case.name(),
+                        mutation.describe()
+                    ));
+                    entry.error = Some(e);
+                }
+            }
+        }
+        result.mutations.push(entry);
+    }
+}
+
+/// The unchanged render's ratios under the drivers as they are, and, on the `reference`
+/// backend, under synthetic rounding of it.
+fn unchanged_noise(
+    case: &Case,
+    kind: BackendKind,
+    reference: bool,
+    goldens: &Goldens,
+    outputs: &BTreeMap<String, Image>,
+    result: &mut SelfTest,
+) {
+    for (pass, ratio) in ratios(case, goldens, outputs) {
+        result.noise.push(NoiseResult {
+            source: "drivers".to_owned(),
+            scene: case.name().to_owned(),
+            backend: kind.name().to_owned(),
+            pass,
+            ratio,
+            live: true,
+        });
+    }
+    if reference {
+        let synthetic = portability::synthetic_rounding(case, outputs);
+        for (pass, ratio) in ratios(case, goldens, &synthetic) {
+            result.noise.push(NoiseResult {
+                source: "synthetic-rounding".to_owned(),
+                scene: case.name().to_owned(),
+                backend: "-".to_owned(),
+                pass,
+                ratio,
+                live: true,
+            });
+        }
+    }
+}
+
+/// The recorded figures of `model` for the sources this run does not produce (CPU code paths,
+/// another Mesa, recorded hosts), as ratios against the case's limits.
+fn recorded_noise(case: &Case, model: &NoiseModel, noise: &mut Vec<NoiseResult>) {
+    let Some(passes) = model.scenes.get(case.name()) else {
+        return;
+    };
+    for (pass, checks) in passes {
+        let Some(rule) = case.rules.get(pass) else {
+            continue;
+        };
+        for (metric, limit) in rule.checks() {
+            let Some(figures) = checks.get(&metric.to_string()) else {
+                continue;
+            };
+            for (key, &value) in &figures.noise {
+                let (source, backend) = key.split_once('/').unwrap_or((key, "-"));
+                if source == "drivers" || source == "synthetic-rounding" {
+                    continue;
+                }
+                noise.push(NoiseResult {
+                    source: source.to_owned(),
+                    scene: case.name().to_owned(),
+                    backend: backend.to_owned(),
+                    pass: pass.clone(),
+                    ratio: crate::golden::tolerance::ratio(value, limit, false),
+                    live: false,
+                });
+            }
+        }
+    }
+}

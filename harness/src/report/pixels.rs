@@ -1,0 +1,90 @@
+//! The exact pixel data the viewers draw: how each pass is displayed, its storage kind and
+//! bytes, and the blobs that embed them (compressed, each once) at the end of the page.
+
+use std::fmt::Write as _;
+
+use base64::Engine as _;
+use engine::{Image, ImageData};
+
+/// How the viewer maps a pass's values to the screen.
+pub(super) fn display_mode(image: &Image, pass: &str) -> &'static str {
+    match (&image.data, pass) {
+        (ImageData::U8(_), _) => "srgb8",
+        (ImageData::F32(_), "depth") => "depth",
+        (ImageData::F32(_), "light") => "hdr",
+        (ImageData::F32(_), p)
+            if p.starts_with("gbuffer_normal") || p.starts_with("gbuffer_tangent") =>
+        {
+            "signed"
+        }
+        (ImageData::F32(_), _) => "linear",
+    }
+}
+
+/// The exact pixel data of an image for the viewer: its storage kind (`u8`; `f16` for fp16
+/// targets, whose values fp16 holds exactly; `f32` otherwise) and the bytes, little-endian.
+/// `like` decides the kind, so that a golden read from an fp16 EXR is embedded like the fp16
+/// output it is compared with.
+pub(super) fn pixel_bytes(image: &Image, like: &Image) -> (&'static str, Vec<u8>) {
+    match &image.data {
+        ImageData::U8(data) => ("u8", data.clone()),
+        ImageData::F32(data) if like.format == engine::backend::TextureFormat::Rgba16Float => (
+            "f16",
+            data.iter()
+                .flat_map(|&v| half::f16::from_f32(v).to_le_bytes())
+                .collect(),
+        ),
+        ImageData::F32(data) => ("f32", data.iter().flat_map(|v| v.to_le_bytes()).collect()),
+    }
+}
+
+/// Pixel data embedded once each at the end of the page, zlib-compressed and base64-encoded in
+/// `<script type="application/octet-stream" id="blob-N">` elements; identical data (backends
+/// that render the same pixels) is embedded once, and compressed once.
+#[derive(Default)]
+pub(super) struct Blobs {
+    /// Encoded blobs, in page order.
+    encoded: Vec<String>,
+    /// Hash and length of each blob's raw bytes, to find repeats before compressing.
+    raw: Vec<(u64, usize)>,
+}
+
+impl Blobs {
+    /// Adds `bytes` (unless the same bytes are there already) and returns its blob number.
+    pub(super) fn add(&mut self, bytes: &[u8]) -> usize {
+        use std::hash::{Hash as _, Hasher as _};
+        let mut hasher = std::collections::hash_map::DefaultHasher::new();
+        bytes.hash(&mut hasher);
+        let id = (hasher.finish(), bytes.len());
+        if let Some(same) = self.raw.iter().position(|r| *r == id) {
+            return same;
+        }
+        use std::io::Write as _;
+        let mut encoder =
+            flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+        // Writing to a Vec cannot fail.
+        let _ = encoder.write_all(bytes);
+        let compressed = encoder.finish().unwrap_or_default();
+        self.encoded
+            .push(base64::engine::general_purpose::STANDARD.encode(compressed));
+        self.raw.push(id);
+        self.encoded.len() - 1
+    }
+
+    /// Base64 bytes embedded so far.
+    pub(super) fn bytes(&self) -> usize {
+        self.encoded.iter().map(String::len).sum()
+    }
+
+    /// The blobs as `<script>` elements.
+    pub(super) fn html(&self) -> String {
+        let mut out = String::new();
+        for (i, blob) in self.encoded.iter().enumerate() {
+            let _ = writeln!(
+                out,
+                "<script type=\"application/octet-stream\" id=\"blob-{i}\">{blob}</script>"
+            );
+        }
+        out
+    }
+}
