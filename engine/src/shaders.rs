@@ -37,8 +37,30 @@ pub const DEPTH_COPY: ShaderSource = shader!("depth_copy.wgsl");
 
 /// Deferred renderer: geometry pass into the G-buffer and shader-mask pass.
 pub const GBUFFER: ShaderSource = shader!("gbuffer.wgsl");
-/// Deferred renderer: one full-screen lighting pass per lighting model.
-pub const LIGHTING: ShaderSource = shader!("lighting.wgsl");
+/// The parts of the lighting shader under `engine/shaders/lighting/`, in the order they are
+/// concatenated (WGSL declarations may come in any order; the split is for the reader).
+pub const LIGHTING_PARTS: &[&str] = &[
+    "inputs.wgsl",
+    "shadows.wgsl",
+    "surface.wgsl",
+    "brdf.wgsl",
+    "ibl.wgsl",
+    "shade.wgsl",
+];
+
+/// Deferred renderer: one full-screen lighting pass per lighting model, one module made of
+/// [`LIGHTING_PARTS`] (naga's line numbers count through them in that order).
+pub const LIGHTING: ShaderSource = ShaderSource {
+    name: "lighting.wgsl",
+    wgsl: concat!(
+        include_str!("../shaders/lighting/inputs.wgsl"),
+        include_str!("../shaders/lighting/shadows.wgsl"),
+        include_str!("../shaders/lighting/surface.wgsl"),
+        include_str!("../shaders/lighting/brdf.wgsl"),
+        include_str!("../shaders/lighting/ibl.wgsl"),
+        include_str!("../shaders/lighting/shade.wgsl"),
+    ),
+};
 /// Deferred renderer: environment behind the objects.
 pub const SKYBOX: ShaderSource = shader!("skybox.wgsl");
 /// Deferred renderer: HDR light buffer to the sRGB final image.
@@ -247,10 +269,29 @@ mod tests {
             .map(|e| e.unwrap().file_name().into_string().unwrap())
             .filter(|n| n.ends_with(".wgsl"))
             .collect();
+        // A shader made of parts is a folder of them: `lighting/` is `lighting.wgsl`.
+        on_disk.push("lighting.wgsl".to_owned());
         on_disk.sort();
         let mut listed: Vec<String> = ALL.iter().map(|s| s.name.to_owned()).collect();
         listed.sort();
         assert_eq!(on_disk, listed, "engine/shaders/ and shaders::ALL differ");
+        let mut parts: Vec<String> = std::fs::read_dir(format!("{dir}/lighting"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        parts.sort();
+        let mut listed_parts: Vec<&str> = LIGHTING_PARTS.to_vec();
+        listed_parts.sort();
+        assert_eq!(
+            parts, listed_parts,
+            "engine/shaders/lighting/ and LIGHTING_PARTS differ"
+        );
+        // The concatenation in LIGHTING is the parts in LIGHTING_PARTS's order.
+        let joined: String = LIGHTING_PARTS
+            .iter()
+            .map(|p| std::fs::read_to_string(format!("{dir}/lighting/{p}")).unwrap())
+            .collect();
+        assert_eq!(joined, LIGHTING.wgsl);
     }
 
     #[test]

@@ -1,0 +1,122 @@
+// Lighting shader, part 5 of 6: image-based lighting (the split sum, and filtered importance
+// sampling of the prefiltered cube).
+
+// World direction to environment-map direction (the rotation about +Y, as skybox.wgsl).
+fn environment_direction(d: vec3<f32>) -> vec3<f32> {
+    let c = u.ibl.z;
+    let s = u.ibl.w;
+    return vec3<f32>(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
+}
+
+fn ibl_irradiance_at(n: vec3<f32>) -> vec3<f32> {
+    return textureSampleLevel(ibl_irradiance, ibl_sampler, environment_direction(n), 0.0).rgb;
+}
+
+fn ibl_prefiltered(r: vec3<f32>, roughness: f32) -> vec3<f32> {
+    let lod = clamp(roughness, 0.0, 1.0) * u.ibl.y;
+    return textureSampleLevel(ibl_specular, ibl_sampler, environment_direction(r), lod).rgb;
+}
+
+// The PBR specular IBL by filtered importance sampling (Krivanek and Colbert 2008): IBL_SAMPLES
+// samples of the GGX lobe (anisotropic where the surface is; the stretched-slope sampling of
+// Heitz's "Understanding the Masking-Shadowing Function", so the pdf is D(h) n.h), stratified in
+// the radial variable and radical-inverse in the angle, each weighted by F V 4 v.h n.l / n.h
+// and read from the prefiltered cube at the roughness whose lobe (about 4 pi alpha^2 steradians)
+// covers the sample's solid angle 1 / (N pdf). Unlike the split sum, the lobe follows the view.
+fn ibl_specular_sampled(s: Surface, v: vec3<f32>, f0: vec3<f32>) -> vec3<f32> {
+    let n = s.normal;
+    let n_dot_v = max(dot(n, v), MIN_N_DOT_V);
+    let alpha = s.roughness * s.roughness + 0.001;
+    var t: vec3<f32>;
+    var at = alpha;
+    var ab = alpha;
+    let anisotropic = ANISOTROPY && s.anisotropy != 0.0;
+    if anisotropic {
+        // Sampling needs an orthonormal frame: the stored tangent, made perpendicular to n.
+        t = safe_normalize(s.tangent - n * dot(n, s.tangent), s.tangent);
+        at = max(alpha * (1.0 + s.anisotropy), 0.001);
+        ab = max(alpha * (1.0 - s.anisotropy), 0.001);
+    } else {
+        let up = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 0.0, 1.0), abs(n.z) < 0.999);
+        t = normalize(cross(up, n));
+    }
+    let b = cross(n, t);
+    let count = f32(IBL_SAMPLES);
+    var sum = vec3<f32>(0.0);
+    for (var i = 0u; i < IBL_SAMPLES; i++) {
+        let u1 = (f32(i) + 0.5) / count;
+        let u2 = f32(reverseBits(i)) * 2.3283064365386963e-10;
+        let slope = sqrt(u1 / (1.0 - u1));
+        let phi = 2.0 * PI * u2;
+        let local = normalize(vec3<f32>(at * slope * cos(phi), ab * slope * sin(phi), 1.0));
+        let h = normalize(t * local.x + b * local.y + n * local.z);
+        let v_dot_h = dot(v, h);
+        if v_dot_h <= 0.0 {
+            continue;
+        }
+        let l = 2.0 * v_dot_h * h - v;
+        let n_dot_l = dot(n, l);
+        if n_dot_l <= 0.0 {
+            continue;
+        }
+        let n_dot_h = max(local.z, 1e-4);
+        var d: f32;
+        var vis: f32;
+        if anisotropic {
+            d = d_ggx_anisotropic(at, ab, local.x, local.y, n_dot_h);
+            vis = v_smith_ggx_correlated_anisotropic(
+                at, ab, dot(t, v), dot(b, v), dot(t, l), dot(b, l), n_dot_v, n_dot_l);
+        } else {
+            d = d_ggx(n, h, n_dot_h, alpha);
+            vis = v_smith_ggx_correlated(n_dot_v, n_dot_l, alpha);
+        }
+        let pdf = max(d * n_dot_h / (4.0 * v_dot_h), 1e-6);
+        let lobe_roughness = sqrt(sqrt(1.0 / (count * pdf) / (4.0 * PI)));
+        let fresnel = f0 + (vec3<f32>(1.0) - f0) * pow5(1.0 - v_dot_h);
+        sum += ibl_prefiltered(l, lobe_roughness) * fresnel * (vis * 4.0 * v_dot_h * n_dot_l / n_dot_h);
+    }
+    return sum / count;
+}
+
+// Split-sum IBL of the PBR model (unexposed; the caller scales by u.ibl.x); the specular part by
+// filtered importance sampling instead when IBL_SAMPLES > 0.
+fn pbr_ibl(s: Surface, v: vec3<f32>) -> vec3<f32> {
+    let n = s.normal;
+    let n_dot_v = max(dot(n, v), MIN_N_DOT_V);
+    let f0 = vec3<f32>(0.16 * s.specular * s.specular * (1.0 - s.metallic)) + s.base_color * s.metallic;
+    // Texel i of the table holds parameter i / (size - 1) (crate::ibl::dfg): remap so that 0 and 1
+    // land on the first and last texel centers.
+    let dfg_size = vec2<f32>(textureDimensions(ibl_dfg));
+    let dfg_uv = (vec2<f32>(n_dot_v, clamp(s.roughness, 0.0, 1.0)) * (dfg_size - 1.0) + 0.5) / dfg_size;
+    let dfg = textureSampleLevel(ibl_dfg, ibl_sampler, dfg_uv, 0.0).xy;
+    let e = f0 * dfg.x + vec3<f32>(dfg.y);
+    // Anisotropy: reflect about a normal bent towards the anisotropic direction (Filament's
+    // getReflectedVector), scaled down for smooth surfaces.
+    var bent = n;
+    if ANISOTROPY && s.anisotropy != 0.0 {
+        let b = cross(n, s.tangent);
+        let direction = select(s.tangent, b, s.anisotropy >= 0.0);
+        let anisotropic_tangent = cross(direction, v);
+        let anisotropic_normal = cross(anisotropic_tangent, direction);
+        let amount = abs(s.anisotropy) * clamp(5.0 * s.roughness, 0.0, 1.0);
+        bent = safe_normalize(mix(n, anisotropic_normal, amount), n);
+    }
+    // The lobe's dominant direction leans from R towards N as roughness grows (Filament's
+    // getSpecularDominantDirection): the split sum's N = V = R assumption misses that.
+    let r = reflect(-v, bent);
+    let dominant = safe_normalize(mix(r, bent, s.roughness * s.roughness * s.roughness * s.roughness), r);
+    var specular: vec3<f32>;
+    if IBL_SAMPLES > 0u {
+        specular = ibl_specular_sampled(s, v, f0);
+    } else {
+        specular = ibl_prefiltered(dominant, s.roughness) * e;
+    }
+    let diffuse = s.base_color * (1.0 - s.metallic) * (vec3<f32>(1.0) - e) * ibl_irradiance_at(n);
+    if !CLEARCOAT {
+        return diffuse + specular;
+    }
+    let clearcoat_fresnel = (0.04 + 0.96 * pow5(1.0 - n_dot_v)) * s.clearcoat;
+    let clearcoat = ibl_prefiltered(reflect(-v, n), s.clearcoat_roughness) * clearcoat_fresnel;
+    return (diffuse + specular) * (1.0 - clearcoat_fresnel) + clearcoat;
+}
+
