@@ -277,7 +277,7 @@ pub fn run(kind: BackendKind, mut progress: impl FnMut(&str)) -> Result<Vec<Hard
         ("chess x1000", scaled(&chess, 1e3)),
     ] {
         let frame = render(backend.as_mut(), &moved)?;
-        let diff = crate::golden::compare::u8_difference(
+        let diff = crate::golden::metrics::compare::u8_difference(
             reference.output("final").ok_or("no final image")?,
             frame.output("final").ok_or("no final image")?,
             1,

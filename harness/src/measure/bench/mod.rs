@@ -1,0 +1,118 @@
+//! Per-pass timing against floors: where a frame's time goes, and how close each pass is to what
+//! the driver can do at all.
+//!
+//! A pass's time is its GPU time from timestamp queries (the sum over its render passes: a point
+//! light's six faces count as its shadow pass), the median over several frames. Its floor is the
+//! cheapest pass writing the same targets (same formats and sizes) over every pixel: a
+//! full-screen triangle writing constants (`floor.wgsl`), depth included where the pass writes
+//! depth, timed the same way in the same run. The ratio pass / floor is what compares across
+//! machines; the milliseconds do not.
+//!
+//! A lighting pass has a second, more honest floor: its *input floor*, the same pass (same
+//! routing, same draws) with every draw's shading replaced by reading the inputs its model
+//! reads (the G-buffer targets it uses, and depth where positions come from it) and writing
+//! their sum. Pass / input floor is
+//! the cost of shading alone. `harness bench --breakdown` goes further and times each lighting
+//! pass with one part of its work taken away at a time ([`breakdown`]).
+//!
+//! `harness bench` prints this per scene and backend, and the criterion benchmarks in `benches/`
+//! use the same [`Floors`] and [`pass_time`].
+
+mod floors;
+mod lighting_breakdown;
+mod precompute;
+mod report;
+mod series;
+mod tables;
+mod timing;
+
+pub use floors::Floors;
+pub use lighting_breakdown::{breakdown, BreakdownRow, PassBreakdown};
+pub use precompute::{precompute, Precompute};
+pub use report::{report_sections, series_svg, BENCH_JSON, SERIES_JSON};
+pub use series::{series, SeriesPoint, SERIES};
+pub use tables::{breakdown_table, series_table, table};
+pub use timing::{bench_scene, pass_time, timed_render, PassBench, SceneBench};
+
+/// Why a benchmark could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    /// The backend is missing or failed.
+    #[error("{backend}: {message}")]
+    Backend {
+        /// Backend name.
+        backend: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// Rendering the scene failed.
+    #[error("scene `{scene}` on {backend}: {message}")]
+    Render {
+        /// Scene name.
+        scene: String,
+        /// Backend name.
+        backend: String,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use engine::backend::PassTiming;
+    use engine::plan::PassSpec;
+
+    fn timing(name: &str, ns: f64) -> PassTiming {
+        PassTiming {
+            name: name.to_owned(),
+            gpu_ns: Some(ns),
+        }
+    }
+
+    #[test]
+    fn a_pass_time_sums_its_faces_and_nothing_else() {
+        let spec = |name: &str| PassSpec {
+            name: name.to_owned(),
+            kind: engine::plan::PassKind::Geometry,
+            reads: vec![],
+            writes: vec![],
+            detail: String::new(),
+        };
+        let timings = [
+            timing("shadow_0+x", 1.0),
+            timing("shadow_0-x", 2.0),
+            timing("shadow_0_blur_x", 4.0),
+            timing("shadow_1", 8.0),
+            timing("geometry", 16.0),
+        ];
+        assert_eq!(pass_time(&timings, &spec("shadow_0")), Some(3.0));
+        assert_eq!(pass_time(&timings, &spec("shadow_0_blur_x")), Some(4.0));
+        assert_eq!(pass_time(&timings, &spec("shadow_1")), Some(8.0));
+        assert_eq!(pass_time(&timings, &spec("lighting_pbr")), None);
+        let untimed = [PassTiming {
+            name: "geometry".to_owned(),
+            gpu_ns: None,
+        }];
+        assert_eq!(pass_time(&untimed, &spec("geometry")), None);
+    }
+
+    #[test]
+    fn series_plots_have_a_point_per_value() {
+        let points: Vec<SeriesPoint> = [(1u64, 1.0), (8, 3.0), (64, 20.0)]
+            .into_iter()
+            .map(|(value, ms)| SeriesPoint {
+                series: "lights".to_owned(),
+                value,
+                pass: "lighting_pbr".to_owned(),
+                pass_ms: Some(ms),
+                frame_ms: Some(ms + 1.0),
+            })
+            .collect();
+        let svg = series_svg(&points);
+        assert_eq!(svg.matches("<circle").count(), 3);
+        assert!(svg.contains("lighting_pbr ms against lights"));
+        let table = series_table(&points);
+        assert!(table.contains("8.0") && table.contains("6.67"), "{table}");
+    }
+}

@@ -1,0 +1,128 @@
+//! The scaling series: how a frame's or a pass's cost grows with resolution, point lights,
+//! triangles and shadow-map size.
+
+use engine::backend::{self, BackendKind};
+use engine::plan::RenderPlan;
+use engine::scene::Scene;
+
+use super::timing::{median_frame_ms, median_pass_ms, time_frames};
+use super::BenchError;
+
+/// The scaling series `harness bench --series` knows.
+pub const SERIES: [&str; 4] = ["resolution", "lights", "triangles", "shadow-map"];
+
+/// One point of a scaling series.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct SeriesPoint {
+    /// Series name (see [`SERIES`]).
+    pub series: String,
+    /// The value varied: pixels per side, point lights, triangles, or shadow-map texels per side.
+    pub value: u64,
+    /// The pass the series is about.
+    pub pass: String,
+    /// Its median GPU time, ms.
+    pub pass_ms: Option<f64>,
+    /// Median GPU time of the whole frame, ms.
+    pub frame_ms: Option<f64>,
+}
+
+/// How a frame's cost grows: chess at 256..2048 pixels (frame, lighting), 1..256 point lights on
+/// a floor (lighting), chess's meshes subdivided 1x..64x (geometry), chess's sun with 512..4096
+/// shadow maps (shadow pass).
+pub fn series(
+    name: &str,
+    kind: BackendKind,
+    frames: usize,
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<SeriesPoint>, BenchError> {
+    let chess = || {
+        crate::load_scene("chess")
+            .map(|l| l.scene)
+            .map_err(|e| BenchError::Render {
+                scene: "chess".to_owned(),
+                backend: kind.name().to_owned(),
+                message: e.to_string(),
+            })
+    };
+    let settings: Vec<(u64, Scene, &str)> = match name {
+        "resolution" => [256u32, 512, 1024, 2048]
+            .into_iter()
+            .map(|size| {
+                let mut scene = chess()?;
+                scene.quality.width = size;
+                scene.quality.height = size;
+                Ok((u64::from(size), scene, "lighting_pbr"))
+            })
+            .collect::<Result<_, BenchError>>()?,
+        "lights" => [1usize, 8, 64, 256]
+            .into_iter()
+            .map(|n| {
+                (
+                    n as u64,
+                    crate::test_scenes::many_point_lights(512, n),
+                    "lighting_pbr",
+                )
+            })
+            .collect(),
+        "triangles" => {
+            let mut scene = chess()?;
+            let mut points = Vec::new();
+            for level in 0..4 {
+                if level > 0 {
+                    let mut subdivided = std::collections::HashMap::new();
+                    for object in &mut scene.objects {
+                        let key = std::sync::Arc::as_ptr(&object.mesh);
+                        let mesh = subdivided
+                            .entry(key)
+                            .or_insert_with(|| std::sync::Arc::new(object.mesh.subdivided()))
+                            .clone();
+                        object.mesh = mesh;
+                    }
+                }
+                let triangles: usize = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
+                points.push((triangles as u64, scene.clone(), "geometry"));
+            }
+            points
+        }
+        "shadow-map" => [512u32, 1024, 2048, 4096]
+            .into_iter()
+            .map(|size| {
+                let mut scene = chess()?;
+                for light in &mut scene.lights {
+                    if let engine::scene::Light::Directional {
+                        shadow: Some(s), ..
+                    } = light
+                    {
+                        s.map_size = size;
+                    }
+                }
+                Ok((u64::from(size), scene, "shadow_0"))
+            })
+            .collect::<Result<_, BenchError>>()?,
+        other => {
+            return Err(BenchError::Render {
+                scene: "-".to_owned(),
+                backend: kind.name().to_owned(),
+                message: format!("unknown series `{other}` (known: {})", SERIES.join(", ")),
+            })
+        }
+    };
+    let mut backend = backend::create(kind).map_err(|e| BenchError::Backend {
+        backend: kind.name().to_owned(),
+        message: e.to_string(),
+    })?;
+    let mut points = Vec::new();
+    for (value, scene, pass) in settings {
+        progress(&format!("{name} {value}"));
+        let plan = RenderPlan::new(&scene);
+        let (timings, _) = time_frames(backend.as_mut(), &scene, frames.max(1), None)?;
+        points.push(SeriesPoint {
+            series: name.to_owned(),
+            value,
+            pass: pass.to_owned(),
+            pass_ms: median_pass_ms(&plan, &timings, pass),
+            frame_ms: median_frame_ms(&timings),
+        });
+    }
+    Ok(points)
+}

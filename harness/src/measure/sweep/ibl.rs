@@ -1,0 +1,220 @@
+//! The IBL sweep: the IBL precompute's settings one knob at a time, each timed (precompute
+//! and lighting pass) and measured against the Monte Carlo reference per roughness.
+
+use engine::backend::{self, BackendKind};
+use engine::renderer::{self, Readback};
+use engine::scene::Scene;
+
+use super::{pareto_front_n, pass_ms, stats, SweepError};
+
+/// One setting of the IBL sweep.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct IblSweepRow {
+    /// What differs from the default settings.
+    pub setting: String,
+    /// The settings.
+    pub settings: engine::ibl::IblSettings,
+    /// CPU precompute of the maps without caches, seconds (the DFG table, shared by every
+    /// setting, is computed once per process and not included).
+    pub precompute_s: f64,
+    /// Median GPU time of the lighting pass, ms.
+    pub lighting_ms: Option<f64>,
+    /// Error of the light buffer against the Monte Carlo reference, per roughness.
+    pub by_roughness: Vec<crate::reference::ibl::RoughnessError>,
+    /// Mean relative error over every reference pixel.
+    pub mean_relative: f64,
+    /// 99th percentile and maximum relative error over every reference pixel.
+    pub p99_max_relative: (f64, f64),
+    /// Mean and 95th-percentile relative error per material family (rows) and roughness
+    /// (cells).
+    pub by_family: Vec<crate::reference::ibl::FamilyRow>,
+    /// Whether these are the default settings.
+    pub is_default: bool,
+    /// Whether no other setting has both a shorter precompute and a smaller mean error.
+    pub pareto: bool,
+}
+
+/// The settings the IBL sweep visits: the default, then one knob changed at a time.
+pub fn ibl_settings() -> Vec<(String, engine::ibl::IblSettings)> {
+    use engine::ibl::{IblSettings, IrradianceMethod};
+    let d = IblSettings::default();
+    vec![
+        ("default".to_owned(), d.clone()),
+        (
+            "64 samples".to_owned(),
+            IblSettings {
+                specular_samples: 64,
+                ..d.clone()
+            },
+        ),
+        (
+            "1024 samples".to_owned(),
+            IblSettings {
+                specular_samples: 1024,
+                ..d.clone()
+            },
+        ),
+        (
+            "specular 64".to_owned(),
+            IblSettings {
+                specular_size: 64,
+                ..d.clone()
+            },
+        ),
+        (
+            "specular 256".to_owned(),
+            IblSettings {
+                specular_size: 256,
+                ..d.clone()
+            },
+        ),
+        (
+            "sh9 irradiance".to_owned(),
+            IblSettings {
+                irradiance: IrradianceMethod::Sh9,
+                ..d.clone()
+            },
+        ),
+        (
+            "fis 16".to_owned(),
+            IblSettings {
+                runtime_samples: 16,
+                ..d.clone()
+            },
+        ),
+        (
+            "fis 64".to_owned(),
+            IblSettings {
+                runtime_samples: 64,
+                ..d.clone()
+            },
+        ),
+        (
+            "fis 256".to_owned(),
+            IblSettings {
+                runtime_samples: 256,
+                ..d.clone()
+            },
+        ),
+        // The extracted sun without its shadow: the Monte Carlo reference, like the split sum,
+        // sees the environment unoccluded, so a shadow one sphere casts on the next would count
+        // as an error of the lighting (the shadow itself is tested in tests/ibl.rs).
+        (
+            "sun".to_owned(),
+            IblSettings {
+                extract_sun: true,
+                sun_shadow: false,
+                ..d.clone()
+            },
+        ),
+        (
+            "sun + fis 64".to_owned(),
+            IblSettings {
+                extract_sun: true,
+                sun_shadow: false,
+                runtime_samples: 64,
+                ..d
+            },
+        ),
+    ]
+}
+
+/// Reference pixels and directions per strategy of the IBL sweep's Monte Carlo reference.
+pub const IBL_REFERENCE_PIXELS: usize = 576;
+/// Directions per strategy and pixel (three or four strategies).
+pub const IBL_REFERENCE_SAMPLES: usize = 4096;
+
+/// Runs the IBL sweep on one backend: per setting, the precompute time, the lighting pass's GPU
+/// time (median of `repeats` renders) and the error against the Monte Carlo reference per
+/// roughness. The reference is computed once, from the default render's G-buffer (the
+/// G-buffer does not depend on IBL settings).
+pub fn ibl_sweep(
+    scene: &Scene,
+    kind: BackendKind,
+    repeats: usize,
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<IblSweepRow>, SweepError> {
+    let environment = scene
+        .environment
+        .as_ref()
+        .ok_or_else(|| SweepError::NoEnvironment(scene.name.clone()))?;
+    let mut backend = backend::create(kind).map_err(|e| SweepError::Render(e.to_string()))?;
+    let mut rows = Vec::new();
+    let mut references = None;
+    let mut built: Vec<(engine::ibl::cache::Key, f64)> = Vec::new();
+    for (name, settings) in ibl_settings() {
+        progress(&format!("precompute {name}"));
+        engine::ibl::dfg_table();
+        // Timed, and kept in memory for the render below. Settings that change only the
+        // render (the runtime samples) share an earlier setting's maps and its time.
+        let key = engine::ibl::cache::key_of_shared(&environment.image, &settings);
+        let precompute_s = match built.iter().find(|(k, _)| *k == key) {
+            Some(&(_, seconds)) => seconds,
+            None => {
+                let (_, seconds) = engine::ibl::build_timed(&environment.image, &settings);
+                built.push((key, seconds));
+                seconds
+            }
+        };
+        let mut variant = scene.clone();
+        variant.quality.ibl = settings.clone();
+        let mut frames = Vec::new();
+        for _ in 0..repeats.max(1) {
+            frames.push(
+                renderer::render(backend.as_mut(), &variant, Readback::All)
+                    .map_err(|e| SweepError::Render(e.to_string()))?,
+            );
+        }
+        if references.is_none() {
+            progress("Monte Carlo reference");
+            references = Some(
+                crate::reference::ibl::reference_pixels(
+                    scene,
+                    &frames[0],
+                    IBL_REFERENCE_PIXELS,
+                    IBL_REFERENCE_SAMPLES,
+                )
+                .map_err(SweepError::Render)?,
+            );
+        }
+        let references = references.as_deref().unwrap_or_default();
+        let by_roughness = crate::reference::ibl::error_by_roughness(&frames[0], references);
+        let by_family = crate::reference::ibl::error_by_family(&frames[0], references);
+        let (_, p99, max) = stats(crate::reference::ibl::pixel_errors(&frames[0], references));
+        let total: usize = by_roughness.iter().map(|r| r.pixels).sum();
+        let mean_relative = by_roughness
+            .iter()
+            .map(|r| r.mean_relative * r.pixels as f64)
+            .sum::<f64>()
+            / total.max(1) as f64;
+        let is_default = settings == engine::ibl::IblSettings::default();
+        rows.push(IblSweepRow {
+            setting: name,
+            settings,
+            precompute_s,
+            lighting_ms: pass_ms(&frames, "lighting"),
+            by_roughness,
+            mean_relative,
+            p99_max_relative: (p99, max),
+            by_family,
+            is_default,
+            pareto: false,
+        });
+    }
+    // Two costs: the precompute (once per environment and settings) and the lighting pass (every
+    // frame; the filtered importance sampling settings spend it there).
+    let points: Vec<Vec<f64>> = rows
+        .iter()
+        .map(|r| {
+            vec![
+                r.precompute_s,
+                r.lighting_ms.unwrap_or(f64::INFINITY),
+                r.mean_relative,
+            ]
+        })
+        .collect();
+    for (row, on_front) in rows.iter_mut().zip(pareto_front_n(&points)) {
+        row.pareto = on_front;
+    }
+    Ok(rows)
+}

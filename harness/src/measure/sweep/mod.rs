@@ -1,0 +1,79 @@
+//! Speed against error for one quality knob.
+//!
+//! `harness sweep --scene ibl --knob ibl` varies the IBL precompute (sample count, specular
+//! size, SH9 irradiance) and measures each setting's precompute time, lighting-pass time and
+//! error against the Monte Carlo reference ([`crate::reference::ibl`]) per roughness.
+//!
+//! `harness sweep --scene chess --knob shadow` renders
+//! the scene once per setting (shadow filter x map size), times the passes from GPU timestamps
+//! (median of several renders), and measures the error of the shadow term against
+//!
+//! - exact hard visibility by ray casting ([`crate::reference::shadows`]): the fraction of
+//!   lit-surface pixels whose term is on the wrong side of 0.5, and the mean absolute difference;
+//! - the converged soft filter (`soft-reference`, 1024 samples) for the soft filters and VSM
+//!   (directional lights only): mean absolute difference.
+
+mod gbuffer;
+mod ibl;
+mod pareto;
+mod report;
+mod shadow;
+mod tables;
+
+pub use gbuffer::{gbuffer_settings, gbuffer_sweep, GbufferSweepRow, GBUFFER_DISTANCES};
+pub use ibl::{ibl_settings, ibl_sweep, IblSweepRow, IBL_REFERENCE_PIXELS, IBL_REFERENCE_SAMPLES};
+pub use pareto::{pareto_front, pareto_front_n, pareto_svg};
+pub use report::{report_sections, result_file};
+pub use shadow::{shadow_sweep, SweepRow};
+pub use tables::{
+    gbuffer_table, ibl_goal_line, ibl_table, stable_gbuffer_table, stable_ibl_table, stable_table,
+    table, worst_cells, IBL_GOAL_MEAN, IBL_GOAL_P95,
+};
+
+use engine::renderer::Frame;
+use engine::stats::median;
+
+/// Why a sweep failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    /// The knob is not one the sweep knows.
+    #[error("unknown knob `{0}` (known: shadow, ibl, gbuffer)")]
+    UnknownKnob(String),
+    /// The scene has no environment (for the `ibl` knob).
+    #[error("scene `{0}` has no environment")]
+    NoEnvironment(String),
+    /// The scene has no shadowed light.
+    #[error("scene `{0}` has no light with shadows")]
+    NoShadows(String),
+    /// Rendering failed.
+    #[error("{0}")]
+    Render(String),
+}
+
+fn pass_ms(frames: &[Frame], prefix: &str) -> Option<f64> {
+    median(
+        frames
+            .iter()
+            .filter_map(|f| {
+                let ns: Vec<f64> = f
+                    .timings
+                    .iter()
+                    .filter(|t| t.name.starts_with(prefix) && !t.name.starts_with("shadow_term"))
+                    .filter_map(|t| t.gpu_ns)
+                    .collect();
+                (!ns.is_empty()).then(|| ns.iter().sum::<f64>() / 1e6)
+            })
+            .collect(),
+    )
+}
+
+/// Mean, 99th percentile and maximum of some errors (zeros when there are none).
+pub fn stats(mut errors: Vec<f64>) -> (f64, f64, f64) {
+    if errors.is_empty() {
+        return (0.0, 0.0, 0.0);
+    }
+    errors.sort_by(f64::total_cmp);
+    let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+    let p99 = engine::stats::percentile_of_sorted(&errors, 0.99);
+    (mean, p99, errors[errors.len() - 1])
+}
