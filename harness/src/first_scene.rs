@@ -4,7 +4,7 @@
 use engine::backend::{self, BackendKind, BackendStatus};
 use engine::lit_cube::{self, LitCubeImages};
 
-use crate::golden::compare::{
+use crate::golden::metrics::compare::{
     relative_difference, u8_difference, RelativeDifference, U8Difference,
 };
 
@@ -63,7 +63,7 @@ pub fn agreement(
     images: &LitCubeImages,
     reference: BackendKind,
     reference_images: &LitCubeImages,
-) -> Result<Agreement, crate::golden::compare::CompareError> {
+) -> Result<Agreement, crate::golden::metrics::compare::CompareError> {
     Ok(Agreement {
         backend,
         reference,

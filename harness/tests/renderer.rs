@@ -117,7 +117,7 @@ fn scene_far_from_the_origin_matches_the_scene_at_the_origin() {
         let mut backend = engine::backend::create(kind).unwrap();
         let a = render(backend.as_mut(), &near);
         let b = render(backend.as_mut(), &far);
-        let diff = harness::golden::compare::u8_difference(
+        let diff = harness::golden::metrics::compare::u8_difference(
             a.output("final").unwrap(),
             b.output("final").unwrap(),
             1,
@@ -294,7 +294,7 @@ fn gizmos_are_optional_and_only_touch_the_final_image() {
         assert!(!plain.plan.passes.iter().any(|p| p.name == "gizmos"));
         assert!(with.plan.passes.iter().any(|p| p.name == "gizmos"));
         assert_eq!(plain.outputs["light"], with.outputs["light"], "{kind}");
-        let changed = harness::golden::compare::u8_difference(
+        let changed = harness::golden::metrics::compare::u8_difference(
             &plain.outputs["final"],
             &with.outputs["final"],
             0,

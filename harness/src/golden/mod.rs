@@ -4,7 +4,6 @@
 //! self-test that proves the limits catch real changes.
 
 pub mod check;
-pub mod compare;
 pub mod metrics;
 pub mod noise;
 pub mod pass_kind;

@@ -1,4 +1,5 @@
-//! Image difference statistics between two read-back images of the same size and format.
+//! Symmetric difference statistics of two read-back renders of the same size and format, neither
+//! of them a golden (one backend against another, a render against a moved copy of its scene).
 
 use engine::image::{Image, ImageData};
 

@@ -1,5 +1,6 @@
 //! Image-difference metrics, written once and used by tolerances, the noise model, the report
-//! and bless.
+//! and bless; [`compare`] holds the symmetric comparisons of two renders with no golden between
+//! them (one backend against another).
 //!
 //! Every metric compares an `actual` image with a `golden` (expected) one of the same size and
 //! channel count. 8-bit images are compared in 0..1 units (1/255 per step); float images in their
@@ -22,6 +23,8 @@
 //! Non-finite values are counted separately and always fail (see [`crate::golden::tolerance`]).
 
 use std::borrow::Cow;
+
+pub mod compare;
 
 use engine::{Image, ImageData};
 
