@@ -155,7 +155,10 @@ fn sample_seeds_agree() {
             ..IblSettings::default()
         },
     );
-    assert_ne!(a.specular, b.specular, "the seed changed nothing");
+    assert_ne!(
+        a.specular, b.specular,
+        "another sample seed changed nothing"
+    );
     for (m, (la, lb)) in a
         .specular
         .levels

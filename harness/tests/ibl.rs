@@ -135,7 +135,10 @@ fn sample_seeds_give_the_same_picture() {
         .zip(lb)
         .map(|(x, y)| f64::from((x - y).abs() / x.abs().max(1e-3)))
         .collect();
-    assert!(errors.iter().any(|&e| e > 0.0), "the seed changed nothing");
+    assert!(
+        errors.iter().any(|&e| e > 0.0),
+        "another sample seed changed nothing"
+    );
     errors.sort_by(f64::total_cmp);
     let p99 = engine::stats::percentile_of_sorted(&errors, 0.99);
     eprintln!(

@@ -70,9 +70,7 @@ fn sun_region(image: &EnvironmentImage) -> Option<(Vec<usize>, [f32; 3])> {
         .enumerate()
         .filter(|(_, l)| l.is_finite())
         .max_by(|a, b| a.1.total_cmp(b.1))?;
-    let mut sorted: Vec<f64> = lum.iter().copied().filter(|l| l.is_finite()).collect();
-    let middle = sorted.len() / 2;
-    let median = *sorted.select_nth_unstable_by(middle, f64::total_cmp).1;
+    let median = crate::stats::median(lum.iter().copied().filter(|l| l.is_finite()).collect())?;
     if peak < 1000.0 * median.max(1e-6) {
         return None;
     }

@@ -1,0 +1,50 @@
+//! The layout rules a newcomer relies on: no source file over 600 lines (shaders, scripts and
+//! the review page's JS and CSS included), so each concern stays in a file that can be read in
+//! one sitting. Function length is clippy's `too_many_lines` (see clippy.toml).
+
+use std::path::{Path, PathBuf};
+
+/// The longest a source file may be.
+const MAX_LINES: usize = 600;
+
+/// Extensions of the files the rule covers.
+const SOURCE_EXTENSIONS: &[&str] = &["rs", "wgsl", "geom", "js", "css", "py", "sh"];
+
+/// Folders the rule does not walk: build outputs and version control.
+const SKIPPED: &[&str] = &["target", ".git"];
+
+fn source_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let entry = entry.unwrap();
+        let path = entry.path();
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if entry.file_type().unwrap().is_dir() {
+            if !SKIPPED.contains(&name.as_str()) {
+                source_files(&path, out);
+            }
+        } else if path
+            .extension()
+            .is_some_and(|e| SOURCE_EXTENSIONS.contains(&e.to_string_lossy().as_ref()))
+        {
+            out.push(path);
+        }
+    }
+}
+
+#[test]
+fn no_source_file_is_over_600_lines() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut files = Vec::new();
+    for dir in ["engine", "harness", "benches", "scripts", "fuzz", ".ci"] {
+        source_files(&root.join(dir), &mut files);
+    }
+    assert!(files.len() > 100, "found only {} source files", files.len());
+    let long: Vec<String> = files
+        .iter()
+        .filter_map(|path| {
+            let lines = std::fs::read_to_string(path).ok()?.lines().count();
+            (lines > MAX_LINES).then(|| format!("{} ({lines} lines)", path.display()))
+        })
+        .collect();
+    assert!(long.is_empty(), "over {MAX_LINES} lines: {long:?}");
+}
