@@ -99,8 +99,18 @@ fn ibl_sweep() {
     if !gl_available() {
         return;
     }
+    // The maps come from the IBL caches: this test checks errors, not the precompute's cost,
+    // and the cache is keyed by the environment, the settings and the maps' format version.
+    harness::use_ibl_cache();
     let scene = harness::load_scene("ibl").unwrap().scene;
-    let rows = harness::measure::sweep::ibl_sweep(&scene, BackendKind::Gl, 1, |_| {}).unwrap();
+    let rows = harness::measure::sweep::ibl_sweep_with(
+        &scene,
+        BackendKind::Gl,
+        1,
+        harness::measure::sweep::MapSource::Cached,
+        |_| {},
+    )
+    .unwrap();
     assert!(
         rows.iter().any(|r| r.is_default),
         "the default setting is swept"

@@ -15,7 +15,7 @@ pub struct IblSweepRow {
     /// The settings.
     pub settings: engine::ibl::IblSettings,
     /// CPU precompute of the maps without caches, seconds (the DFG table, shared by every
-    /// setting, is computed once per process and not included).
+    /// setting, is computed once per process and not included); NaN with [`MapSource::Cached`].
     pub precompute_s: f64,
     /// Median GPU time of the lighting pass, ms.
     pub lighting_ms: Option<f64>,
@@ -124,6 +124,18 @@ pub const IBL_REFERENCE_PIXELS: usize = 576;
 /// Directions per strategy and pixel (three or four strategies).
 pub const IBL_REFERENCE_SAMPLES: usize = 4096;
 
+/// Where the IBL sweep's maps come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MapSource {
+    /// Built for the sweep without caches and timed: the precompute column and the Pareto
+    /// front (the `harness sweep` command).
+    Timed,
+    /// From the IBL caches (memory, then disk) like any render, built only where missing, and
+    /// not timed: `precompute_s` is NaN and no row is on a front. For checking errors, where
+    /// the cost of the precompute is not what is measured (the sweep tests).
+    Cached,
+}
+
 /// Runs the IBL sweep on one backend: per setting, the precompute time, the lighting pass's GPU
 /// time (median of `repeats` renders) and the error against the Monte Carlo reference per
 /// roughness. The reference is computed once, from the default render's G-buffer (the
@@ -132,6 +144,17 @@ pub fn ibl_sweep(
     scene: &Scene,
     kind: BackendKind,
     repeats: usize,
+    progress: impl FnMut(&str),
+) -> Result<Vec<IblSweepRow>, SweepError> {
+    ibl_sweep_with(scene, kind, repeats, MapSource::Timed, progress)
+}
+
+/// [`ibl_sweep`] with its maps from `maps`.
+pub fn ibl_sweep_with(
+    scene: &Scene,
+    kind: BackendKind,
+    repeats: usize,
+    maps: MapSource,
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<IblSweepRow>, SweepError> {
     let environment = scene
@@ -150,6 +173,11 @@ pub fn ibl_sweep(
         let key = engine::ibl::cache::key_of_shared(&environment.image, &settings);
         let precompute_s = match built.iter().find(|(k, _)| *k == key) {
             Some(&(_, seconds)) => seconds,
+            None if maps == MapSource::Cached => {
+                engine::ibl::prepare(&environment.image, &settings);
+                built.push((key, f64::NAN));
+                f64::NAN
+            }
             None => {
                 let (_, seconds) = engine::ibl::build_timed(&environment.image, &settings);
                 built.push((key, seconds));
@@ -214,7 +242,7 @@ pub fn ibl_sweep(
         })
         .collect();
     for (row, on_front) in rows.iter_mut().zip(pareto_front_n(&points)) {
-        row.pareto = on_front;
+        row.pareto = on_front && maps == MapSource::Timed;
     }
     Ok(rows)
 }

@@ -21,7 +21,10 @@ mod shadow;
 mod tables;
 
 pub use gbuffer::{gbuffer_settings, gbuffer_sweep, GbufferSweepRow, GBUFFER_DISTANCES};
-pub use ibl::{ibl_settings, ibl_sweep, IblSweepRow, IBL_REFERENCE_PIXELS, IBL_REFERENCE_SAMPLES};
+pub use ibl::{
+    ibl_settings, ibl_sweep, ibl_sweep_with, IblSweepRow, MapSource, IBL_REFERENCE_PIXELS,
+    IBL_REFERENCE_SAMPLES,
+};
 pub use pareto::{pareto_front, pareto_front_n, pareto_svg};
 pub use report::{report_sections, result_file};
 pub use shadow::{shadow_sweep, SweepRow};
