@@ -23,7 +23,8 @@ relative error |harness - mitsuba| / mitsuba (luminance). The per-pixel figures 
 Mitsuba's own noise, about 1/sqrt(spp) of the pixel value; the ratio of means does not.
 
     pip install mitsuba          # 3.x; the scalar_rgb variant ships in the wheel
-    python3 scripts/mitsuba_crosscheck.py [--spp 1024] [--out target/mitsuba]
+    python3 scripts/mitsuba_crosscheck.py [--spp 1024] [--out target/mitsuba] [--min-n-dot-v 0.3]
+                                          [--harness target/debug/harness]
 
 Not part of `cargo test`: it takes a few minutes and needs Mitsuba. The README's "IBL against a
 path tracer" section records its table.
@@ -56,6 +57,8 @@ SPHERES = [
     ("mirror r 0", {"roughness": 0.0}, {"type": "conductor", "material": "none"}),
 ]
 ENVIRONMENTS = ["sunset.exr", "interior.exr"]
+# N.V bands of the second table (within the pixels compared).
+N_DOT_V_BANDS = [(0.0, 0.2), (0.2, 0.4), (0.4, 0.6), (0.6, 0.8), (0.8, 1.01)]
 
 
 def sphere_x(index):
@@ -161,9 +164,9 @@ def luminance(rgb):
     return rgb[..., 0] * 0.2126 + rgb[..., 1] * 0.7152 + rgb[..., 2] * 0.0722
 
 
-def sphere_pixels():
-    """Per sphere, a boolean mask of the pixels whose ray hits it with N.V >= 0.3, from the
-    camera model both renderers share (pixel centres)."""
+def sphere_pixels(min_n_dot_v):
+    """Per sphere, a boolean mask of the pixels whose ray hits it with N.V >= `min_n_dot_v`, and
+    N.V at every pixel, from the camera model both renderers share (pixel centres)."""
     ys, xs = np.mgrid[0:HEIGHT, 0:WIDTH]
     tan_half = np.tan(np.radians(FOV_Y) / 2)
     aspect = WIDTH / HEIGHT
@@ -174,6 +177,7 @@ def sphere_pixels():
     directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
     origin = np.array(CAMERA)
     masks = []
+    n_dot_vs = []
     for index in range(len(SPHERES)):
         center = np.array([sphere_x(index), 0.0, 0.0])
         oc = origin - center
@@ -185,14 +189,16 @@ def sphere_pixels():
         points = origin + directions * t[..., None]
         normals = (points - center) / RADIUS
         n_dot_v = -(normals * directions).sum(axis=-1)
-        masks.append(hit & (n_dot_v >= 0.3))
-    return masks
+        masks.append(hit & (n_dot_v >= min_n_dot_v))
+        n_dot_vs.append(np.where(hit, n_dot_v, -1.0))
+    return masks, n_dot_vs
 
 
-def run_harness(scene_path, light_path):
-    """The harness's light buffer of the scene, rendered on gl into `light_path` (EXR)."""
-    command = [
-        "cargo", "run", "--release", "-q", "-p", "harness", "--",
+def run_harness(scene_path, light_path, harness_binary):
+    """The harness's light buffer of the scene, rendered on gl into `light_path` (EXR), by
+    `harness_binary` or, without one, by `cargo run --release`."""
+    launcher = [harness_binary] if harness_binary else ["cargo", "run", "--release", "-q", "-p", "harness", "--"]
+    command = launcher + [
         "render", "--scene", scene_path, "--backend", "gl", "--pass", "light", "--out", light_path,
     ]
     subprocess.run(command, cwd=ROOT, check=True)
@@ -203,11 +209,20 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--spp", type=int, default=1024, help="Mitsuba samples per pixel (default 1024)")
     parser.add_argument("--out", default=os.path.join(ROOT, "target", "mitsuba"), help="working folder")
+    parser.add_argument(
+        "--min-n-dot-v", type=float, default=0.3,
+        help="pixels compared: N.V at least this (default 0.3; 0 takes the silhouettes too)",
+    )
+    parser.add_argument(
+        "--harness", default=None,
+        help="a built harness binary (e.g. target/debug/harness) instead of `cargo run --release`",
+    )
     args = parser.parse_args()
     mi.set_variant("scalar_rgb")
     os.makedirs(args.out, exist_ok=True)
-    masks = sphere_pixels()
+    masks, n_dot_vs = sphere_pixels(args.min_n_dot_v)
     rows = []
+    bands = []
     for environment in ENVIRONMENTS:
         source = os.path.join(ROOT, "scenes", "assets", environment)
         work = os.path.join(args.out, os.path.splitext(environment)[0])
@@ -217,21 +232,33 @@ def main():
         with open(scene_path, "w") as f:
             f.write(harness_scene(environment))
         print(f"{environment}: harness ...", file=sys.stderr)
-        harness = run_harness(scene_path, os.path.join(work, "light.exr"))
+        harness = run_harness(scene_path, os.path.join(work, "light.exr"), args.harness)
         texels = np.array(mi.Bitmap(source), dtype=np.float32)[..., :3]
         clamped = mi.Bitmap(np.ascontiguousarray(np.maximum(texels, 0.0)))
         print(f"{environment}: Mitsuba, {args.spp} spp ...", file=sys.stderr)
         reference = mitsuba_render(clamped, args.spp, masks)
         mi.Bitmap(reference.astype(np.float32)).write(os.path.join(work, "mitsuba.exr"))
-        for (label, _, _), mask in zip(SPHERES, masks):
+        for (label, _, _), mask, n_dot_v in zip(SPHERES, masks, n_dot_vs):
             h = luminance(harness[mask])
             m = luminance(reference[mask])
             relative = np.abs(h - m) / np.maximum(m, 1e-6)
             rows.append((environment, label, h.mean() / m.mean(), relative.mean(), np.percentile(relative, 95), int(mask.sum())))
+            ratios = []
+            for low, high in N_DOT_V_BANDS:
+                band = mask & (n_dot_v >= low) & (n_dot_v < high)
+                hb, mb = luminance(harness[band]), luminance(reference[band])
+                ratios.append(hb.mean() / mb.mean() if band.any() and mb.mean() > 0 else float("nan"))
+            bands.append((environment, label, ratios))
     print(f"| environment | sphere | harness / Mitsuba (means) | per-pixel error, mean | p95 | pixels |")
     print("|---|---|---|---|---|---|")
     for environment, label, ratio, mean, p95, pixels in rows:
         print(f"| {environment} | {label} | {ratio:.4f} | {mean * 100:.1f}% | {p95 * 100:.1f}% | {pixels} |")
+    print()
+    print("harness / Mitsuba (means) by N.V band:")
+    print("| environment | sphere | " + " | ".join(f"N.V {low:.1f}-{min(high, 1.0):.1f}" for low, high in N_DOT_V_BANDS) + " |")
+    print("|---|---|" + "---|" * len(N_DOT_V_BANDS))
+    for environment, label, ratios in bands:
+        print(f"| {environment} | {label} | " + " | ".join(f"{r:.3f}" for r in ratios) + " |")
 
 
 if __name__ == "__main__":
