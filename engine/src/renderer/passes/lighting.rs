@@ -20,8 +20,8 @@ use crate::scene::Scene;
 use crate::shaders;
 
 /// The layout of `lighting.wgsl`'s bindings 0..17. Parameters are in uniform buffers; nothing
-/// in them steers a branch or loop (see the top of shaders/lighting/inputs.wgsl), so lavapipe has nothing to
-/// specialise per draw.
+/// in them steers a branch or loop (see the top of shaders/lighting/inputs.wgsl), so lavapipe
+/// has nothing to specialise per draw.
 fn binding_layouts() -> Vec<BindingLayout> {
     let mut layouts = vec![BindingLayout {
         binding: 0,

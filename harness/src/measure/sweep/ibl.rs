@@ -166,22 +166,23 @@ pub fn ibl_sweep_with(
     let mut references = None;
     let mut built: Vec<(engine::ibl::cache::Key, f64)> = Vec::new();
     for (name, settings) in ibl_settings() {
-        progress(&format!("precompute {name}"));
-        engine::ibl::dfg_table();
-        // Timed, and kept in memory for the render below. Settings that change only the
-        // render (the runtime samples) share an earlier setting's maps and its time.
-        let key = engine::ibl::cache::key_of_shared(&environment.image, &settings);
-        let precompute_s = match built.iter().find(|(k, _)| *k == key) {
-            Some(&(_, seconds)) => seconds,
-            None if maps == MapSource::Cached => {
-                engine::ibl::prepare(&environment.image, &settings);
-                built.push((key, f64::NAN));
-                f64::NAN
-            }
-            None => {
-                let (_, seconds) = engine::ibl::build_timed(&environment.image, &settings);
-                built.push((key, seconds));
-                seconds
+        // Cached: the render below prepares its maps through the caches, as any render does.
+        let precompute_s = match maps {
+            MapSource::Cached => f64::NAN,
+            MapSource::Timed => {
+                progress(&format!("precompute {name}"));
+                engine::ibl::dfg_table();
+                // Timed, and kept in memory for the render below. Settings that change only
+                // the render (the runtime samples) share an earlier setting's maps and its time.
+                let key = engine::ibl::cache::key_of_shared(&environment.image, &settings);
+                match built.iter().find(|(k, _)| *k == key) {
+                    Some(&(_, seconds)) => seconds,
+                    None => {
+                        let (_, seconds) = engine::ibl::build_timed(&environment.image, &settings);
+                        built.push((key, seconds));
+                        seconds
+                    }
+                }
             }
         };
         let mut variant = scene.clone();
@@ -229,6 +230,9 @@ pub fn ibl_sweep_with(
             pareto: false,
         });
     }
+    if maps == MapSource::Cached {
+        return Ok(rows);
+    }
     // Two costs: the precompute (once per environment and settings) and the lighting pass (every
     // frame; the filtered importance sampling settings spend it there).
     let points: Vec<Vec<f64>> = rows
@@ -242,7 +246,7 @@ pub fn ibl_sweep_with(
         })
         .collect();
     for (row, on_front) in rows.iter_mut().zip(pareto_front_n(&points)) {
-        row.pareto = on_front && maps == MapSource::Timed;
+        row.pareto = on_front;
     }
     Ok(rows)
 }
