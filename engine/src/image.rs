@@ -62,12 +62,17 @@ impl Image {
             TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb => {
                 ImageData::U8(bytes.to_vec())
             }
-            TextureFormat::Rgba16Float => ImageData::F32(
-                bytes
+            TextureFormat::Rgba16Float => {
+                use half::slice::HalfFloatSliceExt;
+                let halves: Vec<half::f16> = bytes
                     .chunks_exact(2)
-                    .map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32())
-                    .collect(),
-            ),
+                    .map(|b| half::f16::from_le_bytes([b[0], b[1]]))
+                    .collect();
+                // The slice conversion uses F16C on whole vectors (exact, as per value).
+                let mut values = vec![0.0f32; halves.len()];
+                halves.convert_to_f32_slice(&mut values);
+                ImageData::F32(values)
+            }
             TextureFormat::Rgba32Float | TextureFormat::R32Float | TextureFormat::Depth32Float => {
                 ImageData::F32(
                     bytes

@@ -182,11 +182,12 @@ fn read_color(
         backend.queue.submit([encoder.finish()]);
     })?;
     let padded = backend.read_buffer(&buffer, &context)?;
-    Ok(padded
-        .chunks_exact(padded_row)
-        .flat_map(|r| &r[..row])
-        .copied()
-        .collect())
+    // Row by row (a byte-wise iterator here cost a tenth of the self-test's time).
+    let mut texels = Vec::with_capacity(row * h as usize);
+    for padded_row in padded.chunks_exact(padded_row) {
+        texels.extend_from_slice(&padded_row[..row]);
+    }
+    Ok(texels)
 }
 
 /// The depth copy pipeline, created on first use.
