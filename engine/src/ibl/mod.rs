@@ -75,7 +75,9 @@ pub struct IblSettings {
     /// with the DFG table); N > 0 integrates the full GGX lobe (anisotropic where the surface
     /// is) with N filtered importance samples per pixel, each read from the prefiltered cube at
     /// the roughness whose lobe covers the sample's solid angle (Krivanek and Colbert, "Real-time
-    /// Shading with Filtered Importance Sampling", 2008). It changes no precomputed map.
+    /// Shading with Filtered Importance Sampling", 2008). Lobes narrower than a level-0 texel
+    /// of the prefiltered cube (alpha < 2 / `specular_size`) keep the split sum's lookup. It
+    /// changes no precomputed map.
     pub runtime_samples: u32,
     /// Cut the environment's sun out of the maps and light it as a directional light instead
     /// ([`sun`]).
