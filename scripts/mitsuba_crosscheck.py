@@ -24,7 +24,7 @@ Mitsuba's own noise, about 1/sqrt(spp) of the pixel value; the ratio of means do
 
     pip install mitsuba          # 3.x; the scalar_rgb variant ships in the wheel
     python3 scripts/mitsuba_crosscheck.py [--spp 1024] [--out target/mitsuba] [--min-n-dot-v 0.3]
-                                          [--harness target/debug/harness]
+                                          [--harness target/debug/harness] [--rotation 0]
 
 Not part of `cargo test`: it takes a few minutes and needs Mitsuba. The README's "IBL against a
 path tracer" section records its table.
@@ -65,7 +65,7 @@ def sphere_x(index):
     return (index - (len(SPHERES) - 1) / 2) * 2.2
 
 
-def harness_scene(environment):
+def harness_scene(environment, rotation):
     """The scene file the harness renders (in the folder that holds a copy of the environment)."""
     lines = [
         "# Written by scripts/mitsuba_crosscheck.py.",
@@ -82,7 +82,7 @@ def harness_scene(environment):
         "exposure = 1.0",
         "[environment]",
         f'path = "{environment}"',
-        "rotation = 0.0",
+        f"rotation = {rotation}",
         "intensity = 1.0",
     ]
     for index, (label, material, _) in enumerate(SPHERES):
@@ -104,7 +104,7 @@ def harness_scene(environment):
     return "\n".join(lines) + "\n"
 
 
-def mitsuba_sphere(environment_bitmap, spp, index, crop):
+def mitsuba_sphere(environment_bitmap, rotation, spp, index, crop):
     """Mitsuba's render of sphere `index` alone (the harness does not model one sphere hiding
     the sky from another), over the pixel rectangle `crop` = (x, y, width, height)."""
     label, material, bsdf = SPHERES[index]
@@ -137,7 +137,7 @@ def mitsuba_sphere(environment_bitmap, spp, index, crop):
             "type": "envmap",
             "bitmap": environment_bitmap,
             "scale": 1.0,
-            "to_world": mi.ScalarTransform4f().rotate(axis=[0, 1, 0], angle=180.0 + 0.0),
+            "to_world": mi.ScalarTransform4f().rotate(axis=[0, 1, 0], angle=180.0 + rotation),
         },
         "sphere": {
             "type": "sphere",
@@ -149,13 +149,13 @@ def mitsuba_sphere(environment_bitmap, spp, index, crop):
     return np.array(mi.render(mi.load_dict(scene)), dtype=np.float64)[..., :3]
 
 
-def mitsuba_render(environment_bitmap, spp, masks):
+def mitsuba_render(environment_bitmap, rotation, spp, masks):
     """The five spheres' pixels from Mitsuba, each sphere rendered alone; zero elsewhere."""
     image = np.zeros((HEIGHT, WIDTH, 3))
     for index, mask in enumerate(masks):
         ys, xs = np.nonzero(mask)
         x0, y0, x1, y1 = xs.min(), ys.min(), xs.max() + 1, ys.max() + 1
-        crop = mitsuba_sphere(environment_bitmap, spp, index, (int(x0), int(y0), int(x1 - x0), int(y1 - y0)))
+        crop = mitsuba_sphere(environment_bitmap, rotation, spp, index, (int(x0), int(y0), int(x1 - x0), int(y1 - y0)))
         image[y0:y1, x0:x1] = crop
     return image
 
@@ -217,6 +217,11 @@ def main():
         "--harness", default=None,
         help="a built harness binary (e.g. target/debug/harness) instead of `cargo run --release`",
     )
+    parser.add_argument(
+        "--rotation", type=float, default=0.0,
+        help="environment rotation about +Y in degrees, in both renderers (default 0); the camera "
+        "looks down -Z, so this turns which part of the sky each sphere reflects",
+    )
     args = parser.parse_args()
     mi.set_variant("scalar_rgb")
     os.makedirs(args.out, exist_ok=True)
@@ -230,13 +235,13 @@ def main():
         shutil.copyfile(source, os.path.join(work, environment))
         scene_path = os.path.join(work, "spheres.toml")
         with open(scene_path, "w") as f:
-            f.write(harness_scene(environment))
+            f.write(harness_scene(environment, args.rotation))
         print(f"{environment}: harness ...", file=sys.stderr)
         harness = run_harness(scene_path, os.path.join(work, "light.exr"), args.harness)
         texels = np.array(mi.Bitmap(source), dtype=np.float32)[..., :3]
         clamped = mi.Bitmap(np.ascontiguousarray(np.maximum(texels, 0.0)))
         print(f"{environment}: Mitsuba, {args.spp} spp ...", file=sys.stderr)
-        reference = mitsuba_render(clamped, args.spp, masks)
+        reference = mitsuba_render(clamped, args.rotation, args.spp, masks)
         mi.Bitmap(reference.astype(np.float32)).write(os.path.join(work, "mitsuba.exr"))
         for (label, _, _), mask, n_dot_v in zip(SPHERES, masks, n_dot_vs):
             h = luminance(harness[mask])
