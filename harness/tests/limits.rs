@@ -126,6 +126,8 @@ fn a_scene_past_the_byte_limit_is_refused_naming_the_file() {
 /// same as with the defaults.
 #[test]
 fn with_limits_off_rendering_is_unchanged() {
+    // chess's sunset maps come from the IBL caches: the precompute is not under test here.
+    harness::use_ibl_cache();
     let chess = harness::scenes_dir().join("chess.toml");
     let default = engine::scene_file::load(&chess).unwrap();
     let none = engine::scene_file::load_with_limits(&chess, Limits::NONE).unwrap();

@@ -151,6 +151,8 @@ fn open_plane_has_no_shadow_acne() {
 /// pixels.
 #[test]
 fn hard_shadows_match_the_ray_cast_reference() {
+    // chess's sunset maps come from the IBL caches: the precompute is not under test here.
+    harness::use_ibl_cache();
     for (scene_name, light) in [("chess", 0usize), ("chess", 1), ("arrow", 0)] {
         let mut scene = harness::load_scene(scene_name).unwrap().scene;
         scene.quality.debug_shadow_terms = true;
@@ -328,6 +330,8 @@ fn box_on_a_plane_shows_at_most_a_two_texel_contact_gap() {
 /// light, whose taps offset the lookup direction across cube faces.
 #[test]
 fn soft_shadow_early_out_matches_the_full_kernel_outside_penumbrae() {
+    // chess's sunset maps come from the IBL caches: the precompute is not under test here.
+    harness::use_ibl_cache();
     let term = |backend: &mut dyn engine::Backend, scene_name: &str, filter: ShadowFilter| {
         let mut scene = harness::load_scene(scene_name).unwrap().scene;
         scene.quality.debug_shadow_terms = true;
@@ -380,6 +384,8 @@ fn soft_shadow_early_out_matches_the_full_kernel_outside_penumbrae() {
 /// (VSM's light bleeding and blur make it less exact than PCF; the sweep reports the figure).
 #[test]
 fn variance_shadow_maps_agree_with_the_ray_cast_reference() {
+    // chess's sunset maps come from the IBL caches: the precompute is not under test here.
+    harness::use_ibl_cache();
     let mut scene = harness::load_scene("chess").unwrap().scene;
     scene.quality.debug_shadow_terms = true;
     if let Light::Directional {
