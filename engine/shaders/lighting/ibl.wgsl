@@ -109,9 +109,9 @@ fn pbr_ibl(s: Surface, v: vec3<f32>) -> vec3<f32> {
     // Sampling only where the lobe is wider than a texel of the prefiltered cube's level 0 (GGX
     // alpha against the texel's 2 / size radians): a narrower lobe is the level 0 lookup the
     // split sum makes, while its samples' solid-angle lod would blur the tail samples' reads.
-    let lobe_wider_than_a_texel =
-        s.roughness * s.roughness >= 2.0 / f32(textureDimensions(ibl_specular).x);
-    if IBL_SAMPLES > 0u && lobe_wider_than_a_texel {
+    // (`&&` short-circuits: the split-sum variant makes no size query.)
+    if IBL_SAMPLES > 0u
+        && s.roughness * s.roughness >= 2.0 / f32(textureDimensions(ibl_specular).x) {
         specular = ibl_specular_sampled(s, v, f0);
     } else {
         specular = ibl_prefiltered(dominant, s.roughness) * e;
