@@ -14,6 +14,18 @@ fn render(backend: &mut dyn Backend, scene: &Scene) -> Frame {
         .unwrap_or_else(|e| panic!("{} on {}: {e}", scene.name, backend.kind()))
 }
 
+/// Whether two images hold the same bits (f32 compared by bit pattern: -0 is not 0).
+fn same_bits(a: &Image, b: &Image) -> bool {
+    use engine::image::ImageData;
+    match (&a.data, &b.data) {
+        (ImageData::U8(x), ImageData::U8(y)) => x == y,
+        (ImageData::F32(x), ImageData::F32(y)) => {
+            x.len() == y.len() && x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits())
+        }
+        _ => false,
+    }
+}
+
 fn save(name: &str, image: &Image) {
     let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("renderer");
     std::fs::create_dir_all(&out).unwrap();
@@ -381,5 +393,63 @@ fn an_environment_without_objects_renders_the_sky_everywhere() {
             }
         }
         assert!(compared > 1000, "{kind}: {compared} sky pixels compared");
+    }
+}
+
+/// Culling: a render that asks only for some targets ([`Readback::Needed`]) runs only the passes
+/// they depend on, and gives the same targets, bit for bit, as the whole frame: the G-buffer
+/// alone (geometry and mask only), the shadow terms (no lighting, no tone mapping), the light
+/// buffer (no tone mapping). On chess (shadowed sun and point light, environment) and arrow
+/// (two lighting models), on every backend, at 128 x 128 (culling works on the recorded passes,
+/// whatever their size).
+#[test]
+fn culled_renders_give_the_whole_frame_s_targets() {
+    harness::use_ibl_cache();
+    let scenes: Vec<Scene> = ["chess", "arrow"]
+        .map(|name| {
+            let mut scene = harness::load_scene(name).unwrap().scene;
+            scene.quality.debug_shadow_terms = true;
+            (scene.quality.width, scene.quality.height) = (128, 128);
+            scene
+        })
+        .into();
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        for scene in &scenes {
+            let name = &scene.name;
+            let plan = engine::plan::RenderPlan::new(scene);
+            let terms: Vec<&str> = plan
+                .target_names()
+                .into_iter()
+                .filter(|t| t.starts_with("shadow_term_"))
+                .collect();
+            assert!(!terms.is_empty(), "{name} has no shadow term");
+            let mut gbuffer = engine::plan::GBUFFER_TARGETS.to_vec();
+            gbuffer.extend(["depth", "mask"]);
+            // Each wanted set, and the passes that must not run for it.
+            let cases: [(&[&str], &[&str]); 3] = [
+                (&gbuffer, &["shadow_", "skybox", "lighting_", "tonemap"]),
+                (&terms, &["skybox", "lighting_", "tonemap"]),
+                (&["light"], &["shadow_term_", "tonemap"]),
+            ];
+            let whole = render(backend.as_mut(), scene);
+            for (wanted, culled) in cases {
+                let frame = renderer::render(backend.as_mut(), scene, Readback::Needed(wanted))
+                    .unwrap_or_else(|e| panic!("{name} on {kind}: {e}"));
+                for target in wanted {
+                    assert!(
+                        same_bits(&frame.outputs[*target], &whole.outputs[*target]),
+                        "{name} on {kind}: {target} differs when only {wanted:?} are rendered"
+                    );
+                }
+                let ran: Vec<&str> = frame.timings.iter().map(|t| t.name.as_str()).collect();
+                assert!(
+                    ran.iter().all(|pass| !culled
+                        .iter()
+                        .any(|c| pass.starts_with(c) && !wanted.contains(pass))),
+                    "{name} on {kind}: for {wanted:?}, {ran:?} ran"
+                );
+            }
+        }
     }
 }

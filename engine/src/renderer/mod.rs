@@ -10,6 +10,7 @@
 //! camera-relative positions, so a scene 10 km from the origin renders like one at the origin.
 
 mod builders;
+mod cull;
 mod ibl;
 mod passes;
 mod resources;
@@ -89,8 +90,12 @@ impl From<BackendError> for RenderError {
 pub enum Readback<'a> {
     /// Every target of the plan.
     All,
-    /// Only these targets.
+    /// Only these targets; every pass of the plan still runs (what the bench times).
     Only(&'a [&'a str]),
+    /// Only these targets, and only the passes they depend on run: the others are culled before
+    /// submission, so they take no GPU time and report no timing. The targets read back are the
+    /// same, bit for bit, as with [`Readback::Only`].
+    Needed(&'a [&'a str]),
 }
 
 /// A rendered frame: the plan it followed, the outputs read back, and GPU time per pass.
@@ -163,7 +168,7 @@ pub fn render_with_faults(
             .iter()
             .map(|s| (*s).to_owned())
             .collect(),
-        Readback::Only(names) => {
+        Readback::Only(names) | Readback::Needed(names) => {
             for name in names {
                 if plan.target(name).is_none() {
                     return Err(RenderError::UnknownOutput {
@@ -176,12 +181,13 @@ pub fn render_with_faults(
             names.iter().map(|s| (*s).to_owned()).collect()
         }
     };
+    let cull = matches!(readback, Readback::Needed(_));
     let mut scope = ResourceScope::default();
     let result = record_and_submit(
         backend,
         scene,
         &plan,
-        &wanted,
+        (&wanted, cull),
         faults,
         ibl_maps.as_deref(),
         &mut scope,
@@ -227,13 +233,13 @@ impl CameraMatrices {
 
 type Outputs = (BTreeMap<String, Image>, Vec<PassTiming>);
 
-/// Records every pass of `plan` (in [`passes`], one file each), submits them at once and reads
-/// back the `wanted` targets.
+/// Records every pass of `plan` (in [`passes`], one file each), submits them at once (with
+/// `cull`, only those the `wanted` targets depend on) and reads back the `wanted` targets.
 fn record_and_submit(
     backend: &mut dyn Backend,
     scene: &Scene,
     plan: &RenderPlan,
-    wanted: &[String],
+    (wanted, cull): (&[String], bool),
     faults: &Faults,
     ibl_maps: Option<&crate::ibl::IblMaps>,
     scope: &mut ResourceScope,
@@ -267,6 +273,10 @@ fn record_and_submit(
         )?);
     }
 
+    if cull {
+        let targets: Vec<Handle<Texture>> = wanted.iter().map(|name| frame.target(name)).collect();
+        passes = cull::needed(passes, &targets);
+    }
     let timings = backend.submit(&passes)?;
     let mut outputs = BTreeMap::new();
     for name in wanted {
