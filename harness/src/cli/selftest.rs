@@ -30,7 +30,13 @@ pub(crate) fn run(json: bool) -> anyhow::Result<ExitCode> {
             .collect::<Vec<_>>()
             .join(", ")
     );
-    let mut result = harness::golden::selftest::run(&cases, &store, &available, &model);
+    let mut result = harness::golden::selftest::run(
+        &cases,
+        &store,
+        &available,
+        &model,
+        harness::golden::selftest::MutationChecks::EveryPass,
+    );
     result.errors.extend(
         broken
             .iter()

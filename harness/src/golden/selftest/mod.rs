@@ -30,6 +30,19 @@ mod tables;
 pub use mutations::Mutation;
 pub use run::run;
 
+/// Which golden passes of a mutated render the self-test checks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MutationChecks {
+    /// Every golden pass: [`MutationResult::also_failing`] then lists where else a change
+    /// shows (what `harness selftest` prints).
+    EveryPass,
+    /// Only the passes where each mutation originates, which is all the verdict reads
+    /// ([`SelfTest::weak_detections`]); the render runs only the passes they depend on, so a
+    /// material change costs a G-buffer pass, not a frame. The unchanged renders are checked
+    /// in every pass either way.
+    Origin,
+}
+
 /// One mutation rendered on one scene and backend.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct MutationResult {
@@ -41,7 +54,8 @@ pub struct MutationResult {
     pub backend: String,
     /// Whether the mutation applies to the scene (if not, nothing was rendered).
     pub applies: bool,
-    /// `value / limit` of every golden pass's rule (see [`crate::golden::tolerance::Verdict::ratio`]).
+    /// `value / limit` of every checked golden pass's rule (see
+    /// [`crate::golden::tolerance::Verdict::ratio`] and [`MutationChecks`]).
     pub ratios: BTreeMap<String, f64>,
     /// Why the render failed, if it did.
     pub error: Option<String>,

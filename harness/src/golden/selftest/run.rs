@@ -9,7 +9,7 @@ use engine::renderer::{self, Faults, Readback};
 use engine::scene::Scene;
 use engine::Image;
 
-use super::{Mutation, MutationResult, NoiseResult, SelfTest};
+use super::{Mutation, MutationChecks, MutationResult, NoiseResult, SelfTest};
 use crate::golden::noise::NoiseModel;
 use crate::golden::portability;
 use crate::golden::suite::{self, Case};
@@ -40,18 +40,20 @@ fn ratios(
 
 /// Runs the self-test on `backends`: every mutation and an unchanged render on each, synthetic
 /// rounding of the reference backend's render, and the figures `model` recorded for the sources
-/// this run does not produce (CPU code paths, another Mesa, recorded hosts). Scenes run in
-/// parallel, one thread each, each with its own backends.
+/// this run does not produce (CPU code paths, another Mesa, recorded hosts). `checks` says which
+/// passes of a mutated render are checked. Scenes run in parallel, one thread each, each with
+/// its own backends.
 pub fn run(
     cases: &[Case],
     store: &GoldenStore,
     backends: &[BackendKind],
     model: &NoiseModel,
+    checks: MutationChecks,
 ) -> SelfTest {
     let parts: Vec<SelfTest> = std::thread::scope(|scope| {
         let handles: Vec<_> = cases
             .iter()
-            .map(|case| scope.spawn(move || run_case(case, store, backends, model)))
+            .map(|case| scope.spawn(move || run_case(case, store, backends, model, checks)))
             .collect();
         handles
             .into_iter()
@@ -84,6 +86,7 @@ fn run_case(
     store: &GoldenStore,
     backends: &[BackendKind],
     model: &NoiseModel,
+    checks: MutationChecks,
 ) -> SelfTest {
     let mut result = SelfTest {
         mutations: vec![],
@@ -104,7 +107,8 @@ fn run_case(
         .find(|&k| k == suite::REFERENCE_BACKEND)
         .or(backends.first().copied());
     for &kind in backends {
-        run_backend(case, kind, Some(kind) == reference, &goldens, &mut result);
+        let reference = Some(kind) == reference;
+        run_backend(case, kind, reference, &goldens, checks, &mut result);
     }
     // The sources this run does not produce, from the figures golden/noise.toml recorded.
     recorded_noise(case, model, &mut result.noise);
@@ -112,12 +116,14 @@ fn run_case(
 }
 
 /// One scene on one backend: the unchanged render (and its synthetic rounding, on the
-/// `reference` backend), then every mutation.
+/// `reference` backend), then every mutation. Each render runs only the passes its checked
+/// targets depend on (the others are culled; the targets are the same bit for bit).
 fn run_backend(
     case: &Case,
     kind: BackendKind,
     reference: bool,
     goldens: &Goldens,
+    checks: MutationChecks,
     result: &mut SelfTest,
 ) {
     let scene = &case.loaded.scene;
@@ -131,11 +137,11 @@ fn run_backend(
             return;
         }
     };
-    let mut render = |scene: &Scene, faults: &Faults| {
-        renderer::render_with_faults(backend.as_mut(), scene, Readback::Only(&wanted), faults)
+    let mut render = |scene: &Scene, faults: &Faults, wanted: &[&str]| {
+        renderer::render_with_faults(backend.as_mut(), scene, Readback::Needed(wanted), faults)
             .map_err(|e| e.to_string())
     };
-    match render(scene, &Faults::default()) {
+    match render(scene, &Faults::default(), &wanted) {
         Ok(frame) => unchanged_noise(case, kind, reference, goldens, &frame.outputs, result),
         Err(e) => result
             .errors
@@ -152,7 +158,15 @@ fn run_backend(
         };
         if let Some((mutated, faults)) = mutation.apply(scene) {
             entry.applies = true;
-            match render(&mutated, &faults) {
+            let checked: Vec<&str> = match checks {
+                MutationChecks::EveryPass => wanted.clone(),
+                MutationChecks::Origin => wanted
+                    .iter()
+                    .copied()
+                    .filter(|pass| mutation.is_origin(pass))
+                    .collect(),
+            };
+            match render(&mutated, &faults, &checked) {
                 Ok(frame) => entry.ratios = ratios(case, goldens, &frame.outputs),
                 Err(e) => {
                     result.errors.push(format!(
