@@ -145,8 +145,13 @@ impl Occluders {
             return false;
         }
         let inverse = DVec3::ONE / direction;
-        let mut stack = vec![0usize];
-        while let Some(index) = stack.pop() {
+        // The nodes still to visit: a median split halves the triangles per level, so the
+        // depth (and this stack, one entry per level plus one) stays far below 64.
+        let mut stack = [0usize; 64];
+        let mut depth = 1;
+        while depth > 0 {
+            depth -= 1;
+            let index = stack[depth];
             match &self.nodes[index] {
                 Node::Leaf {
                     bounds,
@@ -168,8 +173,9 @@ impl Occluders {
                     right,
                 } => {
                     if bounds.hit(origin, inverse, t_max) {
-                        stack.push(*left);
-                        stack.push(*right);
+                        stack[depth] = *left;
+                        stack[depth + 1] = *right;
+                        depth += 2;
                     }
                 }
             }
@@ -220,6 +226,23 @@ pub struct VisibilityError {
     pub false_lit: usize,
 }
 
+/// The targets [`visibility_error`] reads for `light`, of those `plan` has: what a render
+/// for it needs to read back (with [`engine::renderer::Readback::Needed`], nothing else runs).
+pub fn visibility_targets(plan: &plan::RenderPlan, light: usize) -> Vec<String> {
+    let term = plan::shadow_term_target_name(light);
+    [
+        term.as_str(),
+        plan::GBUFFER_TARGETS[0],
+        plan::GBUFFER_TARGETS[1],
+        "mask",
+        "mask_1",
+    ]
+    .into_iter()
+    .filter(|name| plan.target(name).is_some())
+    .map(str::to_owned)
+    .collect()
+}
+
 /// Compares the frame's `shadow_term_<light>` with ray-cast visibility. `epsilon` (meters) moves
 /// each ray's origin off its surface along the normal.
 pub fn visibility_error(
@@ -228,73 +251,166 @@ pub fn visibility_error(
     light: usize,
     epsilon: f64,
 ) -> Result<VisibilityError, String> {
-    let get = |name: &str| {
-        frame
-            .output(name)
-            .and_then(|i| i.as_f32().map(|d| (i, d)))
-            .ok_or_else(|| format!("frame has no float output `{name}`"))
-    };
-    let (_, term) = get(&plan::shadow_term_target_name(light))?;
-    let (_, position) = get(plan::GBUFFER_TARGETS[0])?;
-    let (_, normal) = get(plan::GBUFFER_TARGETS[1])?;
-    let mask = frame
-        .output("mask")
-        .and_then(|i| i.as_u8())
-        .ok_or("frame has no mask output")?;
-    let mask_1 = frame.output("mask_1").and_then(|i| i.as_u8());
-    let occluders = Occluders::new(scene);
-    let camera = scene.camera.position;
-    let light_data = scene.lights.get(light).ok_or("no such light")?;
-    let (mut lit_surface, mut wrong, mut shadowed, mut false_lit) = (0, 0, 0, 0);
-    for i in 0..term.len() / 4 {
-        let covered = mask[i * 4..i * 4 + 4].iter().any(|&m| m > 127)
-            || mask_1.is_some_and(|m| m[i * 4..i * 4 + 4].iter().any(|&v| v > 127));
-        if !covered {
-            continue;
-        }
-        let p = DVec3::new(
-            position[i * 4] as f64,
-            position[i * 4 + 1] as f64,
-            position[i * 4 + 2] as f64,
-        );
-        let n = DVec3::new(
-            normal[i * 4] as f64,
-            normal[i * 4 + 1] as f64,
-            normal[i * 4 + 2] as f64,
-        )
-        .normalize_or_zero();
-        let (direction, distance) = match light_data {
-            Light::Directional { direction, .. } => (direction.normalize(), f64::INFINITY),
-            Light::Point { position, .. } => {
-                let to_light = *position - camera - p;
-                (to_light.normalize_or_zero(), to_light.length())
-            }
+    RayCastVisibility::cast(scene, frame, light, epsilon)?.error(frame)
+}
+
+/// The frame's G-buffer inputs of the ray cast: position, normal, mask and the second mask.
+struct GbufferInputs<'a> {
+    position: &'a [f32],
+    normal: &'a [f32],
+    mask: &'a [u8],
+    mask_1: Option<&'a [u8]>,
+}
+
+impl<'a> GbufferInputs<'a> {
+    fn of(frame: &'a Frame) -> Result<Self, String> {
+        let float = |name: &str| {
+            frame
+                .output(name)
+                .and_then(|i| i.as_f32())
+                .ok_or_else(|| format!("frame has no float output `{name}`"))
         };
-        if n.dot(direction) <= 0.0 {
-            continue;
-        }
-        lit_surface += 1;
-        let origin = p + n * epsilon;
-        let visible = !occluders.occluded(origin, direction, distance);
-        if !visible {
-            shadowed += 1;
-        }
-        if (term[i * 4] > 0.5) != visible {
-            wrong += 1;
-            if visible {
-                continue;
-            }
-            false_lit += 1;
-        }
+        Ok(Self {
+            position: float(plan::GBUFFER_TARGETS[0])?,
+            normal: float(plan::GBUFFER_TARGETS[1])?,
+            mask: frame
+                .output("mask")
+                .and_then(|i| i.as_u8())
+                .ok_or("frame has no mask output")?,
+            mask_1: frame.output("mask_1").and_then(|i| i.as_u8()),
+        })
     }
-    Ok(VisibilityError {
-        light,
-        lit_surface_pixels: lit_surface,
-        misclassified: wrong,
-        fraction: wrong as f64 / lit_surface.max(1) as f64,
-        shadowed_by_reference: shadowed,
-        false_lit,
-    })
+
+    /// Whether both hold the same values (floats by bit pattern).
+    fn same(&self, other: &GbufferInputs<'_>) -> bool {
+        let bits = |a: &[f32], b: &[f32]| {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+        };
+        bits(self.position, other.position)
+            && bits(self.normal, other.normal)
+            && self.mask == other.mask
+            && self.mask_1 == other.mask_1
+    }
+}
+
+/// Exact visibility of one light from every covered, light-facing pixel of a frame's G-buffer,
+/// by ray casting: what [`visibility_error`] compares a shadow term with. Frames whose
+/// G-buffer is the same (a sweep over shadow settings changes no geometry) share one cast.
+pub struct RayCastVisibility {
+    light: usize,
+    /// The G-buffer cast from: position, normal, mask, second mask.
+    gbuffer: (Vec<f32>, Vec<f32>, Vec<u8>, Option<Vec<u8>>),
+    /// Per pixel: `None` off the lit surface (uncovered, or facing away from the light), else
+    /// whether the light is visible.
+    visible: Vec<Option<bool>>,
+}
+
+impl RayCastVisibility {
+    /// Casts a ray to `light` from each covered pixel of `frame`'s G-buffer that faces it,
+    /// `epsilon` (meters) off its surface along the normal.
+    pub fn cast(scene: &Scene, frame: &Frame, light: usize, epsilon: f64) -> Result<Self, String> {
+        let inputs = GbufferInputs::of(frame)?;
+        let occluders = Occluders::new(scene);
+        let camera = scene.camera.position;
+        let light_data = scene.lights.get(light).ok_or("no such light")?;
+        let (position, normal, mask) = (inputs.position, inputs.normal, inputs.mask);
+        let visible = (0..position.len() / 4)
+            .map(|i| {
+                let covered = mask[i * 4..i * 4 + 4].iter().any(|&m| m > 127)
+                    || inputs
+                        .mask_1
+                        .is_some_and(|m| m[i * 4..i * 4 + 4].iter().any(|&v| v > 127));
+                if !covered {
+                    return None;
+                }
+                let p = DVec3::new(
+                    position[i * 4] as f64,
+                    position[i * 4 + 1] as f64,
+                    position[i * 4 + 2] as f64,
+                );
+                let n = DVec3::new(
+                    normal[i * 4] as f64,
+                    normal[i * 4 + 1] as f64,
+                    normal[i * 4 + 2] as f64,
+                )
+                .normalize_or_zero();
+                let (direction, distance) = match light_data {
+                    Light::Directional { direction, .. } => (direction.normalize(), f64::INFINITY),
+                    Light::Point { position, .. } => {
+                        let to_light = *position - camera - p;
+                        (to_light.normalize_or_zero(), to_light.length())
+                    }
+                };
+                if n.dot(direction) <= 0.0 {
+                    return None;
+                }
+                Some(!occluders.occluded(p + n * epsilon, direction, distance))
+            })
+            .collect();
+        Ok(Self {
+            light,
+            gbuffer: (
+                position.to_vec(),
+                normal.to_vec(),
+                mask.to_vec(),
+                inputs.mask_1.map(<[u8]>::to_vec),
+            ),
+            visible,
+        })
+    }
+
+    /// Whether `frame`'s G-buffer is the one this cast came from, so that it holds for `frame`.
+    pub fn holds_for(&self, frame: &Frame) -> bool {
+        let (position, normal, mask, mask_1) = &self.gbuffer;
+        let own = GbufferInputs {
+            position,
+            normal,
+            mask,
+            mask_1: mask_1.as_deref(),
+        };
+        GbufferInputs::of(frame).is_ok_and(|inputs| own.same(&inputs))
+    }
+
+    /// `frame`'s shadow term of this light against the cast (the frame must have the same
+    /// G-buffer: see [`RayCastVisibility::holds_for`]).
+    pub fn error(&self, frame: &Frame) -> Result<VisibilityError, String> {
+        let name = plan::shadow_term_target_name(self.light);
+        let term = frame
+            .output(&name)
+            .and_then(|i| i.as_f32())
+            .ok_or_else(|| format!("frame has no float output `{name}`"))?;
+        if term.len() != self.visible.len() * 4 {
+            return Err(format!(
+                "`{name}` has {} pixels, the ray cast {}",
+                term.len() / 4,
+                self.visible.len()
+            ));
+        }
+        let (mut lit_surface, mut wrong, mut shadowed, mut false_lit) = (0, 0, 0, 0);
+        for (i, visible) in self.visible.iter().enumerate() {
+            let Some(visible) = *visible else {
+                continue;
+            };
+            lit_surface += 1;
+            if !visible {
+                shadowed += 1;
+            }
+            if (term[i * 4] > 0.5) != visible {
+                wrong += 1;
+                if !visible {
+                    false_lit += 1;
+                }
+            }
+        }
+        Ok(VisibilityError {
+            light: self.light,
+            lit_surface_pixels: lit_surface,
+            misclassified: wrong,
+            fraction: wrong as f64 / lit_surface.max(1) as f64,
+            shadowed_by_reference: shadowed,
+            false_lit,
+        })
+    }
 }
 
 #[cfg(test)]

@@ -66,11 +66,34 @@ fn with_shadow_samples(
     scene
 }
 
+/// What the shadow sweep's renders cost.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShadowSweepCost {
+    /// Every pass of the frame runs and the shadow and lighting passes are timed: the cost
+    /// columns and the Pareto front (the `harness sweep` command).
+    Timed,
+    /// Only the passes the shadow terms depend on run (no lighting, no tone mapping: the terms
+    /// are the same bit for bit), untimed: the times are `None` and no row is on a front. For
+    /// checking errors (the sweep test).
+    Untimed,
+}
+
 /// Runs the shadow sweep on one backend. `repeats` renders per setting for the timing median.
 pub fn shadow_sweep(
     scene: &Scene,
     kind: BackendKind,
     repeats: usize,
+    progress: impl FnMut(&str),
+) -> Result<Vec<SweepRow>, SweepError> {
+    shadow_sweep_with(scene, kind, repeats, ShadowSweepCost::Timed, progress)
+}
+
+/// [`shadow_sweep`] at the given `cost`.
+pub fn shadow_sweep_with(
+    scene: &Scene,
+    kind: BackendKind,
+    repeats: usize,
+    cost: ShadowSweepCost,
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<SweepRow>, SweepError> {
     let light = scene
@@ -104,11 +127,16 @@ pub fn shadow_sweep(
         plan::GBUFFER_TARGETS[1],
         "mask",
     ];
+    let readback = match cost {
+        ShadowSweepCost::Timed => Readback::Only(&wanted),
+        ShadowSweepCost::Untimed => Readback::Needed(&wanted),
+    };
     let mut render = |scene: &Scene| {
-        renderer::render(backend.as_mut(), scene, Readback::Only(&wanted))
+        renderer::render(backend.as_mut(), scene, readback)
             .map_err(|e| SweepError::Render(e.to_string()))
     };
     let mut rows = Vec::new();
+    let mut ray_cast: Option<shadows::RayCastVisibility> = None;
     for map_size in [512u32, 1024, 2048] {
         progress(&format!("soft reference at {map_size}"));
         let reference_scene = with_shadow(scene, ShadowFilter::SoftReference, map_size);
@@ -134,12 +162,23 @@ pub fn shadow_sweep(
             };
             progress(&format!("{label} at {map_size}"));
             let mutated = with_shadow_samples(scene, filter, map_size, samples);
-            let frames = (0..repeats.max(1))
+            let repeats = match cost {
+                ShadowSweepCost::Timed => repeats.max(1),
+                ShadowSweepCost::Untimed => 1,
+            };
+            let frames = (0..repeats)
                 .map(|_| render(&mutated))
                 .collect::<Result<Vec<_>, _>>()?;
             let frame = &frames[0];
-            let visibility = shadows::visibility_error(&mutated, frame, light, 1e-4)
-                .map_err(SweepError::Render)?;
+            // Shadow settings change no geometry: one ray cast serves every setting whose
+            // G-buffer is the same (checked, bit for bit).
+            let cast = match ray_cast.take() {
+                Some(cast) if cast.holds_for(frame) => cast,
+                _ => shadows::RayCastVisibility::cast(&mutated, frame, light, 1e-4)
+                    .map_err(SweepError::Render)?,
+            };
+            let visibility = cast.error(frame).map_err(SweepError::Render)?;
+            ray_cast = Some(cast);
             let soft = matches!(
                 filter,
                 ShadowFilter::Soft
@@ -167,6 +206,12 @@ pub fn shadow_sweep(
                 pareto: false,
             });
         }
+    }
+    if cost == ShadowSweepCost::Untimed {
+        for row in &mut rows {
+            (row.shadow_ms, row.lighting_ms) = (None, None);
+        }
+        return Ok(rows);
     }
     let points: Vec<(f64, f64)> = rows
         .iter()
