@@ -54,7 +54,7 @@ pub(crate) fn pass_table(
             }
         }
     }
-    let precompute = harness::measure::bench::precompute();
+    let precompute = harness::measure::bench::precompute(&loaded);
     if !json {
         println!("precomputation (apart from frames):");
         for p in &precompute {

@@ -3,6 +3,7 @@
 
 use std::time::Instant;
 
+use engine::scene::Scene;
 use engine::stats::median;
 
 /// Work done once, not per frame, timed apart from frames.
@@ -16,9 +17,10 @@ pub struct Precompute {
     pub ms: f64,
 }
 
-/// The precomputation the renderer does once per process, timed (median of 5 runs): the
-/// stratified soft filter's jitter texture (CPU). The IBL maps join this list when they exist.
-pub fn precompute() -> Vec<Precompute> {
+/// The precomputation the renderer does once per process for `scenes`, timed apart from frames:
+/// the stratified soft filter's jitter texture (CPU, median of 5 runs), and with an environment
+/// the DFG table and each distinct environment's IBL maps at its scene's settings.
+pub fn precompute(scenes: &[Scene]) -> Vec<Precompute> {
     let runs: Vec<f64> = (0..5)
         .map(|_| {
             let start = Instant::now();
@@ -31,17 +33,32 @@ pub fn precompute() -> Vec<Precompute> {
         on: "CPU, once per process".to_owned(),
         ms: median(runs).unwrap_or(0.0),
     }];
-    out.extend(ibl_precompute());
+    out.extend(ibl_precompute(scenes));
     out
 }
 
-/// The IBL maps of the canonical environments at default settings: built from scratch (the DFG
-/// table apart, as it is computed once per process), read back from a disk cache, and found in
-/// memory (a second render in the same process). A build (about a second or two) and the DFG
-/// table are timed once; the cache reads, median of 3.
-fn ibl_precompute() -> Vec<Precompute> {
+/// The IBL maps of each distinct environment of `scenes` at its scene's settings: built from
+/// scratch (the DFG table apart, as it is computed once per process), read back from a disk
+/// cache, and found in memory (a second render in the same process). A build (about a second
+/// or two) and the DFG table are timed once; the cache reads, median of 3. Nothing without an
+/// environment.
+fn ibl_precompute(scenes: &[Scene]) -> Vec<Precompute> {
     use engine::ibl;
+    let mut environments: Vec<(&engine::scene::EnvironmentImage, &ibl::IblSettings)> = Vec::new();
+    for scene in scenes {
+        if let Some(environment) = &scene.environment {
+            let seen = environments.iter().any(|(image, settings)| {
+                image.label == environment.image.label && **settings == scene.quality.ibl
+            });
+            if !seen {
+                environments.push((&environment.image, &scene.quality.ibl));
+            }
+        }
+    }
     let mut out = Vec::new();
+    if environments.is_empty() {
+        return out;
+    }
     let start = Instant::now();
     std::hint::black_box(ibl::dfg::table(ibl::dfg::SIZE, ibl::dfg::SAMPLES));
     out.push(Precompute {
@@ -55,21 +72,14 @@ fn ibl_precompute() -> Vec<Precompute> {
         ms: start.elapsed().as_secs_f64() * 1e3,
     });
     ibl::dfg_table();
-    let settings = ibl::IblSettings::default();
     let Ok(cache) = tempfile::tempdir() else {
         return out;
     };
-    for name in ["sunset.exr", "interior.exr"] {
-        let path = crate::scenes_dir().join("assets").join(name);
-        let Ok(env) = engine::assets::load_environment(&path) else {
-            continue;
-        };
-        let image = engine::scene::EnvironmentImage {
-            label: name.to_owned(),
-            width: env.width,
-            height: env.height,
-            texels: env.texels,
-        };
+    for (image, settings) in environments {
+        let name = std::path::Path::new(&image.label)
+            .file_name()
+            .map_or_else(|| image.label.clone(), |n| n.to_string_lossy().into_owned());
+        let image = image.clone();
         let timed = |f: &mut dyn FnMut()| {
             median(
                 (0..3)
@@ -83,16 +93,16 @@ fn ibl_precompute() -> Vec<Precompute> {
             .unwrap_or(0.0)
         };
         let start = Instant::now();
-        let maps = ibl::build(&image, &settings);
+        let maps = ibl::build(&image, settings);
         out.push(Precompute {
             what: format!("IBL maps of {name}: {}", settings.describe()),
             on: "CPU, built".to_owned(),
             ms: start.elapsed().as_secs_f64() * 1e3,
         });
-        let key = ibl::cache::key(&image, &settings);
+        let key = ibl::cache::key(&image, settings);
         if ibl::cache::write(cache.path(), &key, &maps).is_ok() {
             let read = timed(&mut || {
-                let key = ibl::cache::key(&image, &settings);
+                let key = ibl::cache::key(&image, settings);
                 std::hint::black_box(ibl::cache::read(cache.path(), &key));
             });
             out.push(Precompute {
@@ -105,9 +115,9 @@ fn ibl_precompute() -> Vec<Precompute> {
             let shared = std::sync::Arc::new(image);
             let previous = ibl::cache::directory();
             ibl::cache::set_directory(Some(cache.path().to_path_buf()));
-            ibl::prepare(&shared, &settings);
+            ibl::prepare(&shared, settings);
             let again = timed(&mut || {
-                std::hint::black_box(ibl::prepare(&shared, &settings));
+                std::hint::black_box(ibl::prepare(&shared, settings));
             });
             ibl::cache::set_directory(previous);
             out.push(Precompute {
