@@ -25,6 +25,20 @@ pub struct CubeMap {
     pub levels: Vec<CubeLevel>,
 }
 
+/// `x.floor()` for the texel coordinates of a lookup (|x| far below 2^24), without the libm
+/// call that `f32::floor` compiles to on the x86-64 baseline (no SSE4.1 `roundss`): the same
+/// value, -0 and NaN included.
+fn floor(x: f32) -> f32 {
+    let truncated = x as i64 as f32;
+    if truncated > x {
+        truncated - 1.0
+    } else if truncated < x {
+        truncated
+    } else {
+        x // whole (keeping -0), or NaN
+    }
+}
+
 /// Direction through face coordinates `(u, v)` in -1..1 of `face`.
 pub fn face_direction(face: usize, u: f32, v: f32) -> Vec3 {
     match face {
@@ -103,9 +117,15 @@ impl CubeLevel {
         let n = self.size as f32;
         let fx = (u + 1.0) * 0.5 * n - 0.5;
         let fy = (v + 1.0) * 0.5 * n - 0.5;
-        let (x0, y0) = (fx.floor(), fy.floor());
+        let (x0, y0) = (floor(fx), floor(fy));
         let (tx, ty) = (fx - x0, fy - y0);
+        // The four texels' indices within the face, clamped to its edges.
+        let last = i64::from(self.size) - 1;
         let (x0, y0) = (x0 as i64, y0 as i64);
+        let columns = [x0.clamp(0, last) as usize, (x0 + 1).clamp(0, last) as usize];
+        let rows = [y0.clamp(0, last) as usize, (y0 + 1).clamp(0, last) as usize];
+        let side = self.size as usize;
+        let face = &self.texels[face * side * side..(face + 1) * side * side];
         let mut out = [0.0; 3];
         for (dx, dy, w) in [
             (0, 0, (1.0 - tx) * (1.0 - ty)),
@@ -113,7 +133,7 @@ impl CubeLevel {
             (0, 1, (1.0 - tx) * ty),
             (1, 1, tx * ty),
         ] {
-            let t = self.texel(face, x0 + dx, y0 + dy);
+            let t = face[rows[dy] * side + columns[dx]];
             for c in 0..3 {
                 out[c] += t[c] * w;
             }
@@ -152,7 +172,7 @@ impl CubeMap {
     pub fn sample_lod(&self, d: Vec3, lod: f32) -> [f32; 3] {
         let top = (self.levels.len() - 1) as f32;
         let lod = lod.clamp(0.0, top);
-        let lower = lod.floor() as usize;
+        let lower = floor(lod) as usize;
         let t = lod - lower as f32;
         let a = self.levels[lower].sample(d);
         if t == 0.0 {
@@ -177,7 +197,7 @@ pub fn sample_equirect(image: &EnvironmentImage, d: Vec3) -> [f32; 3] {
     let (u, v) = equirect_uv(d);
     let fx = u * w as f32 - 0.5;
     let fy = v * h as f32 - 0.5;
-    let (x0, y0) = (fx.floor(), fy.floor());
+    let (x0, y0) = (floor(fx), floor(fy));
     let (tx, ty) = (fx - x0, fy - y0);
     let mut out = [0.0; 3];
     for (dx, dy, wgt) in [
@@ -223,6 +243,32 @@ pub fn cube_from_equirect(image: &EnvironmentImage, size: u32) -> CubeLevel {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn floor_is_f32_floor() {
+        for x in [
+            -0.0f32,
+            0.0,
+            0.3,
+            -0.3,
+            1.0,
+            -1.0,
+            2.5,
+            -2.5,
+            127.999,
+            -0.5,
+            1e-30,
+            -1e-30,
+            f32::NAN,
+        ] {
+            assert_eq!(floor(x).to_bits(), x.floor().to_bits(), "{x}");
+        }
+        // Every representable value in -4..260 spaced by 1/1024, as texel coordinates are.
+        for i in -4096..266_240 {
+            let x = i as f32 / 1024.0;
+            assert_eq!(floor(x).to_bits(), x.floor().to_bits(), "{x}");
+        }
+    }
 
     #[test]
     fn face_mapping_round_trips() {
