@@ -1,6 +1,6 @@
 //! The hard numerical cases: the scene files in `scenes/hard/` and the chess scene moved and
 //! scaled, each rendered and checked against its invariant. `harness hard` prints the table and
-//! keeps it for the check report; `tests/hard_cases.rs` asserts every row on every backend.
+//! keeps it for the check report; `tests/integration/hard_cases.rs` asserts every row on every backend.
 //!
 //! Every case must have no NaN/Inf in any pass and a light buffer within 0..65000 (the lighting
 //! pass's fp16 clamp); then each has its own check (the `check` column).

@@ -98,7 +98,7 @@ pub fn ibl_settings() -> Vec<(String, engine::ibl::IblSettings)> {
         ),
         // The extracted sun without its shadow: the Monte Carlo reference, like the split sum,
         // sees the environment unoccluded, so a shadow one sphere casts on the next would count
-        // as an error of the lighting (the shadow itself is tested in tests/ibl.rs).
+        // as an error of the lighting (the shadow itself is tested in tests/integration/ibl.rs).
         (
             "sun".to_owned(),
             IblSettings {

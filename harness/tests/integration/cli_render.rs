@@ -1,8 +1,7 @@
 //! `harness render`: load warnings printed once, unknown passes refused before rendering, and
 //! every pass of a scene file written.
 
-mod common;
-
+use crate::common;
 use std::path::Path;
 
 use common::cli::harness;

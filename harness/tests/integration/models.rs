@@ -3,8 +3,7 @@
 //! loads with a warning per untidy thing, each naming its file and line, and renders on every
 //! available backend with its textures.
 
-mod common;
-
+use crate::common;
 use engine::assets::{srgb_to_linear, ColorSpace, TextureCache};
 use engine::renderer::{self, Readback};
 

@@ -72,8 +72,7 @@ const GBUFFER_P99: &[(&str, f64, f64)] = &[
 const GBUFFER_MARGIN: f64 = 1.5;
 const GBUFFER_SLACK: f64 = 4.9e-4;
 
-mod common;
-
+use crate::common;
 use engine::BackendKind;
 
 fn gl_available() -> bool {

@@ -3,8 +3,7 @@
 //! render (every backend, synthetic rounding, and the sources recorded in golden/noise.toml)
 //! stays at or below half of every limit. Prints the margin and noise tables.
 
-mod common;
-
+use crate::common;
 use harness::golden::noise::NoiseModel;
 use harness::golden::selftest::{self, Mutation, MutationChecks};
 use harness::golden::GoldenStore;

@@ -2,8 +2,7 @@
 //! unknown scene names answered with the canonical ones, and scene assets that regenerate
 //! byte for byte.
 
-mod common;
-
+use crate::common;
 use std::path::Path;
 use std::process::Command;
 

@@ -1,8 +1,7 @@
 //! Shadow maps: no acne on an open plane at any sun elevation, for every filter and both light
 //! types, on every available backend.
 
-mod common;
-
+use crate::common;
 use std::sync::Arc;
 
 use engine::mesh;

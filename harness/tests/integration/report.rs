@@ -8,8 +8,7 @@
 //! Needs Chromium (`apt-get install -y chromium`; CI installs it). Without it the test says so
 //! on stderr and passes, unless REQUIRE_CHROMIUM=1.
 
-mod common;
-
+use crate::common;
 use std::net::TcpStream;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};

@@ -1,8 +1,7 @@
 //! `harness check`: a scene that does not load, failures with their images and the bless
 //! command, and a note when the driver differs from the blessing one.
 
-mod common;
-
+use crate::common;
 use common::cli::darken;
 
 /// A scene in scenes/ whose mesh does not load is one failed case: `check` reports it with its

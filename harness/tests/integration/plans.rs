@@ -1,7 +1,7 @@
 //! The render plan of every canonical scene and test scene, as insta snapshots: a change in what
 //! a scene needs (passes, targets, formats, mask channels, draw counts) shows up in review.
-//! After an intended change: `INSTA_UPDATE=always cargo test -p harness --test plans` (or
-//! `cargo insta review`), then read the diff.
+//! After an intended change: `INSTA_UPDATE=always cargo test -p harness --test integration
+//! plans::` (or `cargo insta review`), then read the diff.
 
 use engine::plan::RenderPlan;
 use harness::test_scenes;

@@ -1,8 +1,7 @@
 //! Foundation acceptance on real drivers: the first scene agrees across backends, renders are
 //! deterministic, readback orientation is pinned, and `harness backends --json` tells the truth.
 
-mod common;
-
+use crate::common;
 use engine::backend::*;
 use engine::shaders;
 use harness::first_scene;

@@ -4,8 +4,7 @@
 //! backend; a check run goes on with the other scenes and fails; no golden is ever left
 //! half-written.
 
-mod common;
-
+use crate::common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};

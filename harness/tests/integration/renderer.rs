@@ -1,8 +1,7 @@
 //! The deferred renderer on every available backend, against the f64 reference and the
 //! renderer's invariants: white furnace, 10 km from the origin, five lighting models, 64 lights.
 
-mod common;
-
+use crate::common;
 use engine::renderer::{self, Frame, Readback};
 use engine::scene::Scene;
 use engine::{Backend, Image};

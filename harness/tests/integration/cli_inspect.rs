@@ -1,8 +1,7 @@
 //! `harness inspect` on bad and good input: it exits 1 with the loader's error (never 101, a
 //! panic) on every malformed fixture, and 0 on fixtures that load with warnings.
 
-mod common;
-
+use crate::common;
 use std::path::Path;
 
 use common::cli::{fixture, harness};

@@ -1,8 +1,7 @@
 //! `harness bench` (pass times, their ratio to the floor, the lighting breakdown) and
 //! `harness noise` (sources measured and judged against the limits).
 
-mod common;
-
+use crate::common;
 use common::cli::{darken, harness};
 
 /// `harness bench --json`: for each scene, backend and pass, the median GPU time and its ratio

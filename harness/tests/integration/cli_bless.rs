@@ -1,8 +1,7 @@
 //! `harness bless`: it rewrites only the named goldens, or only the passes a change reaches,
 //! and refuses without a scene.
 
-mod common;
-
+use crate::common;
 use std::path::{Path, PathBuf};
 
 fn snapshot(dir: &Path) -> std::collections::BTreeMap<PathBuf, (Vec<u8>, std::time::SystemTime)> {

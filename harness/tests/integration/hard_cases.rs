@@ -3,8 +3,7 @@
 //! pass, the light buffer within fp16's safe range, and the case's own check (the lighting pass
 //! against the f64 reference at p99.9 <= 2e-3 where that is defined).
 
-mod common;
-
+use crate::common;
 use harness::measure::hard_cases;
 
 /// Every hard case holds its invariants on every available backend.

@@ -1,8 +1,7 @@
 //! Image-based lighting on every available backend: the white furnace, and renders
 //! that do not depend on the prefilter's sample pattern.
 
-mod common;
-
+use crate::common;
 use std::sync::Arc;
 
 use engine::renderer::{self, Frame, Readback};

@@ -2,8 +2,7 @@
 //! scene whose assets add up past the byte limit are refused with an error naming the file,
 //! before anything is decoded; with the limits off, a scene loads and renders the same.
 
-mod common;
-
+use crate::common;
 use engine::assets::{self, AssetError, ColorSpace, Limits, TextureCache};
 use engine::renderer::{self, Readback};
 

@@ -1,0 +1,32 @@
+//! The harness's integration tests, as one test binary: one link instead of twenty, and one
+//! libtest run whose threads keep both cores busy across what were separate binaries (cargo
+//! runs test binaries one after another, so a binary whose last test runs alone left a core
+//! idle). Each module is the former `tests/<module>.rs`.
+//!
+//! Two suites keep binaries of their own: `tests/golden.rs` (its own runner, one trial per
+//! scene, pass and backend) and `tests/leaks.rs` (it measures the process's memory, which other
+//! tests' allocations would disturb). What the modules share is in `tests/common/`.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod backends;
+mod cli_bless;
+mod cli_check;
+mod cli_inspect;
+mod cli_measure;
+mod cli_render;
+mod cli_workspace;
+mod faults;
+mod hard_cases;
+mod ibl;
+mod layout;
+mod limits;
+mod models;
+mod noise;
+mod plans;
+mod renderer;
+mod report;
+mod selftest;
+mod shadows;
+mod sweeps;
