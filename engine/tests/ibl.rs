@@ -337,3 +337,43 @@ fn an_extracted_sun_travels_with_the_maps_and_through_the_cache() {
     let decoded = ibl::cache::decode(&key, &ibl::cache::encode(&key, &maps)).unwrap();
     assert_eq!(decoded, maps);
 }
+
+/// Threads that ask for the same maps at once (the self-test's scene threads, tests running in
+/// parallel) share one build: one of them builds, the others get the same maps from memory.
+#[test]
+fn concurrent_prepares_of_the_same_maps_build_them_once() {
+    let image = Arc::new(uniform(0.3));
+    let settings = IblSettings {
+        source_size: 64,
+        specular_size: 32,
+        specular_samples: 256,
+        irradiance_size: 8,
+        seed: 11,
+        ..IblSettings::default()
+    };
+    let start = std::sync::Barrier::new(4);
+    let prepared: Vec<_> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..4)
+            .map(|_| {
+                scope.spawn(|| {
+                    start.wait();
+                    ibl::prepare(&image, &settings)
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    let built = prepared
+        .iter()
+        .filter(|(_, source)| matches!(source, MapsSource::Built { .. }))
+        .count();
+    assert_eq!(
+        built,
+        1,
+        "{:?}",
+        prepared.iter().map(|p| &p.1).collect::<Vec<_>>()
+    );
+    assert!(prepared
+        .iter()
+        .all(|(maps, _)| Arc::ptr_eq(maps, &prepared[0].0)));
+}

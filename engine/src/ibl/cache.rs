@@ -122,6 +122,23 @@ pub(super) fn memory_put(key: Key, maps: Arc<IblMaps>) {
     }
 }
 
+/// One lock per key being prepared, so that threads asking for the same maps at once build them
+/// once: the first builds (or reads the disk), the others wait and then find them in memory.
+static PREPARING: Mutex<Vec<(Key, Arc<Mutex<()>>)>> = Mutex::new(Vec::new());
+
+/// The lock [`super::prepare`] holds while it reads or builds `key`'s maps (entries are dropped
+/// once no thread holds or waits for them).
+pub(super) fn preparing(key: &Key) -> Arc<Mutex<()>> {
+    let mut locks = PREPARING.lock().unwrap_or_else(|e| e.into_inner());
+    locks.retain(|(_, lock)| Arc::strong_count(lock) > 1);
+    if let Some((_, lock)) = locks.iter().find(|(k, _)| k == key) {
+        return lock.clone();
+    }
+    let lock = Arc::new(Mutex::new(()));
+    locks.push((*key, lock.clone()));
+    lock
+}
+
 /// Forgets the maps kept in memory (for tests and timing the disk cache).
 pub fn clear_memory() {
     MEMORY.lock().unwrap_or_else(|e| e.into_inner()).clear();

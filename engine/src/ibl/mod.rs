@@ -246,7 +246,8 @@ pub enum MapsSource {
 /// The maps for an environment and settings: from this process's memory, else from the disk
 /// cache set with [`cache::set_directory`], else built (and then stored in both). A disk cache
 /// that cannot be written (full disk, read-only folder) is a warning naming the file, not an
-/// error: the frame renders with the maps just built, and no partial entry is left.
+/// error: the frame renders with the maps just built, and no partial entry is left. Threads
+/// asking for the same maps at once share one build: the others wait for it.
 pub fn prepare(
     image: &Arc<EnvironmentImage>,
     settings: &IblSettings,
@@ -254,6 +255,11 @@ pub fn prepare(
     let key = cache::key_of_shared(image, settings);
     if let Some(maps) = cache::memory_get(&key) {
         return (maps, MapsSource::Memory);
+    }
+    let lock = cache::preparing(&key);
+    let _preparing = lock.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(maps) = cache::memory_get(&key) {
+        return (maps, MapsSource::Memory); // prepared by another thread while this one waited
     }
     let start = Instant::now();
     let directory = cache::directory();
