@@ -377,3 +377,27 @@ fn concurrent_prepares_of_the_same_maps_build_them_once() {
         .iter()
         .all(|(maps, _)| Arc::ptr_eq(maps, &prepared[0].0)));
 }
+
+/// The disk cache's key covers the precompute's code: every source file of engine/src/ibl is in
+/// [`ibl::cache::ALGORITHM_SOURCES`], so an edit to any of them makes every entry miss.
+#[test]
+fn the_cache_key_covers_every_source_file_of_the_precompute() {
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/ibl");
+    let mut files: Vec<String> = std::fs::read_dir(&folder)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|name| name.ends_with(".rs"))
+        .collect();
+    files.sort();
+    let keyed: Vec<&str> = ibl::cache::ALGORITHM_SOURCES
+        .iter()
+        .map(|(name, _)| *name)
+        .collect();
+    assert_eq!(
+        keyed, files,
+        "engine/src/ibl and the cache key's sources differ"
+    );
+    for (name, source) in ibl::cache::ALGORITHM_SOURCES {
+        assert_eq!(std::fs::read_to_string(folder.join(name)).unwrap(), source);
+    }
+}

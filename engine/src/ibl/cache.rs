@@ -1,7 +1,8 @@
 //! Caches of precomputed IBL maps: one in memory per process, and optionally one on disk.
 //!
 //! Disk entries are named by the SHA-256 of the environment's texels, its size, the
-//! [`IblSettings`] and [`FORMAT_VERSION`], so a changed image, setting or algorithm misses. An
+//! [`IblSettings`], [`FORMAT_VERSION`] and the source text of this folder's code (so any edit
+//! to the algorithm misses, without anyone having to remember a version bump). An
 //! entry is written to a temporary file in the same directory and renamed into place, so a
 //! reader never sees half of one. Each entry ends with the SHA-256 of its payload: an entry
 //! that is truncated, corrupt or from another version is rebuilt (with a warning), never
@@ -16,8 +17,22 @@ use sha2::{Digest, Sha256};
 use super::{CubeLevel, CubeMap, IblMaps, IblSettings};
 use crate::scene::EnvironmentImage;
 
-/// Bump when the maps an entry holds would change for the same key (algorithm or layout).
+/// Bump when the entry layout changes (an algorithm change already changes the key through
+/// [`ALGORITHM_SOURCES`]).
 pub const FORMAT_VERSION: u32 = 2;
+
+/// The source of every file of the IBL precompute (this folder), part of every key: the maps
+/// are a function of the image, the settings and this code. A test checks the list covers the
+/// folder.
+pub const ALGORITHM_SOURCES: [(&str, &str); 7] = [
+    ("cache.rs", include_str!("cache.rs")),
+    ("cube.rs", include_str!("cube.rs")),
+    ("dfg.rs", include_str!("dfg.rs")),
+    ("irradiance.rs", include_str!("irradiance.rs")),
+    ("mod.rs", include_str!("mod.rs")),
+    ("specular.rs", include_str!("specular.rs")),
+    ("sun.rs", include_str!("sun.rs")),
+];
 
 const MAGIC: &[u8; 8] = b"IBLMAPS\0";
 
@@ -59,6 +74,10 @@ pub fn key(image: &EnvironmentImage, settings: &IblSettings) -> Key {
     let mut hash = Sha256::new();
     hash.update(MAGIC);
     hash.update(FORMAT_VERSION.to_le_bytes());
+    for (name, source) in ALGORITHM_SOURCES {
+        hash.update(name.as_bytes());
+        hash.update(source.as_bytes());
+    }
     hash.update(image.width.to_le_bytes());
     hash.update(image.height.to_le_bytes());
     for texel in &image.texels {
