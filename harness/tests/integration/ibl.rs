@@ -38,6 +38,10 @@ fn covered(frame: &Frame) -> Vec<([f32; 3], f32)> {
 /// split sum's diffuse (1 - E) and specular E add up to 1).
 #[test]
 fn white_lambert_sphere_returns_one() {
+    // The maps come from the IBL caches, keyed by the environment, the settings and the
+    // precompute's source: the same maps, bit for bit, as a fresh build (which the engine's
+    // IBL tests make).
+    harness::use_ibl_cache();
     for kind in common::available_backends() {
         let mut backend = engine::backend::create(kind).unwrap();
         for (name, lighting, specular) in [
@@ -79,6 +83,10 @@ fn white_lambert_sphere_returns_one() {
 /// (below that the DFG table's first texel center, NoV = 1/128, is extrapolated by clamping).
 #[test]
 fn rough_white_metal_returns_its_directional_albedo() {
+    // The maps come from the IBL caches, keyed by the environment, the settings and the
+    // precompute's source: the same maps, bit for bit, as a fresh build (which the engine's
+    // IBL tests make).
+    harness::use_ibl_cache();
     for kind in common::available_backends() {
         let mut backend = engine::backend::create(kind).unwrap();
         let material = Material {
@@ -191,6 +199,10 @@ fn sky_with_sun(towards: glam::DVec3, radius_degrees: f64, radiance: f32) -> Env
 /// under a tenth as bright as the open floor; with `sun_shadow = false` it is as bright.
 #[test]
 fn extracted_sun_casts_a_shadow() {
+    // The maps come from the IBL caches, keyed by the environment, the settings and the
+    // precompute's source: the same maps, bit for bit, as a fresh build (which the engine's
+    // IBL tests make).
+    harness::use_ibl_cache();
     let sun = glam::DVec3::new(0.0, 1.0, 0.15).normalize();
     let mut scene = test_scenes::ibl_furnace(
         128,
@@ -277,6 +289,10 @@ fn extracted_sun_casts_a_shadow() {
 /// nor a miss between pixels; the disc's area is that of the sun's reflection.
 #[test]
 fn extracted_sun_reflects_as_a_disc() {
+    // The maps come from the IBL caches, keyed by the environment, the settings and the
+    // precompute's source: the same maps, bit for bit, as a fresh build (which the engine's
+    // IBL tests make).
+    harness::use_ibl_cache();
     // 20 degrees above the camera's axis: the reflection is where n is 10 degrees up.
     let towards = glam::DVec3::new(0.0, 20f64.to_radians().sin(), 20f64.to_radians().cos());
     let sun_radiance = 2000.0f32;
