@@ -3,9 +3,10 @@
 //! runs test binaries one after another, so a binary whose last test runs alone left a core
 //! idle). Each module is the former `tests/<module>.rs`.
 //!
-//! Two suites keep binaries of their own: `tests/golden.rs` (its own runner, one trial per
-//! scene, pass and backend) and `tests/leaks.rs` (it measures the process's memory, which other
-//! tests' allocations would disturb). What the modules share is in `tests/common/`.
+//! The golden suite keeps a binary of its own, `tests/golden.rs` (its own runner, one trial per
+//! scene, pass and backend). The leak tests measure their process's memory, which other tests'
+//! allocations would disturb, so each runs in a child process (see `leaks`). What the modules
+//! share is in `tests/common/`.
 
 #[path = "../common/mod.rs"]
 mod common;
@@ -21,6 +22,7 @@ mod faults;
 mod hard_cases;
 mod ibl;
 mod layout;
+mod leaks;
 mod limits;
 mod models;
 mod noise;
