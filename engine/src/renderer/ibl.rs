@@ -23,9 +23,7 @@ pub(super) struct IblTextures {
 const FP16_SAFE_MAX: f32 = 65000.0;
 
 fn half_texels(texels: impl Iterator<Item = [f32; 4]>) -> Vec<u16> {
-    texels
-        .flat_map(|t| t.map(|c| half::f16::from_f32(c.clamp(0.0, FP16_SAFE_MAX)).to_bits()))
-        .collect()
+    crate::image::fp16_bits(texels.flatten(), FP16_SAFE_MAX)
 }
 
 fn cube(

@@ -34,14 +34,7 @@ pub(in crate::renderer) fn record(
             TextureFormat::Rgba16Float,
         ),
     )?;
-    let texels: Vec<u16> = image
-        .texels
-        .iter()
-        .flat_map(|t| {
-            t.iter()
-                .map(|&c| half::f16::from_f32(c.clamp(0.0, 65000.0)).to_bits())
-        })
-        .collect();
+    let texels = crate::image::fp16_bits(image.texels.iter().flatten().copied(), 65000.0);
     backend.write_texture(
         texture,
         Subresource::default(),
