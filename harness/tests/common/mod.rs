@@ -77,9 +77,10 @@ pub fn temp_workspace() -> tempfile::TempDir {
 }
 
 /// The `harness` binary as a command that shares this workspace's IBL cache, also when the test
-/// points HARNESS_ROOT at a temporary copy (the maps depend only on the environment image and
-/// the IBL settings; the cache itself is tested in engine/tests/ibl.rs). Without it, every run
-/// in a temporary workspace would precompute the maps again.
+/// points HARNESS_ROOT at a temporary copy (the maps depend only on the environment image, the
+/// IBL settings and the precompute's code; the cache itself is tested in
+/// engine/tests/integration/ibl.rs). Without it, every run in a temporary workspace would
+/// precompute the maps again.
 pub fn harness_command() -> std::process::Command {
     let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_harness"));
     command.env(

@@ -126,7 +126,7 @@ fn rough_white_metal_returns_its_directional_albedo() {
 #[test]
 fn sample_seeds_give_the_same_picture() {
     // Both seeds' maps come from the IBL caches (keyed by the seed among the settings): the
-    // maps themselves are compared freshly built in engine/tests/ibl.rs.
+    // maps themselves are compared freshly built in engine/tests/integration/ibl.rs.
     harness::use_ibl_cache();
     let loaded =
         engine::scene_file::load(&harness::workspace_root().join("scenes/ibl.toml")).unwrap();

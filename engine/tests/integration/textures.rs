@@ -1,8 +1,6 @@
 //! Texture decoding and CPU mip chain correctness.
 
-mod common;
-
-use common::fixture;
+use crate::common::fixture;
 use engine::assets::{generate_mips, generate_mips_f32, load_texture, ColorSpace, TexelFormat};
 
 /// R = 16x + 64y, G = 255 - R, B = 7, A = 255 except (3,3) = 0.

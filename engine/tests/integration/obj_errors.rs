@@ -1,11 +1,10 @@
 //! Bad-input fixtures: each must error (naming file, line and problem) or
 //! load with a warning, and never panic.
 
-mod common;
-
 use std::time::{Duration, Instant};
 
-use common::{fixture, load, load_err};
+use crate::common;
+use crate::common::{fixture, load, load_err};
 
 #[test]
 fn empty_obj() {

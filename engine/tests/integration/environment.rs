@@ -1,8 +1,6 @@
 //! Environment loading: EXR and Radiance `.hdr`.
 
-mod common;
-
-use common::fixture;
+use crate::common::fixture;
 use engine::assets::load_environment;
 
 #[test]

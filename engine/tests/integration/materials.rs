@@ -1,8 +1,6 @@
 //! MTL handling, texture de-duplication and the inspect summary.
 
-mod common;
-
-use common::fixture;
+use crate::common::fixture;
 use engine::assets::{load_obj, ColorSpace, TextureCache};
 
 #[test]

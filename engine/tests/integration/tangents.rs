@@ -1,8 +1,7 @@
 //! Normal and tangent guarantees on small fixture meshes.
 
-mod common;
-
-use common::{check_model, load};
+use crate::common;
+use crate::common::{check_model, load};
 
 #[test]
 fn vertex_is_48_bytes_and_pod() {
