@@ -2,12 +2,14 @@
 //! those the wanted targets depend on are submitted.
 //!
 //! The dependencies come from the recorded passes themselves, not from the plan's declared
-//! reads: a pass writes its attachments, and reads every texture its draws bind. Walking back
+//! reads: a pass writes its attachments, and reads every texture its draws bind and every
+//! attachment it loads rather than clears (the shader mask tests against the geometry pass's
+//! depth, the lighting passes add into the light buffer). Walking back
 //! from the wanted targets, a pass is kept when it writes a target still needed, and then what
 //! it reads is needed too. Every earlier writer of a needed target is kept (also where a later
 //! one clears it), so the kept passes leave the wanted targets exactly as the whole frame would.
 
-use crate::backend::{BindingResource, Handle, RenderPass, Texture};
+use crate::backend::{BindingResource, Handle, LoadOp, RenderPass, Texture};
 
 /// The passes of `passes` (in their order) that the `wanted` targets depend on.
 pub(super) fn needed(passes: Vec<RenderPass>, wanted: &[Handle<Texture>]) -> Vec<RenderPass> {
@@ -37,15 +39,26 @@ fn writes(pass: &RenderPass) -> impl Iterator<Item = Handle<Texture>> + '_ {
     colors.chain(pass.depth_attachment.map(|d| d.texture))
 }
 
-/// The textures a pass's draws sample.
+/// The textures a pass's draws sample, and the attachments it loads.
 fn reads(pass: &RenderPass) -> impl Iterator<Item = Handle<Texture>> + '_ {
-    pass.draws
+    let sampled = pass
+        .draws
         .iter()
         .flat_map(|draw| &draw.bindings)
         .filter_map(|binding| match binding.resource {
             BindingResource::Texture(texture) => Some(texture),
             _ => None,
-        })
+        });
+    let loaded_colors = pass
+        .color_attachments
+        .iter()
+        .filter(|a| a.load == LoadOp::Load)
+        .map(|a| a.texture);
+    let loaded_depth = pass
+        .depth_attachment
+        .filter(|d| d.load == LoadOp::Load)
+        .map(|d| d.texture);
+    sampled.chain(loaded_colors).chain(loaded_depth)
 }
 
 #[cfg(test)]
@@ -59,8 +72,9 @@ mod tests {
         Handle::new(index, 0)
     }
 
-    /// A pass named `name` writing `color` (and `depth`), whose one draw samples `samples`.
-    fn pass(name: &str, color: &[u32], depth: Option<u32>, samples: &[u32]) -> RenderPass {
+    /// A pass named `name` writing `color` (loaded) and `depth` (`(texture, cleared)`), whose one
+    /// draw samples `samples`.
+    fn pass(name: &str, color: &[u32], depth: Option<(u32, bool)>, samples: &[u32]) -> RenderPass {
         RenderPass {
             name: name.to_owned(),
             color_attachments: color
@@ -71,10 +85,14 @@ mod tests {
                     load: LoadOp::Load,
                 })
                 .collect(),
-            depth_attachment: depth.map(|t| DepthAttachment {
+            depth_attachment: depth.map(|(t, cleared)| DepthAttachment {
                 texture: texture(t),
                 subresource: Subresource::default(),
-                load: LoadOp::Clear(1.0),
+                load: if cleared {
+                    LoadOp::Clear(1.0)
+                } else {
+                    LoadOp::Load
+                },
             }),
             viewports: vec![],
             draws: vec![Draw {
@@ -94,17 +112,17 @@ mod tests {
         }
     }
 
-    /// shadow map 1; G-buffer 2 with depth 3; mask 4 (reads depth); skybox and lighting into
-    /// light 5 (lighting reads 1, 2, 4; routed through depth 6); shadow term 7 (reads 1, 2);
-    /// tone mapping into final 8 (reads 5).
+    /// shadow map 1; G-buffer 2 with depth 3; mask 4 (depth-tested against 3, loaded); skybox
+    /// and lighting into light 5 (lighting reads 1, 2, 4; routed through depth 6, cleared);
+    /// shadow term 7 (reads 1, 2, 4); tone mapping into final 8 (reads 5).
     fn frame() -> Vec<RenderPass> {
         vec![
-            pass("shadow", &[], Some(1), &[]),
-            pass("geometry", &[2], Some(3), &[]),
-            pass("mask", &[4], None, &[3]),
+            pass("shadow", &[], Some((1, true)), &[]),
+            pass("geometry", &[2], Some((3, true)), &[]),
+            pass("mask", &[4], Some((3, false)), &[]),
             pass("skybox", &[5], None, &[4]),
-            pass("lighting", &[5], Some(6), &[1, 2, 4]),
-            pass("shadow_term", &[7], None, &[1, 2]),
+            pass("lighting", &[5], Some((6, true)), &[1, 2, 4]),
+            pass("shadow_term", &[7], None, &[1, 2, 4]),
             pass("tonemap", &[8], None, &[5]),
         ]
     }
@@ -129,6 +147,12 @@ mod tests {
     fn a_gbuffer_target_needs_only_the_geometry_pass() {
         assert_eq!(kept(&[2]), ["geometry"]);
         assert_eq!(kept(&[3, 4]), ["geometry", "mask"]);
+    }
+
+    #[test]
+    fn a_loaded_attachment_needs_its_writers() {
+        // The mask alone: its pass loads the geometry pass's depth.
+        assert_eq!(kept(&[4]), ["geometry", "mask"]);
     }
 
     #[test]
