@@ -44,10 +44,11 @@ pub(crate) fn run(
         "rendering {} ({}x{}) on {kind} ...",
         scene.name, scene.quality.width, scene.quality.height
     );
+    // Only the passes the asked-for outputs depend on run (`harness bench` times whole frames).
     let frame = engine::renderer::render(
         backend.as_mut(),
         scene,
-        engine::renderer::Readback::Only(&wanted),
+        engine::renderer::Readback::Needed(&wanted),
     )?;
     let default_dir = default_out_dir()
         .join("render")
