@@ -44,7 +44,8 @@ pub fn precompute(scenes: &[Scene]) -> Vec<Precompute> {
 /// environment.
 fn ibl_precompute(scenes: &[Scene]) -> Vec<Precompute> {
     use engine::ibl;
-    let mut environments: Vec<(&engine::scene::EnvironmentImage, &ibl::IblSettings)> = Vec::new();
+    type Shared = std::sync::Arc<engine::scene::EnvironmentImage>;
+    let mut environments: Vec<(&Shared, &ibl::IblSettings)> = Vec::new();
     for scene in scenes {
         if let Some(environment) = &scene.environment {
             let seen = environments.iter().any(|(image, settings)| {
@@ -79,7 +80,6 @@ fn ibl_precompute(scenes: &[Scene]) -> Vec<Precompute> {
         let name = std::path::Path::new(&image.label)
             .file_name()
             .map_or_else(|| image.label.clone(), |n| n.to_string_lossy().into_owned());
-        let image = image.clone();
         let timed = |f: &mut dyn FnMut()| {
             median(
                 (0..3)
@@ -93,16 +93,16 @@ fn ibl_precompute(scenes: &[Scene]) -> Vec<Precompute> {
             .unwrap_or(0.0)
         };
         let start = Instant::now();
-        let maps = ibl::build(&image, settings);
+        let maps = ibl::build(image, settings);
         out.push(Precompute {
             what: format!("IBL maps of {name}: {}", settings.describe()),
             on: "CPU, built".to_owned(),
             ms: start.elapsed().as_secs_f64() * 1e3,
         });
-        let key = ibl::cache::key(&image, settings);
+        let key = ibl::cache::key(image, settings);
         if ibl::cache::write(cache.path(), &key, &maps).is_ok() {
             let read = timed(&mut || {
-                let key = ibl::cache::key(&image, settings);
+                let key = ibl::cache::key(image, settings);
                 std::hint::black_box(ibl::cache::read(cache.path(), &key));
             });
             out.push(Precompute {
@@ -112,12 +112,11 @@ fn ibl_precompute(scenes: &[Scene]) -> Vec<Precompute> {
                 on: "CPU, new process".to_owned(),
                 ms: read,
             });
-            let shared = std::sync::Arc::new(image);
             let previous = ibl::cache::directory();
             ibl::cache::set_directory(Some(cache.path().to_path_buf()));
-            ibl::prepare(&shared, settings);
+            ibl::prepare(image, settings);
             let again = timed(&mut || {
-                std::hint::black_box(ibl::prepare(&shared, settings));
+                std::hint::black_box(ibl::prepare(image, settings));
             });
             ibl::cache::set_directory(previous);
             out.push(Precompute {
