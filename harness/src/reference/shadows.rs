@@ -6,7 +6,10 @@
 use engine::plan;
 use engine::renderer::Frame;
 use engine::scene::{Light, Scene};
+use engine::Image;
 use glam::DVec3;
+
+use crate::golden::metrics::bitwise_equal;
 
 /// A triangle in camera-relative world space.
 #[derive(Clone, Copy, Debug)]
@@ -226,21 +229,21 @@ pub struct VisibilityError {
     pub false_lit: usize,
 }
 
+/// The G-buffer targets the ray cast reads (`mask_1` only where the plan has it).
+const CAST_INPUTS: [&str; 4] = [
+    plan::GBUFFER_TARGETS[0],
+    plan::GBUFFER_TARGETS[1],
+    "mask",
+    "mask_1",
+];
+
 /// The targets [`visibility_error`] reads for `light`, of those `plan` has: what a render
 /// for it needs to read back (with [`engine::renderer::Readback::Needed`], nothing else runs).
 pub fn visibility_targets(plan: &plan::RenderPlan, light: usize) -> Vec<String> {
-    let term = plan::shadow_term_target_name(light);
-    [
-        term.as_str(),
-        plan::GBUFFER_TARGETS[0],
-        plan::GBUFFER_TARGETS[1],
-        "mask",
-        "mask_1",
-    ]
-    .into_iter()
-    .filter(|name| plan.target(name).is_some())
-    .map(str::to_owned)
-    .collect()
+    std::iter::once(plan::shadow_term_target_name(light))
+        .chain(CAST_INPUTS.map(str::to_owned))
+        .filter(|name| plan.target(name).is_some())
+        .collect()
 }
 
 /// Compares the frame's `shadow_term_<light>` with ray-cast visibility. `epsilon` (meters) moves
@@ -280,17 +283,6 @@ impl<'a> GbufferInputs<'a> {
             mask_1: frame.output("mask_1").and_then(|i| i.as_u8()),
         })
     }
-
-    /// Whether both hold the same values (floats by bit pattern).
-    fn same(&self, other: &GbufferInputs<'_>) -> bool {
-        let bits = |a: &[f32], b: &[f32]| {
-            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
-        };
-        bits(self.position, other.position)
-            && bits(self.normal, other.normal)
-            && self.mask == other.mask
-            && self.mask_1 == other.mask_1
-    }
 }
 
 /// Exact visibility of one light from every covered, light-facing pixel of a frame's G-buffer,
@@ -298,8 +290,8 @@ impl<'a> GbufferInputs<'a> {
 /// G-buffer is the same (a sweep over shadow settings changes no geometry) share one cast.
 pub struct RayCastVisibility {
     light: usize,
-    /// The G-buffer cast from: position, normal, mask, second mask.
-    gbuffer: (Vec<f32>, Vec<f32>, Vec<u8>, Option<Vec<u8>>),
+    /// The G-buffer cast from: [`CAST_INPUTS`], each where the frame had it.
+    gbuffer: Vec<Option<Image>>,
     /// Per pixel: `None` off the lit surface (uncovered, or facing away from the light), else
     /// whether the light is visible.
     visible: Vec<Option<bool>>,
@@ -349,26 +341,20 @@ impl RayCastVisibility {
             .collect();
         Ok(Self {
             light,
-            gbuffer: (
-                position.to_vec(),
-                normal.to_vec(),
-                mask.to_vec(),
-                inputs.mask_1.map(<[u8]>::to_vec),
-            ),
+            gbuffer: CAST_INPUTS.map(|name| frame.output(name).cloned()).into(),
             visible,
         })
     }
 
     /// Whether `frame`'s G-buffer is the one this cast came from, so that it holds for `frame`.
     pub fn holds_for(&self, frame: &Frame) -> bool {
-        let (position, normal, mask, mask_1) = &self.gbuffer;
-        let own = GbufferInputs {
-            position,
-            normal,
-            mask,
-            mask_1: mask_1.as_deref(),
-        };
-        GbufferInputs::of(frame).is_ok_and(|inputs| own.same(&inputs))
+        CAST_INPUTS
+            .iter()
+            .zip(&self.gbuffer)
+            .all(|(name, own)| match (own, frame.output(name)) {
+                (Some(own), Some(theirs)) => bitwise_equal(own, theirs),
+                (own, theirs) => own.is_none() && theirs.is_none(),
+            })
     }
 
     /// `frame`'s shadow term of this light against the cast (the frame must have the same

@@ -6,23 +6,12 @@ use engine::renderer::{self, Frame, Readback};
 use engine::scene::Scene;
 use engine::{Backend, Image};
 use glam::DVec3;
+use harness::golden::metrics::bitwise_equal;
 use harness::{reference, test_scenes};
 
 fn render(backend: &mut dyn Backend, scene: &Scene) -> Frame {
     renderer::render(backend, scene, Readback::All)
         .unwrap_or_else(|e| panic!("{} on {}: {e}", scene.name, backend.kind()))
-}
-
-/// Whether two images hold the same bits (f32 compared by bit pattern: -0 is not 0).
-fn same_bits(a: &Image, b: &Image) -> bool {
-    use engine::image::ImageData;
-    match (&a.data, &b.data) {
-        (ImageData::U8(x), ImageData::U8(y)) => x == y,
-        (ImageData::F32(x), ImageData::F32(y)) => {
-            x.len() == y.len() && x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits())
-        }
-        _ => false,
-    }
 }
 
 fn save(name: &str, image: &Image) {
@@ -443,7 +432,7 @@ fn culled_renders_give_the_whole_frame_s_targets() {
                     .unwrap_or_else(|e| panic!("{name} on {kind}: {e}"));
                 for target in wanted {
                     assert!(
-                        same_bits(&frame.outputs[*target], &whole.outputs[*target]),
+                        bitwise_equal(&frame.outputs[*target], &whole.outputs[*target]),
                         "{name} on {kind}: {target} differs when only {wanted:?} are rendered"
                     );
                 }

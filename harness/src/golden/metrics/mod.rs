@@ -142,8 +142,8 @@ fn values(image: &Image) -> Cow<'_, [f32]> {
 }
 
 /// Whether two images hold the same values bit for bit (float images compared by bit pattern,
-/// so a NaN matches only the same NaN).
-fn bitwise_equal(actual: &Image, golden: &Image) -> bool {
+/// so a NaN matches only the same NaN, and -0 not 0).
+pub fn bitwise_equal(actual: &Image, golden: &Image) -> bool {
     match (&actual.data, &golden.data) {
         (ImageData::U8(a), ImageData::U8(g)) => a == g,
         (ImageData::F32(a), ImageData::F32(g)) => {

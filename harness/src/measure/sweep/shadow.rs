@@ -121,12 +121,12 @@ pub fn shadow_sweep_with(
     };
     let mut backend = backend::create(kind).map_err(|e| SweepError::Render(e.to_string()))?;
     let term_name = plan::shadow_term_target_name(light);
-    let wanted = [
-        term_name.as_str(),
-        plan::GBUFFER_TARGETS[0],
-        plan::GBUFFER_TARGETS[1],
-        "mask",
-    ];
+    // What the ray-cast comparison reads (shadow settings change no target but the maps').
+    let targets = shadows::visibility_targets(
+        &plan::RenderPlan::new(&with_shadow(scene, ShadowFilter::Hard, 512)),
+        light,
+    );
+    let wanted: Vec<&str> = targets.iter().map(String::as_str).collect();
     let readback = match cost {
         ShadowSweepCost::Timed => Readback::Only(&wanted),
         ShadowSweepCost::Untimed => Readback::Needed(&wanted),
