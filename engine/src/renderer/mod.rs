@@ -181,13 +181,16 @@ pub fn render_with_faults(
             names.iter().map(|s| (*s).to_owned()).collect()
         }
     };
-    let cull = matches!(readback, Readback::Needed(_));
+    let wanted = Wanted {
+        names: &wanted,
+        cull: matches!(readback, Readback::Needed(_)),
+    };
     let mut scope = ResourceScope::default();
     let result = record_and_submit(
         backend,
         scene,
         &plan,
-        (&wanted, cull),
+        wanted,
         faults,
         ibl_maps.as_deref(),
         &mut scope,
@@ -233,13 +236,20 @@ impl CameraMatrices {
 
 type Outputs = (BTreeMap<String, Image>, Vec<PassTiming>);
 
-/// Records every pass of `plan` (in [`passes`], one file each), submits them at once (with
-/// `cull`, only those the `wanted` targets depend on) and reads back the `wanted` targets.
+/// The targets a frame reads back, and whether the passes they do not depend on are culled.
+#[derive(Clone, Copy)]
+struct Wanted<'a> {
+    names: &'a [String],
+    cull: bool,
+}
+
+/// Records every pass of `plan` (in [`passes`], one file each), submits them at once (when
+/// `wanted` culls, only those its targets depend on) and reads back the `wanted` targets.
 fn record_and_submit(
     backend: &mut dyn Backend,
     scene: &Scene,
     plan: &RenderPlan,
-    (wanted, cull): (&[String], bool),
+    wanted: Wanted<'_>,
     faults: &Faults,
     ibl_maps: Option<&crate::ibl::IblMaps>,
     scope: &mut ResourceScope,
@@ -273,13 +283,14 @@ fn record_and_submit(
         )?);
     }
 
-    if cull {
-        let targets: Vec<Handle<Texture>> = wanted.iter().map(|name| frame.target(name)).collect();
+    if wanted.cull {
+        let targets: Vec<Handle<Texture>> =
+            wanted.names.iter().map(|name| frame.target(name)).collect();
         passes = cull::needed(passes, &targets);
     }
     let timings = backend.submit(&passes)?;
     let mut outputs = BTreeMap::new();
-    for name in wanted {
+    for name in wanted.names {
         outputs.insert(
             name.clone(),
             backend
