@@ -113,7 +113,13 @@ impl CubeLevel {
 
     /// Bilinear lookup in the face the direction goes through (edges clamp within the face).
     pub fn sample(&self, d: Vec3) -> [f32; 3] {
-        let (face, u, v) = direction_face(d);
+        self.sample_face(direction_face(d))
+    }
+
+    /// Bilinear lookup at face coordinates (from [`direction_face`]): what [`CubeLevel::sample`]
+    /// does after projecting the direction, so that lookups of one direction in several levels
+    /// project it once.
+    fn sample_face(&self, (face, u, v): (usize, f32, f32)) -> [f32; 3] {
         let n = self.size as f32;
         let fx = (u + 1.0) * 0.5 * n - 0.5;
         let fy = (v + 1.0) * 0.5 * n - 0.5;
@@ -170,17 +176,42 @@ impl CubeMap {
 
     /// Trilinear lookup at fractional level `lod` (clamped to the chain).
     pub fn sample_lod(&self, d: Vec3, lod: f32) -> [f32; 3] {
+        self.sample_at(d, self.lod(lod))
+    }
+
+    /// The two levels and the blend between them that a lookup at `lod` reads (clamped to the
+    /// chain): worked out once for a lod that many lookups share.
+    pub fn lod(&self, lod: f32) -> Lod {
         let top = (self.levels.len() - 1) as f32;
         let lod = lod.clamp(0.0, top);
         let lower = floor(lod) as usize;
-        let t = lod - lower as f32;
-        let a = self.levels[lower].sample(d);
-        if t == 0.0 {
+        Lod {
+            lower,
+            upper: (lower + 1).min(self.levels.len() - 1),
+            t: lod - lower as f32,
+        }
+    }
+
+    /// Trilinear lookup at a [`CubeMap::lod`] of this map (the same result as
+    /// [`CubeMap::sample_lod`] at that lod, bit for bit).
+    pub fn sample_at(&self, d: Vec3, lod: Lod) -> [f32; 3] {
+        let at = direction_face(d);
+        let a = self.levels[lod.lower].sample_face(at);
+        if lod.t == 0.0 {
             return a;
         }
-        let b = self.levels[(lower + 1).min(self.levels.len() - 1)].sample(d);
-        [0, 1, 2].map(|c| a[c] + (b[c] - a[c]) * t)
+        let b = self.levels[lod.upper].sample_face(at);
+        [0, 1, 2].map(|c| a[c] + (b[c] - a[c]) * lod.t)
     }
+}
+
+/// Where a trilinear lookup reads a [`CubeMap`]: two adjacent levels and the weight of the upper
+/// one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lod {
+    lower: usize,
+    upper: usize,
+    t: f32,
 }
 
 /// Equirectangular convention shared with `skybox.wgsl`: `u = 0.5 + atan2(d.x, -d.z) / 2pi`,

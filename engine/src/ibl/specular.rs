@@ -13,7 +13,7 @@
 
 use glam::Vec3;
 
-use super::cube::{texel_direction, CubeLevel, CubeMap};
+use super::cube::{texel_direction, CubeLevel, CubeMap, Lod};
 use super::{d_ggx, ggx_half_vector, hammersley, tangent_frame, IblSettings};
 
 /// Krivanek & Colbert's bias added to the source lod (1 in Karis's and their examples).
@@ -55,7 +55,7 @@ pub fn prefilter(source: &CubeMap, settings: &IblSettings) -> CubeMap {
         let roughness = level_roughness(level, levels);
         let alpha = (roughness * roughness).max(1e-4);
         // Tangent-space samples and their source lod, shared by every texel of the level.
-        let samples: Vec<(Vec3, f32, f32)> = (0..n)
+        let samples: Vec<(Vec3, f32, Lod)> = (0..n)
             .filter_map(|i| {
                 let (u1, u2) = hammersley(i, n, settings.seed);
                 let h = ggx_half_vector(u1, u2, alpha);
@@ -68,7 +68,7 @@ pub fn prefilter(source: &CubeMap, settings: &IblSettings) -> CubeMap {
                 let pdf = d_ggx(h.z, alpha) / 4.0;
                 let omega = 1.0 / (n as f32 * pdf);
                 let lod = (0.5 * (omega / texel_omega).log2() + LOD_BIAS).max(0.0);
-                Some((l, n_dot_l, lod))
+                Some((l, n_dot_l, source.lod(lod)))
             })
             .collect();
         let level_size = (size >> level).max(1);
@@ -79,7 +79,7 @@ pub fn prefilter(source: &CubeMap, settings: &IblSettings) -> CubeMap {
             let mut weight = 0.0;
             for &(l, n_dot_l, lod) in &samples {
                 let d = t * l.x + b * l.y + normal * l.z;
-                let c = source.sample_lod(d, lod);
+                let c = source.sample_at(d, lod);
                 for k in 0..3 {
                     sum[k] += c[k] * n_dot_l;
                 }
