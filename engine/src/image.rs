@@ -7,11 +7,28 @@ use crate::backend::desc::TextureFormat;
 /// CPU has it: the same bits as converting one value at a time).
 pub fn fp16_bits(values: impl Iterator<Item = f32>, max: f32) -> Vec<u16> {
     use half::slice::{HalfBitsSliceExt, HalfFloatSliceExt};
-    let clamped: Vec<f32> = values.map(|v| v.clamp(0.0, max)).collect();
-    let mut bits = vec![0u16; clamped.len()];
-    bits.reinterpret_cast_mut::<half::f16>()
-        .convert_from_f32_slice(&clamped);
-    bits
+    /// Values clamped into a buffer on the stack and converted together: no list of the
+    /// clamped values (an environment has millions) is allocated.
+    const CHUNK: usize = 4096;
+    let mut values = values.map(|v| v.clamp(0.0, max));
+    let mut bits = Vec::with_capacity(values.size_hint().0);
+    let mut chunk = [0.0f32; CHUNK];
+    loop {
+        let mut filled = 0;
+        // `zip` asks the chunk for a slot first, so no value is taken once the chunk is full.
+        for (slot, value) in chunk.iter_mut().zip(&mut values) {
+            *slot = value;
+            filled += 1;
+        }
+        let start = bits.len();
+        bits.resize(start + filled, 0u16);
+        bits[start..]
+            .reinterpret_cast_mut::<half::f16>()
+            .convert_from_f32_slice(&chunk[..filled]);
+        if filled < CHUNK {
+            return bits;
+        }
+    }
 }
 
 /// Texel storage: 8-bit formats stay `u8`, everything else (f16 included) is widened to `f32`.
@@ -128,5 +145,11 @@ mod tests {
             .map(|&v| half::f16::from_f32(v.clamp(0.0, 65000.0)).to_bits())
             .collect();
         assert_eq!(fp16_bits(values.iter().copied(), 65000.0), one_at_a_time);
+        // Whole chunks only, and nothing.
+        assert_eq!(
+            fp16_bits(values[..8192].iter().copied(), 65000.0),
+            one_at_a_time[..8192]
+        );
+        assert_eq!(fp16_bits(std::iter::empty(), 65000.0), Vec::<u16>::new());
     }
 }
