@@ -2,15 +2,18 @@
 
 use crate::backend::desc::TextureFormat;
 
-/// `values`, each clamped to `0..=max`, as fp16 bit patterns for an `Rgba16Float` upload: round
-/// to nearest even, converted a slice at a time (F16C, eight values per instruction, where the
-/// CPU has it: the same bits as converting one value at a time).
-pub fn fp16_bits(values: impl Iterator<Item = f32>, max: f32) -> Vec<u16> {
+/// Largest value an `Rgba16Float` upload stores (fp16's largest finite value is 65504).
+pub const FP16_SAFE_MAX: f32 = 65000.0;
+
+/// `values`, each clamped to `0..=FP16_SAFE_MAX`, as fp16 bit patterns for an `Rgba16Float`
+/// upload: round to nearest even, converted a slice at a time (F16C, eight values per
+/// instruction, where the CPU has it: the same bits as converting one value at a time).
+pub fn fp16_bits(values: impl Iterator<Item = f32>) -> Vec<u16> {
     use half::slice::{HalfBitsSliceExt, HalfFloatSliceExt};
     /// Values clamped into a buffer on the stack and converted together: no list of the
     /// clamped values (an environment has millions) is allocated.
     const CHUNK: usize = 4096;
-    let mut values = values.map(|v| v.clamp(0.0, max));
+    let mut values = values.map(|v| v.clamp(0.0, FP16_SAFE_MAX));
     let mut bits = Vec::with_capacity(values.size_hint().0);
     let mut chunk = [0.0f32; CHUNK];
     loop {
@@ -142,14 +145,14 @@ mod tests {
             .collect();
         let one_at_a_time: Vec<u16> = values
             .iter()
-            .map(|&v| half::f16::from_f32(v.clamp(0.0, 65000.0)).to_bits())
+            .map(|&v| half::f16::from_f32(v.clamp(0.0, FP16_SAFE_MAX)).to_bits())
             .collect();
-        assert_eq!(fp16_bits(values.iter().copied(), 65000.0), one_at_a_time);
+        assert_eq!(fp16_bits(values.iter().copied()), one_at_a_time);
         // Whole chunks only, and nothing.
         assert_eq!(
-            fp16_bits(values[..8192].iter().copied(), 65000.0),
+            fp16_bits(values[..8192].iter().copied()),
             one_at_a_time[..8192]
         );
-        assert_eq!(fp16_bits(std::iter::empty(), 65000.0), Vec::<u16>::new());
+        assert_eq!(fp16_bits(std::iter::empty()), Vec::<u16>::new());
     }
 }

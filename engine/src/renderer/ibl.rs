@@ -19,11 +19,8 @@ pub(super) struct IblTextures {
     pub max_lod: f32,
 }
 
-/// Largest value stored (fp16 max is 65504).
-const FP16_SAFE_MAX: f32 = 65000.0;
-
 fn half_texels(texels: impl Iterator<Item = [f32; 4]>) -> Vec<u16> {
-    crate::image::fp16_bits(texels.flatten(), FP16_SAFE_MAX)
+    crate::image::fp16_bits(texels.flatten())
 }
 
 fn cube(

@@ -34,7 +34,7 @@ pub(in crate::renderer) fn record(
             TextureFormat::Rgba16Float,
         ),
     )?;
-    let texels = crate::image::fp16_bits(image.texels.iter().flatten().copied(), 65000.0);
+    let texels = crate::image::fp16_bits(image.texels.iter().flatten().copied());
     backend.write_texture(
         texture,
         Subresource::default(),
