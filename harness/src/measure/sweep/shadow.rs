@@ -127,9 +127,11 @@ pub fn shadow_sweep_with(
         light,
     );
     let wanted: Vec<&str> = targets.iter().map(String::as_str).collect();
-    let readback = match cost {
-        ShadowSweepCost::Timed => Readback::Only(&wanted),
-        ShadowSweepCost::Untimed => Readback::Needed(&wanted),
+    let timed = cost == ShadowSweepCost::Timed;
+    let readback = if timed {
+        Readback::Only(&wanted)
+    } else {
+        Readback::Needed(&wanted)
     };
     let mut render = |scene: &Scene| {
         renderer::render(backend.as_mut(), scene, readback)
@@ -162,10 +164,7 @@ pub fn shadow_sweep_with(
             };
             progress(&format!("{label} at {map_size}"));
             let mutated = with_shadow_samples(scene, filter, map_size, samples);
-            let repeats = match cost {
-                ShadowSweepCost::Timed => repeats.max(1),
-                ShadowSweepCost::Untimed => 1,
-            };
+            let repeats = if timed { repeats.max(1) } else { 1 };
             let frames = (0..repeats)
                 .map(|_| render(&mutated))
                 .collect::<Result<Vec<_>, _>>()?;
@@ -197,8 +196,8 @@ pub fn shadow_sweep_with(
                 filter: label,
                 map_size,
                 fetches: filter.fetches(samples.unwrap_or(64)),
-                shadow_ms: pass_ms(&frames, "shadow_"),
-                lighting_ms: pass_ms(&frames, "lighting_"),
+                shadow_ms: timed.then(|| pass_ms(&frames, "shadow_")).flatten(),
+                lighting_ms: timed.then(|| pass_ms(&frames, "lighting_")).flatten(),
                 misclassified: visibility.fraction,
                 error_vs_soft_reference: soft.map(|s| s.0),
                 soft_reference_p99_max: soft.map(|s| (s.1, s.2)),
@@ -207,10 +206,7 @@ pub fn shadow_sweep_with(
             });
         }
     }
-    if cost == ShadowSweepCost::Untimed {
-        for row in &mut rows {
-            (row.shadow_ms, row.lighting_ms) = (None, None);
-        }
+    if !timed {
         return Ok(rows);
     }
     let points: Vec<(f64, f64)> = rows
