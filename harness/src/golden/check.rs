@@ -139,16 +139,61 @@ pub fn driver_notes(cases: &[Case], store: &GoldenStore, backends: &[BackendRun]
     notes
 }
 
-/// Compares two backends' outputs of one pass.
-pub fn cross_compare(case: &Case, pass: &str, a: &Image, b: &Image) -> Option<(f64, f64, bool)> {
+/// How far two backends' outputs of one pass disagree: the largest channel difference and the
+/// fraction of pixels over 2/255 (8-bit) or 1e-3 relative above a floor of 1e-3 (float). `None`
+/// when the two cannot be compared (sizes or layouts differ).
+pub fn disagreement(a: &Image, b: &Image) -> Option<(f64, f64)> {
     let pair = crate::golden::metrics::Pair::new(a, b).ok()?;
     let fraction = if golden::is_eight_bit(a) {
         pair.fraction_over(2.0 / 255.0, 0, None, Channels::All)
     } else {
         pair.fraction_over(1e-3, 0, Some(1e-3), Channels::All)
     };
-    let within = golden::check(a, Some(b), &case.rules[pass]).passed();
-    Some((pair.max_abs(0, Channels::All), fraction, within))
+    Some((pair.max_abs(0, Channels::All), fraction))
+}
+
+/// Whether two backends' outputs of `pass` are within the pass's tolerance, `b` taken as the
+/// golden.
+pub fn within_tolerance(case: &Case, pass: &str, a: &Image, b: &Image) -> bool {
+    golden::check(a, Some(b), &case.rules[pass]).passed()
+}
+
+/// The pair of backends whose outputs of `scene`'s `pass` disagree most (by fraction over the
+/// threshold, then by the largest difference), with its tolerance verdict. Only that pair is
+/// reported, so `within_tolerance` is called for it alone: the full rule (FLIP, on an 8-bit
+/// pass) costs more than the disagreement figures of every pair together.
+fn worst_pair(
+    scene: &str,
+    pass: &str,
+    outputs: &[(BackendKind, &Image)],
+    within_tolerance: impl Fn(&Image, &Image) -> bool,
+) -> Option<CrossBackend> {
+    let mut worst: Option<(usize, usize, f64, f64)> = None;
+    for (i, (_, a)) in outputs.iter().enumerate() {
+        for (j, (_, b)) in outputs.iter().enumerate().skip(i + 1) {
+            let Some((max_abs, fraction_over)) = disagreement(a, b) else {
+                continue;
+            };
+            if worst.is_none_or(|(_, _, worst_max, worst_fraction)| {
+                fraction_over > worst_fraction
+                    || (fraction_over == worst_fraction && max_abs > worst_max)
+            }) {
+                worst = Some((i, j, max_abs, fraction_over));
+            }
+        }
+    }
+    worst.map(|(i, j, max_abs, fraction_over)| {
+        let ((a, image_a), (b, image_b)) = (outputs[i], outputs[j]);
+        CrossBackend {
+            scene: scene.to_owned(),
+            pass: pass.to_owned(),
+            a: a.name().to_owned(),
+            b: b.name().to_owned(),
+            max_abs,
+            fraction_over,
+            within_tolerance: within_tolerance(image_a, image_b),
+        }
+    })
 }
 
 /// Runs the check on the backends in `only` (every one when empty; an unavailable one is
@@ -251,35 +296,14 @@ pub fn run_with(
             }
             done += 1;
         }
-        let kinds: Vec<&BackendKind> = frames.keys().collect();
         for pass in &case.passes {
-            let mut worst: Option<CrossBackend> = None;
-            for (i, a) in kinds.iter().enumerate() {
-                for b in &kinds[i + 1..] {
-                    let (ia, ib) = (&frames[*a].outputs[pass], &frames[*b].outputs[pass]);
-                    if let Some((max_abs, fraction_over, within)) =
-                        cross_compare(case, pass, ia, ib)
-                    {
-                        let entry = CrossBackend {
-                            scene: case.name().to_owned(),
-                            pass: pass.clone(),
-                            a: a.name().to_owned(),
-                            b: b.name().to_owned(),
-                            max_abs,
-                            fraction_over,
-                            within_tolerance: within,
-                        };
-                        if worst.as_ref().is_none_or(|w| {
-                            entry.fraction_over > w.fraction_over
-                                || (entry.fraction_over == w.fraction_over
-                                    && entry.max_abs > w.max_abs)
-                        }) {
-                            worst = Some(entry);
-                        }
-                    }
-                }
-            }
-            cross.extend(worst);
+            let outputs: Vec<(BackendKind, &Image)> = frames
+                .iter()
+                .map(|(&kind, frame)| (kind, &frame.outputs[pass]))
+                .collect();
+            cross.extend(worst_pair(case.name(), pass, &outputs, |a, b| {
+                within_tolerance(case, pass, a, b)
+            }));
         }
         for (kind, frame) in frames {
             for (pass, image) in frame.outputs {
@@ -304,4 +328,64 @@ pub fn run_with(
         },
         outputs,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use engine::backend::TextureFormat;
+    use engine::image::ImageData;
+    use std::cell::Cell;
+
+    /// A 4x4 8-bit image whose first `changed` pixels are 10/255 brighter.
+    fn image(changed: usize) -> Image {
+        let mut data = vec![100u8; 4 * 4 * 4];
+        for pixel in data.chunks_exact_mut(4).take(changed) {
+            pixel[0] += 10;
+        }
+        Image {
+            width: 4,
+            height: 4,
+            format: TextureFormat::Rgba8UnormSrgb,
+            data: ImageData::U8(data),
+        }
+    }
+
+    #[test]
+    fn the_worst_pair_is_reported_and_only_its_tolerance_is_evaluated() {
+        let (gl, vulkan, wgpu_gl) = (image(0), image(1), image(4));
+        let outputs = [
+            (BackendKind::Gl, &gl),
+            (BackendKind::WgpuVulkan, &vulkan),
+            (BackendKind::WgpuGl, &wgpu_gl),
+        ];
+        let evaluated = Cell::new(0);
+        let worst = worst_pair("s", "final", &outputs, |a, b| {
+            evaluated.set(evaluated.get() + 1);
+            a == &gl && b == &wgpu_gl
+        })
+        .unwrap();
+        assert_eq!((worst.a.as_str(), worst.b.as_str()), ("gl", "wgpu-gl"));
+        assert_eq!(worst.fraction_over, 4.0 / 16.0);
+        assert!((worst.max_abs - 10.0 / 255.0).abs() < 1e-6, "{}", worst.max_abs);
+        assert!(worst.within_tolerance);
+        assert_eq!(evaluated.get(), 1, "the rule ran for a pair not reported");
+    }
+
+    #[test]
+    fn a_tie_in_fraction_goes_to_the_larger_difference() {
+        let mut brighter = image(1);
+        if let ImageData::U8(data) = &mut brighter.data {
+            data[0] += 20;
+        }
+        let (gl, vulkan) = (image(0), image(1));
+        let outputs = [
+            (BackendKind::Gl, &gl),
+            (BackendKind::WgpuVulkan, &vulkan),
+            (BackendKind::WgpuGl, &brighter),
+        ];
+        let worst = worst_pair("s", "final", &outputs, |_, _| false).unwrap();
+        assert_eq!((worst.a.as_str(), worst.b.as_str()), ("gl", "wgpu-gl"));
+        assert!(!worst.within_tolerance);
+    }
 }
