@@ -367,7 +367,11 @@ mod tests {
         .unwrap();
         assert_eq!((worst.a.as_str(), worst.b.as_str()), ("gl", "wgpu-gl"));
         assert_eq!(worst.fraction_over, 4.0 / 16.0);
-        assert!((worst.max_abs - 10.0 / 255.0).abs() < 1e-6, "{}", worst.max_abs);
+        assert!(
+            (worst.max_abs - 10.0 / 255.0).abs() < 1e-6,
+            "{}",
+            worst.max_abs
+        );
         assert!(worst.within_tolerance);
         assert_eq!(evaluated.get(), 1, "the rule ran for a pair not reported");
     }
