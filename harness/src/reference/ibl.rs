@@ -108,10 +108,20 @@ impl<'a> EnvironmentSampler<'a> {
         (u.rem_euclid(1.0), e.y.clamp(-1.0, 1.0).acos() / PI)
     }
 
+    /// The equirectangular coordinates of world direction `d`, for [`Self::radiance_at`] and
+    /// [`Self::pdf_at`] (an estimator needs both for each direction: one projection serves).
+    pub fn coordinates(&self, d: DVec3) -> (f64, f64) {
+        Self::uv(self.world_to_environment(d))
+    }
+
     /// Radiance arriving from world direction `d` (bilinear, as the skybox reads it).
     pub fn radiance(&self, d: DVec3) -> DVec3 {
+        self.radiance_at(self.coordinates(d))
+    }
+
+    /// [`Self::radiance`] at the [`Self::coordinates`] of a direction.
+    pub fn radiance_at(&self, (u, v): (f64, f64)) -> DVec3 {
         let (w, h) = (self.image.width as i64, self.image.height as i64);
-        let (u, v) = Self::uv(self.world_to_environment(d));
         let fx = u * w as f64 - 0.5;
         let fy = v * h as f64 - 0.5;
         let (x0, y0) = (fx.floor(), fy.floor());
@@ -134,8 +144,12 @@ impl<'a> EnvironmentSampler<'a> {
 
     /// Solid-angle density of [`Self::sample`] at world direction `d`.
     pub fn pdf(&self, d: DVec3) -> f64 {
+        self.pdf_at(self.coordinates(d))
+    }
+
+    /// [`Self::pdf`] at the [`Self::coordinates`] of a direction.
+    pub fn pdf_at(&self, (u, v): (f64, f64)) -> f64 {
         let (w, h) = (self.image.width as usize, self.image.height as usize);
-        let (u, v) = Self::uv(self.world_to_environment(d));
         let x = ((u * w as f64) as usize).min(w - 1);
         let y = ((v * h as f64) as usize).min(h - 1);
         let sin_theta = (v * PI).sin().max(1e-9);
@@ -184,13 +198,13 @@ fn frame_of(n: DVec3) -> (DVec3, DVec3) {
     )
 }
 
-/// GGX half-vector sampling of the reflected direction and its solid-angle pdf.
-fn ggx_sample(n: DVec3, v: DVec3, alpha: f64, a: f64, b: f64) -> DVec3 {
+/// GGX half-vector sampling of the reflected direction about `n`, whose tangent frame is
+/// `(t, bt)` ([`frame_of`]).
+fn ggx_sample(n: DVec3, (t, bt): (DVec3, DVec3), v: DVec3, alpha: f64, a: f64, b: f64) -> DVec3 {
     let a2 = alpha * alpha;
     let cos_theta = ((1.0 - a) / (1.0 + (a2 - 1.0) * a)).max(0.0).sqrt();
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
     let phi = 2.0 * PI * b;
-    let (t, bt) = frame_of(n);
     let h = t * (sin_theta * phi.cos()) + bt * (sin_theta * phi.sin()) + n * cos_theta;
     2.0 * v.dot(h) * h - v
 }
@@ -205,10 +219,10 @@ fn ggx_pdf(n: DVec3, v: DVec3, l: DVec3, alpha: f64) -> f64 {
     reference::d_ggx(n_dot_h, alpha) * n_dot_h / (4.0 * v_dot_h)
 }
 
-fn cosine_sample(n: DVec3, a: f64, b: f64) -> DVec3 {
+/// A cosine-weighted direction about `n`, whose tangent frame is `(t, bt)` ([`frame_of`]).
+fn cosine_sample(n: DVec3, (t, bt): (DVec3, DVec3), a: f64, b: f64) -> DVec3 {
     let r = a.sqrt();
     let phi = 2.0 * PI * b;
-    let (t, bt) = frame_of(n);
     t * (r * phi.cos()) + bt * (r * phi.sin()) + n * (1.0 - a).max(0.0).sqrt()
 }
 
@@ -226,10 +240,10 @@ pub fn integrate(
     let coat_alpha = (s.clearcoat_roughness * s.clearcoat_roughness + 0.001).max(1e-3);
     let mut random = Random(seed);
     let strategies = if s.clearcoat > 0.0 { 4 } else { 3 };
-    let pdfs = |l: DVec3| {
+    let pdfs = |l: DVec3, coordinates: (f64, f64)| {
         let cosine = (n.dot(l) / PI).max(0.0);
         [
-            environment.pdf(l),
+            environment.pdf_at(coordinates),
             cosine,
             ggx_pdf(n, v, l, alpha),
             if strategies == 4 {
@@ -246,26 +260,33 @@ pub fn integrate(
     // replicas' spread / sqrt(REPLICAS): an honest error bar for stratified samples.
     let k = strategies as f64;
     let per_replica = (samples_per_strategy / REPLICAS).max(1);
+    // The unshifted set is the same for every replica and strategy: computed once.
+    let unshifted: Vec<(f64, f64)> = (0..per_replica as u64)
+        .map(|i| (radical_inverse(i, 2), radical_inverse(i, 3)))
+        .collect();
+    let frame = frame_of(n);
     let mut replica_estimates = Vec::with_capacity(REPLICAS);
     for _ in 0..REPLICAS {
         let mut replica = DVec3::ZERO;
         for strategy in 0..strategies {
             let shift = (random.next(), random.next(), random.next());
             let mut sum = DVec3::ZERO;
-            for i in 0..per_replica {
+            for (i, &(base_2, base_3)) in unshifted.iter().enumerate() {
                 let a = ((i as f64 + 0.5) / per_replica as f64 + shift.0).fract();
-                let b = (radical_inverse(i as u64, 2) + shift.1).fract();
-                let c = (radical_inverse(i as u64, 3) + shift.2).fract();
+                let b = (base_2 + shift.1).fract();
+                let c = (base_3 + shift.2).fract();
                 let l = match strategy {
                     0 => environment.sample(a, b, c),
-                    1 => cosine_sample(n, b, c),
-                    2 => ggx_sample(n, v, alpha, a, b),
-                    _ => ggx_sample(n, v, coat_alpha, a, b),
+                    1 => cosine_sample(n, frame, b, c),
+                    2 => ggx_sample(n, frame, v, alpha, a, b),
+                    _ => ggx_sample(n, frame, v, coat_alpha, a, b),
                 };
                 if n.dot(l) > 0.0 {
-                    let mixture: f64 = pdfs(l).iter().sum::<f64>() / k;
+                    let coordinates = environment.coordinates(l);
+                    let mixture: f64 = pdfs(l, coordinates).iter().sum::<f64>() / k;
                     if mixture > 0.0 {
-                        sum += reference::pbr(s, v, l) * environment.radiance(l) / mixture;
+                        sum += reference::pbr(s, v, l) * environment.radiance_at(coordinates)
+                            / mixture;
                     }
                 }
             }
