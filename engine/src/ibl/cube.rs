@@ -111,14 +111,8 @@ impl CubeLevel {
         self.texels[face * (n * n) as usize + (y * n + x) as usize]
     }
 
-    /// Bilinear lookup in the face the direction goes through (edges clamp within the face).
-    pub fn sample(&self, d: Vec3) -> [f32; 3] {
-        self.sample_face(direction_face(d))
-    }
-
-    /// Bilinear lookup at face coordinates (from [`direction_face`]): what [`CubeLevel::sample`]
-    /// does after projecting the direction, so that lookups of one direction in several levels
-    /// project it once.
+    /// Bilinear lookup at face coordinates (from [`direction_face`]; edges clamp within the
+    /// face). A lookup of one direction in several levels projects it once.
     fn sample_face(&self, (face, u, v): (usize, f32, f32)) -> [f32; 3] {
         let n = self.size as f32;
         let fx = (u + 1.0) * 0.5 * n - 0.5;
@@ -174,11 +168,6 @@ impl CubeMap {
         Self { levels }
     }
 
-    /// Trilinear lookup at fractional level `lod` (clamped to the chain).
-    pub fn sample_lod(&self, d: Vec3, lod: f32) -> [f32; 3] {
-        self.sample_at(d, self.lod(lod))
-    }
-
     /// The two levels and the blend between them that a lookup at `lod` reads (clamped to the
     /// chain): worked out once for a lod that many lookups share.
     pub fn lod(&self, lod: f32) -> Lod {
@@ -192,8 +181,7 @@ impl CubeMap {
         }
     }
 
-    /// Trilinear lookup at a [`CubeMap::lod`] of this map (the same result as
-    /// [`CubeMap::sample_lod`] at that lod, bit for bit).
+    /// Trilinear lookup of direction `d` at a [`CubeMap::lod`] of this map.
     pub fn sample_at(&self, d: Vec3, lod: Lod) -> [f32; 3] {
         let at = direction_face(d);
         let a = self.levels[lod.lower].sample_face(at);

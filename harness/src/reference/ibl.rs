@@ -108,19 +108,14 @@ impl<'a> EnvironmentSampler<'a> {
         (u.rem_euclid(1.0), e.y.clamp(-1.0, 1.0).acos() / PI)
     }
 
-    /// The equirectangular coordinates of world direction `d`, for [`Self::radiance_at`] and
-    /// [`Self::pdf_at`] (an estimator needs both for each direction: one projection serves).
+    /// The equirectangular coordinates of world direction `d`, for [`Self::radiance`] and
+    /// [`Self::pdf`] (an estimator needs both for each direction: one projection serves).
     pub fn coordinates(&self, d: DVec3) -> (f64, f64) {
         Self::uv(self.world_to_environment(d))
     }
 
-    /// Radiance arriving from world direction `d` (bilinear, as the skybox reads it).
-    pub fn radiance(&self, d: DVec3) -> DVec3 {
-        self.radiance_at(self.coordinates(d))
-    }
-
-    /// [`Self::radiance`] at the [`Self::coordinates`] of a direction.
-    pub fn radiance_at(&self, (u, v): (f64, f64)) -> DVec3 {
+    /// Radiance arriving from the direction at `coordinates` (bilinear, as the skybox reads it).
+    pub fn radiance(&self, (u, v): (f64, f64)) -> DVec3 {
         let (w, h) = (self.image.width as i64, self.image.height as i64);
         let fx = u * w as f64 - 0.5;
         let fy = v * h as f64 - 0.5;
@@ -142,13 +137,8 @@ impl<'a> EnvironmentSampler<'a> {
         out * self.scale
     }
 
-    /// Solid-angle density of [`Self::sample`] at world direction `d`.
-    pub fn pdf(&self, d: DVec3) -> f64 {
-        self.pdf_at(self.coordinates(d))
-    }
-
-    /// [`Self::pdf`] at the [`Self::coordinates`] of a direction.
-    pub fn pdf_at(&self, (u, v): (f64, f64)) -> f64 {
+    /// Solid-angle density of [`Self::sample`] at the direction at `coordinates`.
+    pub fn pdf(&self, (u, v): (f64, f64)) -> f64 {
         let (w, h) = (self.image.width as usize, self.image.height as usize);
         let x = ((u * w as f64) as usize).min(w - 1);
         let y = ((v * h as f64) as usize).min(h - 1);
@@ -243,7 +233,7 @@ pub fn integrate(
     let pdfs = |l: DVec3, coordinates: (f64, f64)| {
         let cosine = (n.dot(l) / PI).max(0.0);
         [
-            environment.pdf_at(coordinates),
+            environment.pdf(coordinates),
             cosine,
             ggx_pdf(n, v, l, alpha),
             if strategies == 4 {
@@ -285,8 +275,8 @@ pub fn integrate(
                     let coordinates = environment.coordinates(l);
                     let mixture: f64 = pdfs(l, coordinates).iter().sum::<f64>() / k;
                     if mixture > 0.0 {
-                        sum += reference::pbr(s, v, l) * environment.radiance_at(coordinates)
-                            / mixture;
+                        sum +=
+                            reference::pbr(s, v, l) * environment.radiance(coordinates) / mixture;
                     }
                 }
             }
