@@ -142,7 +142,7 @@ pub fn driver_notes(cases: &[Case], store: &GoldenStore, backends: &[BackendRun]
 /// How far two backends' outputs of one pass disagree: the largest channel difference and the
 /// fraction of pixels over 2/255 (8-bit) or 1e-3 relative above a floor of 1e-3 (float). `None`
 /// when the two cannot be compared (sizes or layouts differ).
-pub fn disagreement(a: &Image, b: &Image) -> Option<(f64, f64)> {
+fn disagreement(a: &Image, b: &Image) -> Option<(f64, f64)> {
     let pair = crate::golden::metrics::Pair::new(a, b).ok()?;
     let fraction = if golden::is_eight_bit(a) {
         pair.fraction_over(2.0 / 255.0, 0, None, Channels::All)
@@ -152,16 +152,11 @@ pub fn disagreement(a: &Image, b: &Image) -> Option<(f64, f64)> {
     Some((pair.max_abs(0, Channels::All), fraction))
 }
 
-/// Whether two backends' outputs of `pass` are within the pass's tolerance, `b` taken as the
-/// golden.
-pub fn within_tolerance(case: &Case, pass: &str, a: &Image, b: &Image) -> bool {
-    golden::check(a, Some(b), &case.rules[pass]).passed()
-}
-
 /// The pair of backends whose outputs of `scene`'s `pass` disagree most (by fraction over the
 /// threshold, then by the largest difference), with its tolerance verdict. Only that pair is
-/// reported, so `within_tolerance` is called for it alone: the full rule (FLIP, on an 8-bit
-/// pass) costs more than the disagreement figures of every pair together.
+/// reported, so `within_tolerance` (whether `a` passes the pass's rule with `b` as its golden)
+/// is called for it alone: the full rule (FLIP, on an 8-bit pass) costs more than the
+/// disagreement figures of every pair together.
 fn worst_pair(
     scene: &str,
     pass: &str,
@@ -302,7 +297,7 @@ pub fn run_with(
                 .map(|(&kind, frame)| (kind, &frame.outputs[pass]))
                 .collect();
             cross.extend(worst_pair(case.name(), pass, &outputs, |a, b| {
-                within_tolerance(case, pass, a, b)
+                golden::check(a, Some(b), &case.rules[pass]).passed()
             }));
         }
         for (kind, frame) in frames {
