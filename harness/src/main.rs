@@ -170,9 +170,10 @@ enum Command {
         /// Only this backend (repeatable). Default: every available one.
         #[arg(long = "backend")]
         backends: Vec<BackendKind>,
-        /// Frames timed per scene and backend, after one warm-up frame.
-        #[arg(long, default_value_t = 5)]
-        frames: usize,
+        /// Frames timed per scene and backend, after one warm-up frame [default: 5, or 21 per
+        /// variant with --breakdown].
+        #[arg(long)]
+        frames: Option<usize>,
         /// Instead of the scenes, a scaling series: resolution, lights, triangles, shadow-map,
         /// or all (repeatable).
         #[arg(long = "series")]
@@ -180,7 +181,8 @@ enum Command {
         /// Instead of the pass table, where each lighting pass's time goes: its input floor
         /// (reading the G-buffer, no shading), its per-pixel setup, then the time it loses
         /// without IBL, without each light, and (parts of those) without shadow lookups and
-        /// clearcoat; against the pass as it is.
+        /// clearcoat; against the pass as it is. Each variant's time is the lower quartile of
+        /// its frames (gl unless --backend is given).
         #[arg(long, conflicts_with = "series")]
         breakdown: bool,
         /// Where to keep the results (bench.json, bench_series.json) for the check report.
@@ -282,10 +284,13 @@ fn main() -> ExitCode {
             json,
         } => {
             if breakdown {
+                let frames = frames.unwrap_or(harness::measure::bench::BREAKDOWN_FRAMES);
                 cli::bench::breakdown(&scenes, &backends, frames, json)
             } else if series.is_empty() {
+                let frames = frames.unwrap_or(harness::measure::bench::BENCH_FRAMES);
                 cli::bench::pass_table(&scenes, &backends, frames, &out, json)
             } else {
+                let frames = frames.unwrap_or(harness::measure::bench::BENCH_FRAMES);
                 cli::bench::series(&series, &backends, frames, &out, json)
             }
         }

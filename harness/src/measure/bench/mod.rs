@@ -27,12 +27,17 @@ mod tables;
 mod timing;
 
 pub use floors::Floors;
-pub use lighting_breakdown::{breakdown, BreakdownRow, PassBreakdown};
+pub use lighting_breakdown::{
+    breakdown, BreakdownRow, PassBreakdown, BREAKDOWN_FRAMES, BREAKDOWN_PERCENTILE,
+};
 pub use precompute::{precompute, Precompute};
 pub use report::{report_sections, series_svg, BENCH_JSON, SERIES_JSON};
 pub use series::{series, SeriesPoint, SERIES};
 pub use tables::{breakdown_table, series_table, table};
 pub use timing::{bench_scene, pass_time, timed_render, PassBench, SceneBench};
+
+/// Frames timed per scene and backend by `harness bench` and its series unless told otherwise.
+pub const BENCH_FRAMES: usize = 5;
 
 /// Why a benchmark could not run.
 #[derive(Debug, thiserror::Error)]

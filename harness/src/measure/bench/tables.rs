@@ -11,8 +11,9 @@ pub fn breakdown_table(b: &PassBreakdown) -> String {
             .map_or(String::new(), |(v, t)| format!("{:.0}%", 100.0 * v / t))
     };
     let mut out = format!(
-        "{} {} on {} (GPU ms; each part: the pass minus the pass without it)\n",
-        b.scene, b.pass, b.backend
+        "{} {} on {} (GPU ms, lower quartile of {} frames; each part: the pass minus the pass \
+         without it)\n",
+        b.scene, b.pass, b.backend, b.frames
     );
     for row in &b.rows {
         out.push_str(&format!(

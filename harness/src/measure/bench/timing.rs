@@ -8,7 +8,7 @@ use engine::plan::{LightingFeature, PassKind};
 use engine::plan::{PassSpec, RenderPlan};
 use engine::renderer::{self, Faults, Readback};
 use engine::scene::Scene;
-use engine::stats::median;
+use engine::stats::{median, percentile};
 
 use super::{BenchError, Floors};
 
@@ -128,13 +128,24 @@ pub(super) fn median_pass_ms(
     timings: &[Vec<backend::PassTiming>],
     name: &str,
 ) -> Option<f64> {
+    percentile_pass_ms(plan, timings, name, 0.5)
+}
+
+/// The `p` percentile (nearest rank) over frames of plan pass `name`'s GPU ms.
+pub(super) fn percentile_pass_ms(
+    plan: &RenderPlan,
+    timings: &[Vec<backend::PassTiming>],
+    name: &str,
+    p: f64,
+) -> Option<f64> {
     let spec = plan.passes.iter().find(|p| p.name == name)?;
-    median(
+    percentile(
         timings
             .iter()
             .filter_map(|t| pass_time(t, spec))
             .map(|ns| ns / 1e6)
             .collect(),
+        p,
     )
 }
 
