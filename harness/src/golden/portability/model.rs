@@ -54,7 +54,7 @@ pub fn table(ratios: &[Ratio], sources: &[String]) -> String {
 
 /// The model the measurements give: per scene, pass and metric the largest value per
 /// `<source>/<backend>`, and the limit `margin x max(noise, resolution)`. Scenes of `previous`
-/// that were not measured are kept as they were.
+/// that were not measured are kept as they were, with their known crashes.
 pub fn build_model(
     cases: &[Case],
     measurements: &[Measurement],
@@ -63,20 +63,27 @@ pub fn build_model(
     missed: &[Missed],
     previous: &NoiseModel,
 ) -> NoiseModel {
+    // Keys are `<source>/<backend>/<scene>`: a measured scene's crashes are this run's.
+    let measured = |key: &str| {
+        let scene = key.rsplit('/').next().unwrap_or_default();
+        cases.iter().any(|c| c.name() == scene)
+    };
+    let kept_crashes = previous
+        .known_crashes
+        .iter()
+        .filter(|(key, _)| !measured(key))
+        .map(|(key, why)| (key.clone(), why.clone()));
+    let new_crashes = missed.iter().filter(|m| m.known).map(|m| {
+        (
+            format!("{}/{}/{}", m.source, m.backend, m.scene),
+            m.error.clone(),
+        )
+    });
     let mut model = NoiseModel {
         margin,
         regenerate: REGENERATE.to_owned(),
         sources,
-        known_crashes: missed
-            .iter()
-            .filter(|m| m.known)
-            .map(|m| {
-                (
-                    format!("{}/{}/{}", m.source, m.backend, m.scene),
-                    m.error.clone(),
-                )
-            })
-            .collect(),
+        known_crashes: kept_crashes.chain(new_crashes).collect(),
         scenes: previous.scenes.clone(),
     };
     for case in cases {
@@ -179,4 +186,52 @@ pub struct Ratio {
     pub limit: f64,
     /// value / limit.
     pub ratio: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `harness noise --scene S --write` measures one scene: the other scenes' figures and
+    /// known crashes stay as they were, the measured scene's crashes are this run's.
+    #[test]
+    fn unmeasured_scenes_keep_their_known_crashes() {
+        let why = |text: &str| text.to_owned();
+        let previous = NoiseModel {
+            known_crashes: BTreeMap::from([
+                ("vector-128/wgpu-vulkan/chess".to_owned(), why("old")),
+                ("vector-128/wgpu-vulkan/arrow".to_owned(), why("old")),
+            ]),
+            ..NoiseModel::default()
+        };
+        let missed = [Missed {
+            source: "vector-128".to_owned(),
+            backend: "wgpu-vulkan".to_owned(),
+            scene: "ibl".to_owned(),
+            error: why("new"),
+            known: true,
+        }];
+        // No case measured (as with `--scene ibl`, ibl's case adds its own figures): nothing
+        // of the previous model is lost, and the run's crash is added.
+        let model = build_model(&[], &[], 3.0, BTreeMap::new(), &missed, &previous);
+        assert_eq!(
+            model.known_crashes,
+            BTreeMap::from([
+                ("vector-128/wgpu-vulkan/arrow".to_owned(), why("old")),
+                ("vector-128/wgpu-vulkan/chess".to_owned(), why("old")),
+                ("vector-128/wgpu-vulkan/ibl".to_owned(), why("new")),
+            ])
+        );
+        // Chess measured, and it did not crash this time: its old record goes, arrow's stays.
+        let chess: Vec<Case> = crate::golden::suite::canonical_cases()
+            .unwrap()
+            .into_iter()
+            .filter(|c| c.name() == "chess")
+            .collect();
+        let model = build_model(&chess, &[], 3.0, BTreeMap::new(), &[], &previous);
+        assert_eq!(
+            model.known_crashes,
+            BTreeMap::from([("vector-128/wgpu-vulkan/arrow".to_owned(), why("old"))])
+        );
+    }
 }
