@@ -142,6 +142,45 @@ pub fn load_environment(path: &Path) -> Result<Environment, AssetError> {
     validated(path, w, h, texels)
 }
 
+/// The sizes (width, height) of an environment file's images, from its header alone: every
+/// layer of an EXR, the one image of a Radiance `.hdr`. A load checks its limits with them
+/// before anything is decoded. The format is told by the first bytes, as in
+/// [`load_environment`].
+pub fn environment_sizes(path: &Path) -> Result<Vec<(usize, usize)>, AssetError> {
+    use std::io::BufRead as _;
+    let file = std::fs::File::open(path).map_err(|e| AssetError::io(path, e))?;
+    let mut reader = std::io::BufReader::new(file);
+    let start = reader.fill_buf().map_err(|e| AssetError::io(path, e))?;
+    if start.starts_with(EXR_MAGIC) {
+        let meta = exr::meta::MetaData::read_from_buffered(reader, false).map_err(|source| {
+            AssetError::Exr {
+                path: path.to_owned(),
+                source,
+            }
+        })?;
+        Ok(meta
+            .headers
+            .iter()
+            .map(|h| (h.layer_size.width(), h.layer_size.height()))
+            .collect())
+    } else if start.starts_with(b"#?") {
+        use image::ImageDecoder as _;
+        let decoder = image::codecs::hdr::HdrDecoder::new(reader).map_err(|source| {
+            AssetError::ImageDecode {
+                path: path.to_owned(),
+                source,
+            }
+        })?;
+        let (w, h) = decoder.dimensions();
+        Ok(vec![(w as usize, h as usize)])
+    } else {
+        Err(AssetError::invalid_image(
+            path,
+            "not an OpenEXR or Radiance .hdr file (environments must be one of the two)",
+        ))
+    }
+}
+
 /// Checks an environment's size against [`MAX_ENVIRONMENT_TEXELS`] before decoding.
 fn check_size(path: &Path, w: usize, h: usize) -> Result<(), AssetError> {
     if w == 0 || h == 0 {

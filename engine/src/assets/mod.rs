@@ -36,7 +36,9 @@ mod texture;
 use crate::mesh;
 
 pub use crate::mesh::{Aabb, MeshData, Vertex};
-pub use environment::{load_environment, radiance, Environment, MAX_ENVIRONMENT_TEXELS};
+pub use environment::{
+    environment_sizes, load_environment, radiance, Environment, MAX_ENVIRONMENT_TEXELS,
+};
 pub use error::AssetError;
 pub use limits::{Budget, Limits};
 pub use obj::{load_mtl, load_obj, MaterialData, MaterialMaps, Model};

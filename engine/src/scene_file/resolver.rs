@@ -63,15 +63,10 @@ impl Resolver {
         }
     }
 
-    /// Checks an environment's size from its EXR header and reserves its RGBA32F texels.
+    /// Checks an environment's size from its header (EXR or Radiance `.hdr`) and reserves its
+    /// RGBA32F texels.
     fn reserve_environment(&mut self, path: &Path) -> Result<(), AssetError> {
-        let meta =
-            exr::meta::MetaData::read_from_file(path, false).map_err(|source| AssetError::Exr {
-                path: path.to_owned(),
-                source,
-            })?;
-        for header in &meta.headers {
-            let (w, h) = (header.layer_size.width(), header.layer_size.height());
+        for (w, h) in crate::assets::environment_sizes(path)? {
             let (w, h) = (
                 u32::try_from(w).unwrap_or(u32::MAX),
                 u32::try_from(h).unwrap_or(u32::MAX),

@@ -103,6 +103,40 @@ fn load_error(dir: &Path, name: &str, text: &str) -> SceneFileError {
     scene_file::load(&path).err().unwrap()
 }
 
+/// A scene file may light its scene with a Radiance `.hdr` environment as well as an EXR: its
+/// size is read from the header for the limits, then it loads; above the limits it is refused
+/// naming the file, and a file of neither format is an error naming it.
+#[test]
+fn radiance_hdr_environments_load_from_scene_files() {
+    let temp = tempfile::tempdir().unwrap();
+    let dir = temp.path();
+    std::fs::copy(fixture("sky.hdr"), dir.join("sky.hdr")).unwrap();
+    let path = dir.join("hdr.toml");
+    std::fs::write(
+        &path,
+        format!("{CAMERA}[environment]\npath = \"sky.hdr\"\n"),
+    )
+    .unwrap();
+    let scene = scene_file::load(&path).unwrap().scene;
+    let image = &scene.environment.expect("an environment").image;
+    assert_eq!((image.width, image.height), (8, 4));
+    let small = engine::assets::Limits {
+        max_texture_side: 4,
+        ..engine::assets::Limits::DEFAULT
+    };
+    let e = scene_file::load_with_limits(&path, small)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("sky.hdr") && e.contains('8'), "{e}");
+    std::fs::write(dir.join("sky.hdr"), "P3\n1 1\n255\n0 0 0\n").unwrap();
+    let e = scene_file::load(&path).err().unwrap().to_string();
+    assert!(
+        e.contains("sky.hdr") && e.contains("not an OpenEXR or Radiance .hdr file"),
+        "{e}"
+    );
+}
+
 /// A point light with a VSM shadow filter, which only directional lights have.
 const POINT_LIGHT_WITH_VSM: &str = concat!(
     "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\nradius = 5\n",
