@@ -11,6 +11,9 @@ pub(super) fn line_column(text: &str, offset: usize) -> (usize, usize) {
     (line, column)
 }
 
+/// How a sub-table of the last `[[lights]]` entry starts (`[lights.shadow]`).
+const SUB_TABLE: &str = "[lights.";
+
 /// serde reads a `[[lights]]` table whole before it knows the light's `type`, so an error in one
 /// of its keys is reported at the table's header. When `start` is such a header, this reads the
 /// table again on its own, as the struct of its type, and returns where the key at fault is and
@@ -20,12 +23,16 @@ pub(super) fn light_error(text: &str, start: usize) -> Option<(usize, String)> {
     if !rest.starts_with("[[lights]]") {
         return None;
     }
-    // The table's body: from the line after the header to the next header.
+    // The table's body: from the line after the header to the next header that is not one of
+    // its own sub-tables (`[lights.shadow]`).
     let body_start = start + rest.find('\n')? + 1;
     let body_len = text[body_start..]
         .match_indices('\n')
         .map(|(i, _)| i + 1)
-        .find(|&i| text[body_start + i..].trim_start().starts_with('['))
+        .find(|&i| {
+            let line = text[body_start + i..].trim_start();
+            line.starts_with('[') && !line.starts_with(SUB_TABLE)
+        })
         .unwrap_or(text.len() - body_start);
     let body = &text[body_start..body_start + body_len];
     let kind = toml::from_str::<toml::Table>(body)
@@ -33,7 +40,9 @@ pub(super) fn light_error(text: &str, start: usize) -> Option<(usize, String)> {
         .get("type")?
         .as_str()?
         .to_owned();
-    // The same text without its `type` line (kept as an empty line, so offsets still match).
+    // The same text without its `type` line (kept as an empty line), and its sub-table headers
+    // made the struct's own (`[lights.shadow]` read as `[       shadow]`), so offsets still
+    // match.
     let untyped: String = body
         .split_inclusive('\n')
         .map(|line| {
@@ -44,6 +53,8 @@ pub(super) fn light_error(text: &str, start: usize) -> Option<(usize, String)> {
             if is_type {
                 " ".repeat(line.trim_end_matches('\n').len())
                     + if line.ends_with('\n') { "\n" } else { "" }
+            } else if key.starts_with(SUB_TABLE) {
+                line.replacen(SUB_TABLE, &format!("[{}", " ".repeat(SUB_TABLE.len() - 1)), 1)
             } else {
                 line.to_owned()
             }

@@ -268,6 +268,7 @@ impl Resolver {
             rotation: DQuat::from_euler(EulerRot::ZYX, rz, ry, rx),
             scale,
         };
+        self.check_material_names(&base_name, spec, &parts)?;
         let single = parts.len() == 1;
         let mut objects = Vec::new();
         for (mesh, mtl) in parts.iter() {
@@ -287,6 +288,33 @@ impl Resolver {
             });
         }
         Ok(objects)
+    }
+
+    /// Every `materials.<name>` of an object must name an MTL material one of its meshes uses:
+    /// a misspelt name would otherwise change nothing, silently.
+    fn check_material_names(
+        &self,
+        object: &str,
+        spec: &ObjectSpec,
+        parts: &MeshParts,
+    ) -> Result<(), SceneFileError> {
+        let used: std::collections::BTreeSet<&str> = parts
+            .iter()
+            .filter_map(|(_, mtl)| mtl.as_ref().map(|m| m.name.as_str()))
+            .collect();
+        let Some(unknown) = spec.materials.keys().find(|k| !used.contains(k.as_str())) else {
+            return Ok(());
+        };
+        let known = if used.is_empty() {
+            "it uses none".to_owned()
+        } else {
+            let names: Vec<&str> = used.into_iter().collect();
+            format!("it uses {}", names.join(", "))
+        };
+        Err(self.invalid(format!(
+            "object `{object}`: `materials.{unknown}` names no MTL material of {} ({known})",
+            spec.mesh
+        )))
     }
 
     /// A mesh's material: the defaults, then its MTL material's values and (unless an override

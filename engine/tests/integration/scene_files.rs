@@ -61,6 +61,10 @@ fn errors_in_a_light_name_the_line_of_the_key() {
     let e = light("shadow = { map_sise = 512 }");
     assert!(e.starts_with("dir/bad.toml:9:"), "{e}");
     assert!(e.contains("`map_sise`"), "{e}");
+    // A key in a `[lights.shadow]` sub-table: its own line (9 is the sub-table's header).
+    let e = light("[lights.shadow]\nfilter = \"pcf3\"\nmap_sise = 512");
+    assert!(e.starts_with("dir/bad.toml:11:1:"), "{e}");
+    assert!(e.contains("`map_sise`"), "{e}");
     // The second light, a directional one, with a key only point lights have.
     let e = parse_err(&format!(
         "{CAMERA}\n[[lights]]\ntype = \"directional\"\ndirection = [0, 1, 0]\nradius = 2\n"
@@ -134,6 +138,38 @@ fn radiance_hdr_environments_load_from_scene_files() {
     assert!(
         e.contains("sky.hdr") && e.contains("not an OpenEXR or Radiance .hdr file"),
         "{e}"
+    );
+}
+
+/// An override for an MTL material the object's meshes do not use (a misspelt name) is an error
+/// naming the file, the object and the key, with the names it could have meant.
+#[test]
+fn materials_overrides_must_name_a_material_the_mesh_uses() {
+    let temp = tempfile::tempdir().unwrap();
+    let mesh = fixture("textured.obj");
+    let object = |key: &str| {
+        format!(
+            "{CAMERA}[[objects]]\nname = \"box\"\nmesh = {:?}\nmaterials.{key} = {{ roughness = 0.9 }}\n",
+            mesh.to_str().unwrap()
+        )
+    };
+    let e = load_error(temp.path(), "misspelt.toml", &object("ston")).to_string();
+    assert!(
+        e.contains("misspelt.toml")
+            && e.contains("object `box`")
+            && e.contains("`materials.ston`")
+            && e.contains("it uses brick, stone"),
+        "{e}"
+    );
+    let path = temp.path().join("right.toml");
+    std::fs::write(&path, object("stone")).unwrap();
+    let scene = scene_file::load(&path).unwrap().scene;
+    // Only the stone part takes the override.
+    let roughness: Vec<f32> = scene.objects.iter().map(|o| o.material.roughness).collect();
+    assert_eq!(
+        roughness.iter().filter(|&&r| r == 0.9).count(),
+        1,
+        "{roughness:?}"
     );
 }
 
