@@ -54,7 +54,11 @@ pub(super) fn light_error(text: &str, start: usize) -> Option<(usize, String)> {
                 " ".repeat(line.trim_end_matches('\n').len())
                     + if line.ends_with('\n') { "\n" } else { "" }
             } else if key.starts_with(SUB_TABLE) {
-                line.replacen(SUB_TABLE, &format!("[{}", " ".repeat(SUB_TABLE.len() - 1)), 1)
+                line.replacen(
+                    SUB_TABLE,
+                    &format!("[{}", " ".repeat(SUB_TABLE.len() - 1)),
+                    1,
+                )
             } else {
                 line.to_owned()
             }
