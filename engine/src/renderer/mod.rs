@@ -143,6 +143,22 @@ pub fn render(
     render_with_faults(backend, scene, readback, &Faults::default())
 }
 
+/// The scene as [`render`] draws it: with `[quality.ibl] extract_sun`, the environment's sun
+/// added as a directional light (finding it needs the IBL maps: built, or read from their
+/// caches); otherwise the scene itself. Whatever names a render's passes and targets
+/// (`harness plan`, `harness render --pass`) plans from this, so it lists what the render has.
+pub fn scene_as_drawn(scene: &Scene) -> std::borrow::Cow<'_, Scene> {
+    let maps = scene
+        .environment
+        .as_ref()
+        .filter(|_| scene.quality.ibl.extract_sun)
+        .map(|environment| crate::ibl::prepare(&environment.image, &scene.quality.ibl).0);
+    match crate::ibl::sun::scene_with_sun(scene, maps.as_deref()) {
+        Some(with_sun) => std::borrow::Cow::Owned(with_sun),
+        None => std::borrow::Cow::Borrowed(scene),
+    }
+}
+
 /// [`render`] with deliberate faults injected (see [`Faults`]).
 pub fn render_with_faults(
     backend: &mut dyn Backend,

@@ -83,7 +83,8 @@ pub(crate) fn inspect(path: &Path, json: bool) -> anyhow::Result<ExitCode> {
 pub(crate) fn plan(scene: &str) -> anyhow::Result<ExitCode> {
     harness::load_scene(scene)
         .map(|loaded| {
-            print!("{}", engine::plan::RenderPlan::new(&loaded.scene));
+            let scene = engine::renderer::scene_as_drawn(&loaded.scene);
+            print!("{}", engine::plan::RenderPlan::new(&scene));
             ExitCode::SUCCESS
         })
         .map_err(Into::into)

@@ -18,7 +18,8 @@ pub(crate) fn run(
     let loaded = harness::load_scene(scene)?;
     print_load_warnings(&loaded);
     let scene = &loaded.scene;
-    let plan = engine::plan::RenderPlan::new(scene);
+    // The plan of the scene as drawn: an extracted sun's light and shadow map are outputs too.
+    let plan = engine::plan::RenderPlan::new(&engine::renderer::scene_as_drawn(scene));
     let names: Vec<String> = if passes.is_empty() {
         vec![engine::plan::FINAL.to_owned()]
     } else if passes.iter().any(|p| p == "all") {

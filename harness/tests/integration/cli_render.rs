@@ -96,3 +96,48 @@ fn render_writes_every_pass_of_a_scene_file() {
     assert_eq!(code, 1);
     assert!(stderr.contains("no pass output `shadow`"), "{stderr}");
 }
+
+/// With `[quality.ibl] extract_sun`, the environment's sun is lit as a shadowed directional
+/// light: `harness plan` lists its shadow pass, and `harness render --pass` takes its map as
+/// an output, as the render has them.
+#[test]
+fn plan_and_render_know_the_extracted_sun() {
+    if !common::gl_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/assets");
+    let scene = dir.path().join("sun.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "[camera]\nposition = [0, 2, 4]\ntarget = [0, 0, 0]\n\n\
+             [quality]\nwidth = 64\nheight = 64\n\n[quality.ibl]\nextract_sun = true\n\n\
+             [environment]\npath = {:?}\n\n\
+             [[objects]]\nmesh = \"builtin:sphere\"\n\n\
+             [[objects]]\nmesh = \"builtin:plane\"\nposition = [0, -1, 0]\nscale = 6\n",
+            assets.join("sunset.exr").to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let (code, stdout, stderr) = harness(&["plan", "--scene", scene.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stdout.contains("shadow_0") && stdout.contains("directional"),
+        "{stdout}"
+    );
+    let out = dir.path().join("shadow_0.exr");
+    let (code, stdout, stderr) = harness(&[
+        "render",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--backend",
+        "gl",
+        "--pass",
+        "shadow_0",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    assert!(out.is_file());
+}
