@@ -135,8 +135,11 @@ fn visibility(i: u32, s: Surface, l: vec3<f32>, light: LightData) -> f32 {
     return shadow_visibility(s, l, light);
 }
 
+// A draw's output: non-negative, and at most its share of FP16_SAFE_MAX, so that the pass's
+// additive draws cannot sum past fp16's range to infinity.
 fn finish(radiance: vec3<f32>) -> vec4<f32> {
-    return vec4<f32>(min(max(radiance, vec3<f32>(0.0)), vec3<f32>(FP16_SAFE_MAX)), 1.0);
+    let share = FP16_SAFE_MAX / f32(DRAWS);
+    return vec4<f32>(min(max(radiance, vec3<f32>(0.0)), vec3<f32>(share)), 1.0);
 }
 
 const MODEL_PBR: u32 = 0u;

@@ -52,6 +52,9 @@ override ANISOTROPY: bool = true;
 override POSITION_MODE: u32 = 0u;
 override NORMAL_MODE: u32 = 0u;
 // Cost breakdown (harness bench --breakdown): read the inputs and write their sum, no shading.
+// Draws of this model's pass: they add into the same pixels of the light buffer, so each clamps
+// its output to FP16_SAFE_MAX / DRAWS (see `finish`) and their sum stays finite.
+override DRAWS: u32 = 1u;
 override INPUT_FLOOR: bool = false;
 // Cost breakdown: every variant with a part taken away still reads all the inputs (as the whole
 // pass does), adding them times a uniform zero, so that taking a light away does not also take

@@ -51,6 +51,9 @@ pub struct LightingVariant {
     pub anisotropy: bool,
     /// G-buffer position storage and normal encoding (`POSITION_MODE`, `NORMAL_MODE`).
     pub gbuffer: GbufferSettings,
+    /// Draws of the model's pass (`DRAWS`). They add into the same pixels, so each clamps its
+    /// output to the fp16-safe maximum divided by this, and their sum stays finite.
+    pub draws: u32,
     /// The cost breakdown's input floor: reads the inputs, no shading (`INPUT_FLOOR`).
     pub input_floor: bool,
     /// The cost breakdown's other variants: read every input even where the work left needs
@@ -95,6 +98,7 @@ impl LightingVariant {
             ("ANISOTROPY", flag(self.anisotropy)),
             ("POSITION_MODE", position),
             ("NORMAL_MODE", normal),
+            ("DRAWS", f64::from(self.draws)),
             ("INPUT_FLOOR", flag(self.input_floor)),
             ("KEEP_INPUTS", flag(self.keep_inputs)),
         ]
@@ -280,6 +284,11 @@ pub(super) fn lighting_passes(
                     && materials().any(|m| m.clearcoat != 0.0 || m.clearcoat_map.is_some()),
                 anisotropy: pbr && materials().any(|m| m.anisotropy != 0.0),
                 gbuffer: scene.quality.gbuffer,
+                draws: if model == LightingModel::Unlit {
+                    1
+                } else {
+                    u32::try_from(batches.len()).unwrap_or(u32::MAX)
+                },
                 input_floor: false,
                 keep_inputs: false,
             };

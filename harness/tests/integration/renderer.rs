@@ -201,6 +201,39 @@ fn sixty_four_point_lights() {
     }
 }
 
+/// Lights too bright for fp16, in more than one draw (17 lights: 16 to a draw): each draw
+/// clamps its output to its share of the fp16-safe maximum, so their sum in the light buffer
+/// stays at most 65000. With each draw clamping at 65000 the sum went past it: llvmpipe's blend
+/// saturated at 65504, fp16's largest value; IEEE rounding of the sum gives infinity.
+#[test]
+fn additive_draws_of_overbright_lights_stay_finite() {
+    let mut scene = test_scenes::many_point_lights(64, 17);
+    for light in &mut scene.lights {
+        if let engine::scene::Light::Point { intensity, .. } = light {
+            *intensity = 1e9;
+        }
+    }
+    let plan = engine::plan::RenderPlan::new(&scene);
+    let draws = plan.lighting_draws(engine::scene::LightingModel::Pbr);
+    assert_eq!(draws.len(), 2);
+    assert!(draws.iter().all(|d| d.variant.draws == 2));
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        let frame = renderer::render(backend.as_mut(), &scene, Readback::Only(&["light"]))
+            .unwrap_or_else(|e| panic!("{kind}: {e}"));
+        let light = frame.output("light").unwrap().as_f32().unwrap();
+        let largest = light
+            .iter()
+            .fold(0.0f32, |m, &v| if v > m || v.is_nan() { v } else { m });
+        assert!(
+            largest.is_finite() && largest <= 65000.0,
+            "{kind}: {largest}"
+        );
+        // Both draws reached their cap somewhere: the sum is at the fp16-safe maximum.
+        assert!(largest >= 64000.0, "{kind}: {largest}");
+    }
+}
+
 /// Same scene, same backend: identical outputs, every target.
 #[test]
 fn renders_are_deterministic() {
