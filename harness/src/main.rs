@@ -116,8 +116,8 @@ enum Command {
         #[arg(long)]
         scene: String,
     },
-    /// Load an OBJ, MTL, scene file (.toml), EXR or PNG and report what was loaded; exit 1 if it
-    /// does not load.
+    /// Load an OBJ, MTL, scene file (.toml), environment (EXR, .hdr) or texture (PNG, JPEG, TGA,
+    /// BMP) and report what was loaded; exit 1 if it does not load.
     Inspect {
         /// The file.
         path: PathBuf,

@@ -46,7 +46,7 @@ pub fn settings_problem(light: &Light) -> Option<String> {
     if s.filter == ShadowFilter::Vsm {
         if matches!(light, Light::Point { .. }) {
             return Some(
-                "filter `vsm` is for directional lights; point lights take hard, pcf3 or soft"
+                "filter `vsm` is for directional lights; point lights take every other filter"
                     .to_owned(),
             );
         }

@@ -79,7 +79,7 @@ pub struct QualitySpec {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EnvironmentSpec {
-    /// Equirectangular EXR, relative to the scene file.
+    /// Equirectangular EXR or Radiance `.hdr`, relative to the scene file.
     pub path: PathBuf,
     /// Rotation about +Y in degrees.
     #[serde(default)]
