@@ -156,6 +156,10 @@ enum Command {
         /// rotation and intensity: the IBL sweep under another sky.
         #[arg(long)]
         environment: Option<PathBuf>,
+        /// Where to keep the results (sweep_<scene>_<knob>.json) for the check report (a
+        /// `harness check` with the same --out shows them).
+        #[arg(long, default_value_os_t = default_out_dir())]
+        out: PathBuf,
         /// Print JSON.
         #[arg(long)]
         json: bool,
@@ -265,6 +269,7 @@ fn main() -> ExitCode {
             backend,
             repeats,
             environment,
+            out,
             json,
         } => cli::sweep::run(
             &scene,
@@ -272,6 +277,7 @@ fn main() -> ExitCode {
             backend,
             repeats,
             environment.as_deref(),
+            &out,
             json,
         ),
         Command::Bench {

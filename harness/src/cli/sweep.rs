@@ -6,8 +6,6 @@ use std::process::ExitCode;
 
 use engine::backend::BackendKind;
 
-use super::default_out_dir;
-
 /// Sweeps `knob` over its settings on `scene` (lit by `environment` when one is given) and
 /// prints the table (or JSON); an unknown knob is an error.
 pub(crate) fn run(
@@ -16,6 +14,7 @@ pub(crate) fn run(
     kind: BackendKind,
     repeats: usize,
     environment: Option<&Path>,
+    out: &Path,
     json: bool,
 ) -> anyhow::Result<ExitCode> {
     let mut loaded = harness::load_scene(scene)?;
@@ -27,7 +26,7 @@ pub(crate) fn run(
             eprintln!("  {what} ...");
         })?;
         let text = serde_json::to_string_pretty(&rows)?;
-        save_sweep(&loaded.scene.name, "ibl", &text);
+        save_sweep(out, &loaded.scene.name, "ibl", &text);
         if json {
             println!("{text}");
         } else {
@@ -46,7 +45,7 @@ pub(crate) fn run(
             eprintln!("  {what} ...");
         })?;
         let text = serde_json::to_string_pretty(&rows)?;
-        save_sweep(&loaded.scene.name, "gbuffer", &text);
+        save_sweep(out, &loaded.scene.name, "gbuffer", &text);
         if json {
             println!("{text}");
         } else {
@@ -65,7 +64,7 @@ pub(crate) fn run(
         eprintln!("  {what} ...");
     })?;
     let text = serde_json::to_string_pretty(&rows)?;
-    save_sweep(&loaded.scene.name, "shadow", &text);
+    save_sweep(out, &loaded.scene.name, "shadow", &text);
     if json {
         println!("{text}");
     } else {
@@ -105,11 +104,11 @@ fn replace_environment(scene: &mut engine::scene::Scene, path: &Path) -> anyhow:
     Ok(())
 }
 
-/// Keeps a sweep's results (target/harness/sweep_<scene>_<knob>.json) for the check report; a
-/// failure to write them is a warning.
-fn save_sweep(scene: &str, knob: &str, json: &str) {
-    let path = default_out_dir().join(harness::measure::sweep::result_file(scene, knob));
-    let written = std::fs::create_dir_all(default_out_dir())
+/// Keeps a sweep's results (`out`/sweep_<scene>_<knob>.json, target/harness by default) for the
+/// check report; a failure to write them is a warning.
+fn save_sweep(out: &Path, scene: &str, knob: &str, json: &str) {
+    let path = out.join(harness::measure::sweep::result_file(scene, knob));
+    let written = std::fs::create_dir_all(out)
         .map_err(|e| e.to_string())
         .and_then(|_| {
             harness::images::write_atomically(&path, json.as_bytes()).map_err(|e| e.to_string())

@@ -1,5 +1,6 @@
-//! `harness bench` (pass times, their ratio to the floor, the lighting breakdown) and
-//! `harness noise` (sources measured and judged against the limits).
+//! `harness bench` (pass times, their ratio to the floor, the lighting breakdown), `harness
+//! sweep`'s results kept where `--out` says, and `harness noise` (sources measured and judged
+//! against the limits).
 
 use crate::common;
 use common::cli::{darken, harness};
@@ -56,6 +57,41 @@ fn bench_json_gives_each_pass_its_time_and_ratio_to_the_floor() {
     }
     assert!(json["precompute"][0]["ms"].as_f64().unwrap() >= 0.0);
     assert!(dir.path().join("bench.json").is_file());
+}
+
+/// `harness sweep --out DIR` keeps its results in DIR, where `harness check --out DIR` finds
+/// them for the report (a small scene file's G-buffer sweep: 64x64, one render per setting).
+#[test]
+fn sweep_keeps_its_results_where_out_says() {
+    if !common::gl_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("tiny.toml");
+    std::fs::write(
+        &scene,
+        "[camera]\nposition = [0, 2, 4]\ntarget = [0, 0, 0]\n\n[quality]\nwidth = 64\n\
+         height = 64\n\n[[objects]]\nmesh = \"builtin:sphere\"\n\n[[lights]]\n\
+         type = \"directional\"\ndirection = [0.3, 1, 0.2]\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let (code, stdout, stderr) = harness(&[
+        "sweep",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--knob",
+        "gbuffer",
+        "--repeats",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    let kept = out.join("sweep_tiny_gbuffer.json");
+    let text = std::fs::read_to_string(&kept).unwrap_or_else(|e| panic!("{kept:?}: {e}"));
+    serde_json::from_str::<serde_json::Value>(&text).unwrap();
+    assert!(stderr.contains(kept.to_str().unwrap()), "{stderr}");
 }
 
 /// `harness bench --breakdown --json`: a row per part of each lighting pass (input floor,
