@@ -185,8 +185,9 @@ enum Command {
         /// Instead of the pass table, where each lighting pass's time goes: its input floor
         /// (reading the G-buffer, no shading), its per-pixel setup, then the time it loses
         /// without IBL, without each light, and (parts of those) without shadow lookups and
-        /// clearcoat; against the pass as it is. Each variant's time is the lower quartile of
-        /// its frames (gl unless --backend is given).
+        /// clearcoat (each from a baseline that re-reads its inputs as the variants do, and a row
+        /// taking that re-read away); against the pass as it is. Each variant's time is the
+        /// lower quartile of its frames (gl unless --backend is given).
         #[arg(long, conflicts_with = "series")]
         breakdown: bool,
         /// Where to keep the results (bench.json, bench_series.json) for the check report.

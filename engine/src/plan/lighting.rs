@@ -233,6 +233,10 @@ pub enum LightingFeature {
     Lighting,
     /// Every light, IBL kept.
     Lights,
+    /// Nothing: the pass as it is, except that every draw also re-reads its inputs
+    /// (`KEEP_INPUTS`) as the variants with a part taken away do. The baseline of their
+    /// differences, so that a re-read the compiler does not merge away is not counted as a part.
+    KeptInputs,
 }
 
 /// The draws of each lighting model: unshadowed lights 16 to a draw, then one draw per shadowed
@@ -401,6 +405,7 @@ impl RenderPlan {
                         draw.lights.clear();
                         draw.shadowed = None;
                     }
+                    LightingFeature::KeptInputs => {}
                 }
                 draw.variant.keep_inputs = feature != LightingFeature::Shading;
                 if pass.model != LightingModel::Unlit {

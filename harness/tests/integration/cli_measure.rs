@@ -140,6 +140,7 @@ fn bench_breakdown_lists_the_parts_of_each_lighting_pass() {
             ]
             .into_iter()
             .chain((pass["pass"] == "lighting_pbr").then_some("  of which clearcoat"))
+            .chain(["less the variants' re-read of the inputs"])
             .collect::<Vec<_>>(),
             "{pass}"
         );

@@ -11,7 +11,7 @@ pub fn breakdown_table(b: &PassBreakdown) -> String {
             .map_or(String::new(), |(v, t)| format!("{:.0}%", 100.0 * v / t))
     };
     let mut out = format!(
-        "{} {} on {} (GPU ms, lower quartile of {} frames; each part: the pass minus the pass \
+        "{} {} on {} (GPU ms, lower quartile of {} frames; each part: what the pass loses \
          without it)\n",
         b.scene, b.pass, b.backend, b.frames
     );
