@@ -125,19 +125,33 @@ fn check_dwa_blocks(path: &Path, bytes: &[u8]) -> Result<(), AssetError> {
 /// The first bytes of an OpenEXR file.
 const EXR_MAGIC: &[u8] = &[0x76, 0x2f, 0x31, 0x01];
 
+/// The two environment formats.
+enum Format {
+    Exr,
+    Radiance,
+}
+
+/// An environment file's format, told by its first bytes (not its name).
+fn format(path: &Path, start: &[u8]) -> Result<Format, AssetError> {
+    if start.starts_with(EXR_MAGIC) {
+        Ok(Format::Exr)
+    } else if start.starts_with(b"#?") {
+        Ok(Format::Radiance)
+    } else {
+        Err(AssetError::invalid_image(
+            path,
+            "not an OpenEXR or Radiance .hdr file (environments must be one of the two)",
+        ))
+    }
+}
+
 /// Loads an EXR or Radiance `.hdr` environment map; rejects missing/corrupt files, other
 /// formats, zero or oversized images and any non-finite texel (naming the first bad pixel).
 pub fn load_environment(path: &Path) -> Result<Environment, AssetError> {
     let bytes = std::fs::read(path).map_err(|e| AssetError::io(path, e))?;
-    let (w, h, texels) = if bytes.starts_with(EXR_MAGIC) {
-        decode_exr(path, &bytes)?
-    } else if bytes.starts_with(b"#?") {
-        decode_radiance(path, &bytes)?
-    } else {
-        return Err(AssetError::invalid_image(
-            path,
-            "not an OpenEXR or Radiance .hdr file (environments must be one of the two)",
-        ));
+    let (w, h, texels) = match format(path, &bytes)? {
+        Format::Exr => decode_exr(path, &bytes)?,
+        Format::Radiance => decode_radiance(path, &bytes)?,
     };
     validated(path, w, h, texels)
 }
@@ -151,33 +165,32 @@ pub fn environment_sizes(path: &Path) -> Result<Vec<(usize, usize)>, AssetError>
     let file = std::fs::File::open(path).map_err(|e| AssetError::io(path, e))?;
     let mut reader = std::io::BufReader::new(file);
     let start = reader.fill_buf().map_err(|e| AssetError::io(path, e))?;
-    if start.starts_with(EXR_MAGIC) {
-        let meta = exr::meta::MetaData::read_from_buffered(reader, false).map_err(|source| {
-            AssetError::Exr {
-                path: path.to_owned(),
-                source,
-            }
-        })?;
-        Ok(meta
-            .headers
-            .iter()
-            .map(|h| (h.layer_size.width(), h.layer_size.height()))
-            .collect())
-    } else if start.starts_with(b"#?") {
-        use image::ImageDecoder as _;
-        let decoder = image::codecs::hdr::HdrDecoder::new(reader).map_err(|source| {
-            AssetError::ImageDecode {
-                path: path.to_owned(),
-                source,
-            }
-        })?;
-        let (w, h) = decoder.dimensions();
-        Ok(vec![(w as usize, h as usize)])
-    } else {
-        Err(AssetError::invalid_image(
-            path,
-            "not an OpenEXR or Radiance .hdr file (environments must be one of the two)",
-        ))
+    match format(path, start)? {
+        Format::Exr => {
+            let meta =
+                exr::meta::MetaData::read_from_buffered(reader, false).map_err(|source| {
+                    AssetError::Exr {
+                        path: path.to_owned(),
+                        source,
+                    }
+                })?;
+            Ok(meta
+                .headers
+                .iter()
+                .map(|h| (h.layer_size.width(), h.layer_size.height()))
+                .collect())
+        }
+        Format::Radiance => {
+            use image::ImageDecoder as _;
+            let decoder = image::codecs::hdr::HdrDecoder::new(reader).map_err(|source| {
+                AssetError::ImageDecode {
+                    path: path.to_owned(),
+                    source,
+                }
+            })?;
+            let (w, h) = decoder.dimensions();
+            Ok(vec![(w as usize, h as usize)])
+        }
     }
 }
 

@@ -17,7 +17,7 @@ use super::BenchError;
 
 /// The percentile of each variant's frames that stands for its time: the lower quartile (see
 /// the module docs).
-pub const BREAKDOWN_PERCENTILE: f64 = 0.25;
+const BREAKDOWN_PERCENTILE: f64 = 0.25;
 
 /// Frames per variant of `harness bench --breakdown` unless told otherwise: enough for a lower
 /// quartile over several frames of each cluster.

@@ -27,9 +27,7 @@ mod tables;
 mod timing;
 
 pub use floors::Floors;
-pub use lighting_breakdown::{
-    breakdown, BreakdownRow, PassBreakdown, BREAKDOWN_FRAMES, BREAKDOWN_PERCENTILE,
-};
+pub use lighting_breakdown::{breakdown, BreakdownRow, PassBreakdown, BREAKDOWN_FRAMES};
 pub use precompute::{precompute, Precompute};
 pub use report::{report_sections, series_svg, BENCH_JSON, SERIES_JSON};
 pub use series::{series, SeriesPoint, SERIES};
