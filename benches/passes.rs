@@ -15,25 +15,21 @@ use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode};
 use engine::backend::{self, Backend, BackendKind};
-use engine::plan::RenderPlan;
+use engine::plan::PassId;
+use engine::renderer::PreparedFrame;
 use engine::scene::Scene;
-use harness::measure::bench::{pass_time, Floors};
+use harness::measure::bench::Floors;
 
 /// GPU time of plan pass `pass` (every pass when `None`) in one render of `scene` (wall time
 /// of the render when the backend has no timestamps).
 fn timed_render(
     backend: &mut dyn Backend,
-    scene: &Scene,
-    plan: &RenderPlan,
-    pass: Option<&str>,
+    scene: &PreparedFrame,
+    pass: Option<PassId>,
 ) -> Duration {
     harness::measure::bench::timed_render(backend, scene, |timings| match pass {
-        Some(name) => plan
-            .passes
-            .iter()
-            .find(|p| p.name == name)
-            .and_then(|spec| pass_time(timings, spec)),
-        None => timings.iter().map(|t| t.gpu_ns).sum(),
+        Some(pass) => timings.pass_time(pass),
+        None => timings.total(),
     })
 }
 
@@ -55,8 +51,9 @@ fn passes(c: &mut Criterion) {
             eprintln!("{kind}: no GPU timestamps; timing by wall clock");
         }
         for scene in &scenes {
-            let plan = RenderPlan::new(scene);
-            let floors = Floors::new(backend.as_mut(), &plan).expect("floor passes");
+            let prepared = PreparedFrame::new(scene).expect("canonical scene renders");
+            let plan = prepared.plan();
+            let floors = Floors::new(backend.as_mut(), plan).expect("floor passes");
             let mut group = c.benchmark_group(format!("{}/{kind}", scene.name));
             group.sampling_mode(SamplingMode::Flat);
             group.sample_size(10);
@@ -65,26 +62,26 @@ fn passes(c: &mut Criterion) {
             group.bench_function("frame", |b| {
                 b.iter_custom(|iters| {
                     (0..iters)
-                        .map(|_| timed_render(backend.as_mut(), scene, &plan, None))
+                        .map(|_| timed_render(backend.as_mut(), &prepared, None))
                         .sum()
                 })
             });
             for spec in &plan.passes {
-                group.bench_function(BenchmarkId::new(&spec.name, "pass"), |b| {
+                let name = spec.id.to_string();
+                group.bench_function(BenchmarkId::new(&name, "pass"), |b| {
                     b.iter_custom(|iters| {
                         (0..iters)
-                            .map(|_| timed_render(backend.as_mut(), scene, &plan, Some(&spec.name)))
+                            .map(|_| timed_render(backend.as_mut(), &prepared, Some(spec.id)))
                             .sum()
                     })
                 });
-                group.bench_function(BenchmarkId::new(&spec.name, "floor"), |b| {
+                group.bench_function(BenchmarkId::new(&name, "floor"), |b| {
                     b.iter_custom(|iters| {
                         (0..iters)
                             .map(|_| {
                                 let start = Instant::now();
-                                let ns = floors
-                                    .time(backend.as_mut(), &spec.name)
-                                    .expect("floor pass");
+                                let ns =
+                                    floors.time(backend.as_mut(), spec.id).expect("floor pass");
                                 ns.map_or(start.elapsed(), |ns| Duration::from_nanos(ns as u64))
                             })
                             .sum()

@@ -19,18 +19,38 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode};
 use engine::backend::{self, Backend, BackendKind};
+use engine::plan::PassId;
+use engine::renderer::PreparedFrame;
 use engine::scene::{Light, PointShadowPass, Scene, ShadowFilter};
 
-/// GPU time of the passes whose names start with one of `prefixes` in one render of `scene`
-/// (wall time of the render where the backend has no timestamps).
-fn timed_render(backend: &mut dyn Backend, scene: &Scene, prefixes: &[&str]) -> Duration {
+/// GPU time of the passes `of` selects in one render of `scene` (wall time of the render where
+/// the backend has no timestamps).
+fn timed_render(
+    backend: &mut dyn Backend,
+    scene: &PreparedFrame,
+    of: impl Fn(PassId) -> bool,
+) -> Duration {
     harness::measure::bench::timed_render(backend, scene, |timings| {
         timings
+            .passes
             .iter()
-            .filter(|t| prefixes.iter().any(|p| t.name.starts_with(p)))
-            .map(|t| t.gpu_ns)
+            .zip(&timings.owners)
+            .filter(|(_, owner)| owner.is_some_and(&of))
+            .map(|(t, _)| t.gpu_ns)
             .sum()
     })
+}
+
+/// Light 0's shadow map: its caster pass and, with VSM, its blur passes.
+fn shadow_0_map(pass: PassId) -> bool {
+    matches!(
+        pass,
+        PassId::Shadow { light: 0 } | PassId::ShadowBlur { light: 0, .. }
+    )
+}
+
+fn prepared(scene: &Scene) -> PreparedFrame {
+    PreparedFrame::new(scene).unwrap_or_else(|e| panic!("{}: {e}", scene.name))
 }
 
 fn with_filter(scene: &Scene, filter: ShadowFilter) -> Scene {
@@ -74,10 +94,11 @@ fn shadows(c: &mut Criterion) {
         for path in paths {
             let mut scene = arrow.clone();
             scene.quality.point_shadows = path;
+            let scene = prepared(&scene);
             group.bench_function(BenchmarkId::new("shadow_0", path.name()), |b| {
                 b.iter_custom(|iters| {
                     (0..iters)
-                        .map(|_| timed_render(backend.as_mut(), &scene, &["shadow_0"]))
+                        .map(|_| timed_render(backend.as_mut(), &scene, shadow_0_map))
                         .sum()
                 })
             });
@@ -97,14 +118,15 @@ fn shadows(c: &mut Criterion) {
             ShadowFilter::SoftReference,
             ShadowFilter::Vsm,
         ] {
-            let scene = with_filter(&chess, filter);
-            for passes in ["shadow_0_map", "shadow_term_0"] {
-                // `shadow_0` names the map pass and VSM's `shadow_0_blur_*` passes.
-                let prefix = passes.trim_end_matches("_map");
-                group.bench_function(BenchmarkId::new(passes, filter.name()), |b| {
+            let scene = prepared(&with_filter(&chess, filter));
+            let term = |pass| pass == PassId::ShadowTerm { light: 0 };
+            let selections: [(&str, &dyn Fn(PassId) -> bool); 2] =
+                [("shadow_0_map", &shadow_0_map), ("shadow_term_0", &term)];
+            for (label, of) in selections {
+                group.bench_function(BenchmarkId::new(label, filter.name()), |b| {
                     b.iter_custom(|iters| {
                         (0..iters)
-                            .map(|_| timed_render(backend.as_mut(), &scene, &[prefix]))
+                            .map(|_| timed_render(backend.as_mut(), &scene, of))
                             .sum()
                     })
                 });

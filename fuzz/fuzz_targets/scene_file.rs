@@ -35,6 +35,8 @@ fuzz_target!(|data: &[u8]| {
     if let Ok(loaded) = engine::scene_file::load(&path) {
         // A scene that loads must also pass the renderer's checks or fail them cleanly.
         let _ = engine::renderer::validate(&loaded.scene);
-        let _ = engine::plan::RenderPlan::new(&loaded.scene).to_string();
+        if let Ok(frame) = engine::renderer::PreparedFrame::new(&loaded.scene) {
+            let _ = frame.plan().to_string();
+        }
     }
 });

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use engine::assets::{self, ColorSpace, TextureCache};
-use engine::plan::RenderPlan;
+use engine::renderer::PreparedFrame;
 use engine::scene::{Light, Object};
 use engine::scene_file;
 use serde_json::{json, Value};
@@ -144,7 +144,10 @@ fn inspect_scene(path: &Path) -> Result<Value, InspectError> {
         "textures": textures,
         "textures_decoded": loaded.textures_decoded,
         "warnings": loaded.warnings,
-        "plan": RenderPlan::new(scene).to_string(),
+        "plan": match PreparedFrame::new(scene) {
+            Ok(frame) => frame.plan().to_string(),
+            Err(e) => format!("cannot be drawn: {e}"),
+        },
     }))
 }
 

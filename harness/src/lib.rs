@@ -76,6 +76,21 @@ pub fn error_text(error: &(dyn std::error::Error + 'static)) -> String {
     text
 }
 
+/// Identities' names, comma-separated, for messages.
+pub fn names<T: std::fmt::Display>(ids: &[T]) -> String {
+    let names: Vec<String> = ids.iter().map(ToString::to_string).collect();
+    names.join(", ")
+}
+
+/// Serializes a backend as its name, or `-` for none (a source of renders that has no backend
+/// of its own, such as synthetic rounding).
+pub fn backend_or_dash<S: serde::Serializer>(
+    backend: &Option<engine::backend::BackendKind>,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    s.serialize_str(backend.map_or("-", engine::backend::BackendKind::name))
+}
+
 #[cfg(test)]
 mod tests {
     #[test]

@@ -11,7 +11,9 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
 use engine::backend::{self, BackendKind};
+use engine::plan::TargetId;
 use engine::renderer::Frame;
+use harness::golden::bless::{bless_pass, BlessRequest};
 use harness::golden::suite::{self, Case, REFERENCE_BACKEND};
 use harness::golden::{self, GoldenStore};
 use libtest_mimic::{Arguments, Failed, Trial};
@@ -40,7 +42,7 @@ impl Suite {
         cell
     }
 
-    fn run(&self, case_index: usize, pass: &str, kind: BackendKind) -> Result<(), Failed> {
+    fn run(&self, case_index: usize, pass: TargetId, kind: BackendKind) -> Result<(), Failed> {
         let case = &self.cases[case_index];
         let rendered = self.frame(case_index, kind);
         let frame = match rendered.get() {
@@ -48,30 +50,30 @@ impl Suite {
             Some(Err(e)) => return Err(format!("render failed on {kind}: {e}").into()),
             None => return Err("render did not run".into()),
         };
-        let actual = &frame.outputs[pass];
+        let actual = &frame.outputs[&pass];
         if self.update {
             if kind == REFERENCE_BACKEND {
-                let change = suite::bless_change(&self.store, case, pass, actual);
-                if !change.changed {
-                    eprintln!("{}/{pass}: {}; kept", case.name(), change.previous);
-                    return Ok(());
-                }
-                let previous = change.previous;
+                // The same path, and the same words, as `harness bless --scene S`.
                 let driver = backend::create(kind)
                     .map(|b| golden::fingerprint(b.info()))
                     .unwrap_or_default();
-                let path = self
-                    .store
-                    .bless(case.name(), pass, actual, kind.name(), &driver, &previous)
-                    .map_err(|e| Failed::from(e.to_string()))?;
-                eprintln!("blessed {} (vs old: {previous})", path.display());
+                let blessed = bless_pass(
+                    &self.store,
+                    case,
+                    pass,
+                    actual,
+                    (kind, &driver),
+                    BlessRequest::default(),
+                )
+                .map_err(|e| Failed::from(e.to_string()))?;
+                eprintln!("{blessed}");
                 return Ok(());
             }
             // Check the other backends against the reference backend's fresh render.
             let reference = self.frame(case_index, REFERENCE_BACKEND);
             if let Some(Ok(reference)) = reference.get() {
                 let outcome =
-                    golden::check(actual, Some(&reference.outputs[pass]), &case.rules[pass]);
+                    golden::check(actual, Some(&reference.outputs[&pass]), &case.rules[&pass]);
                 return if outcome.passed() {
                     Ok(())
                 } else {
@@ -156,14 +158,13 @@ fn main() {
         failures: Mutex::default(),
     });
     for (index, case) in suite.cases.iter().enumerate() {
-        for pass in &case.passes {
+        for &pass in &case.passes {
             for kind in BackendKind::ALL {
                 let name = format!("{}::{pass}::{kind}", case.name());
                 let is_available = available.contains(&kind);
                 let suite = suite.clone();
-                let pass = pass.clone();
                 trials.push(
-                    Trial::test(name, move || suite.run(index, &pass, kind))
+                    Trial::test(name, move || suite.run(index, pass, kind))
                         .with_ignored_flag(!is_available),
                 );
             }
@@ -190,19 +191,10 @@ fn write_failure_report(suite: &Suite) {
         let Some(index) = suite.cases.iter().position(|c| c.name() == check.scene) else {
             continue;
         };
-        let Ok(kind) = check.backend.parse::<BackendKind>() else {
-            continue;
-        };
+        let kind = check.backend;
         if let Some(Some(Ok(frame))) = frames.get(&(index, kind)).map(|cell| cell.get()) {
             if let Some(image) = frame.outputs.get(&check.pass) {
-                outputs.insert(
-                    (
-                        check.scene.clone(),
-                        check.pass.clone(),
-                        check.backend.clone(),
-                    ),
-                    image.clone(),
-                );
+                outputs.insert((check.scene.clone(), check.pass, kind), image.clone());
             }
         }
     }

@@ -82,7 +82,7 @@ pub enum BackendError {
 pub type Result<T, E = BackendError> = std::result::Result<T, E>;
 
 /// The backends this crate provides.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum BackendKind {
     /// OpenGL 4.6/4.5 core through glow, headless via EGL surfaceless.
     Gl,
@@ -106,9 +106,23 @@ impl BackendKind {
     }
 }
 
+/// In files and JSON a backend is its name (`gl`, `wgpu-vulkan`, `wgpu-gl`).
+impl serde::Serialize for BackendKind {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for BackendKind {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        name.parse().map_err(serde::de::Error::custom)
+    }
+}
+
 impl fmt::Display for BackendKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
+        f.pad(self.name())
     }
 }
 
@@ -128,10 +142,10 @@ impl FromStr for BackendKind {
 }
 
 /// A driver fingerprint: what produced an image. Recorded with goldens and reports.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct DriverInfo {
-    /// Backend name (`gl`, `wgpu-vulkan`, `wgpu-gl`).
-    pub backend: String,
+    /// Backend (its name in JSON: `gl`, `wgpu-vulkan`, `wgpu-gl`).
+    pub backend: BackendKind,
     /// Graphics API (`OpenGL`, `Vulkan`, `OpenGL ES`).
     pub api: String,
     /// API version reported by the driver (e.g. `4.5 (Core Profile) Mesa 22.3.6`).
@@ -153,6 +167,22 @@ pub struct DriverInfo {
 }
 
 impl DriverInfo {
+    /// `backend`'s fingerprint with nothing known yet (every string empty, no timestamps).
+    pub fn new(backend: BackendKind) -> Self {
+        Self {
+            backend,
+            api: String::new(),
+            api_version: String::new(),
+            renderer: String::new(),
+            vendor: String::new(),
+            driver: String::new(),
+            mesa_version: None,
+            llvm_version: None,
+            timestamps: false,
+            env: BTreeMap::new(),
+        }
+    }
+
     /// Fills `mesa_version`, `llvm_version` and `env` from the strings already set.
     pub(crate) fn complete(mut self) -> Self {
         let all = format!("{} {} {}", self.api_version, self.renderer, self.driver);
@@ -416,7 +446,7 @@ mod tests {
         let info = DriverInfo {
             api_version: "4.5 (Core Profile) Mesa 22.3.6".into(),
             renderer: "llvmpipe (LLVM 15.0.6, 256 bits)".into(),
-            ..Default::default()
+            ..DriverInfo::new(BackendKind::Gl)
         }
         .complete();
         assert_eq!(info.mesa_version.as_deref(), Some("22.3.6"));

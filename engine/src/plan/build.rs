@@ -6,15 +6,12 @@ use crate::backend::TextureFormat;
 use crate::scene::{Light, LightingModel, Scene, ShadowFilter, ShadowSettings};
 
 use super::lighting::{lighting_passes, LightingPass};
-use super::target_names::{
-    mask_target_name, shadow_blur_target_name, shadow_moments_target_name, shadow_target_name,
-    shadow_term_target_name, DEPTH, FINAL, GBUFFER_TARGETS, LIGHT, ROUTE,
-};
-use super::{MaskChannel, PassKind, PassSpec, RenderPlan, TargetSpec};
+use super::{BlurAxis, MaskChannel, PassId, PassSpec, RenderPlan, TargetId, TargetSpec};
 
 impl RenderPlan {
-    /// Builds the plan for a scene.
-    pub fn new(scene: &Scene) -> Self {
+    /// Builds the plan for a scene as drawn. Only [`crate::renderer::PreparedFrame`] calls
+    /// this, so that no caller can plan a scene other than the one that renders.
+    pub(crate) fn new(scene: &Scene) -> Self {
         let models = scene.lighting_models();
         let mask_channels = mask_channels(&models);
         let mask_targets = models.len().div_ceil(4);
@@ -28,8 +25,8 @@ impl RenderPlan {
         } = ShadowStage::new(scene, casters);
         targets.extend(shadow_targets);
 
-        let masks: Vec<String> = (0..mask_targets).map(mask_target_name).collect();
-        let gbuffer: Vec<String> = GBUFFER_TARGETS.iter().map(|s| (*s).to_owned()).collect();
+        let masks: Vec<TargetId> = (0..mask_targets).map(TargetId::Mask).collect();
+        let gbuffer = TargetId::GBUFFER;
         let mut passes = shadow_passes;
         passes.push(geometry_pass(scene, &gbuffer));
         passes.push(mask_pass(&models, &masks));
@@ -90,11 +87,11 @@ fn screen_targets(
         "rgb base color, a anisotropy",
         "r metallic, g clearcoat, b clearcoat roughness, a specular exponent",
     ];
-    let mut targets: Vec<TargetSpec> = GBUFFER_TARGETS
-        .iter()
+    let mut targets: Vec<TargetSpec> = TargetId::GBUFFER
+        .into_iter()
         .zip(gbuffer_contents)
-        .map(|(name, contents)| TargetSpec {
-            name: (*name).to_owned(),
+        .map(|(id, contents)| TargetSpec {
+            id,
             format: TextureFormat::Rgba16Float,
             width: scene.quality.width,
             height: scene.quality.height,
@@ -102,7 +99,7 @@ fn screen_targets(
         })
         .collect();
     targets.push(TargetSpec {
-        name: DEPTH.to_owned(),
+        id: TargetId::Depth,
         format: TextureFormat::Depth32Float,
         width: scene.quality.width,
         height: scene.quality.height,
@@ -115,7 +112,7 @@ fn screen_targets(
             .map(|c| format!("{} {}", ["r", "g", "b", "a"][c.channel], c.model))
             .collect();
         targets.push(TargetSpec {
-            name: mask_target_name(index),
+            id: TargetId::Mask(index),
             format: TextureFormat::Rgba8Unorm,
             width: scene.quality.width,
             height: scene.quality.height,
@@ -124,7 +121,7 @@ fn screen_targets(
     }
     if !models.is_empty() {
         targets.push(TargetSpec {
-            name: ROUTE.to_owned(),
+            id: TargetId::Route,
             format: TextureFormat::Depth32Float,
             width: scene.quality.width,
             height: scene.quality.height,
@@ -133,14 +130,14 @@ fn screen_targets(
         });
     }
     targets.push(TargetSpec {
-        name: LIGHT.to_owned(),
+        id: TargetId::Light,
         format: TextureFormat::Rgba16Float,
         width: scene.quality.width,
         height: scene.quality.height,
         contents: format!("exposed radiance (exposure {})", scene.quality.exposure),
     });
     targets.push(TargetSpec {
-        name: FINAL.to_owned(),
+        id: TargetId::Final,
         format: TextureFormat::Rgba8UnormSrgb,
         width: scene.quality.width,
         height: scene.quality.height,
@@ -158,7 +155,7 @@ struct ShadowStage {
     /// The shadowed lights.
     lights: Vec<usize>,
     /// The maps the lighting passes read.
-    maps: Vec<String>,
+    maps: Vec<TargetId>,
 }
 
 impl ShadowStage {
@@ -194,9 +191,9 @@ impl ShadowStage {
         casters: usize,
     ) {
         let n = settings.map_size;
-        let name = shadow_target_name(index);
+        let map = TargetId::Shadow { light: index };
         self.targets.push(TargetSpec {
-            name: name.clone(),
+            id: map,
             format: TextureFormat::Depth32Float,
             width: if point { 3 * n } else { n },
             height: if point { 2 * n } else { n },
@@ -207,13 +204,13 @@ impl ShadowStage {
             },
         });
         self.lights.push(index);
-        self.maps.push(name.clone());
-        let mut writes = vec![name.clone()];
+        self.maps.push(map);
+        let mut writes = vec![map];
         let vsm = settings.filter == ShadowFilter::Vsm;
         if vsm {
-            let moments = shadow_moments_target_name(index);
+            let moments = TargetId::ShadowMoments { light: index };
             self.targets.push(TargetSpec {
-                name: moments.clone(),
+                id: moments,
                 format: TextureFormat::Rgba16Float,
                 width: n,
                 height: n,
@@ -221,12 +218,11 @@ impl ShadowStage {
                     "light {index} VSM moments: depth (r + g), depth^2 (b + a), blurred"
                 ),
             });
-            writes.push(moments.clone());
+            writes.push(moments);
             self.maps.push(moments);
         }
         self.passes.push(PassSpec {
-            name: name.clone(),
-            kind: PassKind::Shadow { light: index },
+            id: PassId::Shadow { light: index },
             reads: vec![],
             writes,
             detail: format!(
@@ -243,55 +239,55 @@ impl ShadowStage {
             ),
         });
         if vsm && settings.vsm_blur_radius > 0 {
-            self.add_vsm_blur(index, &name, settings);
+            self.add_vsm_blur(index, settings);
         }
     }
 
     /// The separable Gaussian blur of light `index`'s VSM moments: along x into the blur
     /// target, then along y back into the moments.
-    fn add_vsm_blur(&mut self, index: usize, name: &str, settings: ShadowSettings) {
+    fn add_vsm_blur(&mut self, index: usize, settings: ShadowSettings) {
         let n = settings.map_size;
-        let moments = shadow_moments_target_name(index);
-        let blur = shadow_blur_target_name(index);
+        let moments = TargetId::ShadowMoments { light: index };
+        let blur = TargetId::ShadowBlur { light: index };
         self.targets.push(TargetSpec {
-            name: blur.clone(),
+            id: blur,
             format: TextureFormat::Rgba16Float,
             width: n,
             height: n,
             contents: format!("light {index} VSM moments blurred along x"),
         });
         let radius = settings.vsm_blur_radius;
-        for (axis, reads, writes) in [("x", &moments, &blur), ("y", &blur, &moments)] {
+        for (axis, name, reads, writes) in [
+            (BlurAxis::X, "x", moments, blur),
+            (BlurAxis::Y, "y", blur, moments),
+        ] {
             self.passes.push(PassSpec {
-                name: format!("{name}_blur_{axis}"),
-                kind: PassKind::ShadowBlur { light: index },
-                reads: vec![reads.clone()],
-                writes: vec![writes.clone()],
-                detail: format!("Gaussian along {axis}, radius {radius} texels"),
+                id: PassId::ShadowBlur { light: index, axis },
+                reads: vec![reads],
+                writes: vec![writes],
+                detail: format!("Gaussian along {name}, radius {radius} texels"),
             });
         }
     }
 }
 
 /// Every object into the G-buffer and depth.
-fn geometry_pass(scene: &Scene, gbuffer: &[String]) -> PassSpec {
+fn geometry_pass(scene: &Scene, gbuffer: &[TargetId]) -> PassSpec {
     let objects = scene.objects.len();
     let triangles: usize = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
     PassSpec {
-        name: "geometry".to_owned(),
-        kind: PassKind::Geometry,
+        id: PassId::Geometry,
         reads: vec![],
-        writes: gbuffer.iter().cloned().chain([DEPTH.to_owned()]).collect(),
+        writes: gbuffer.iter().copied().chain([TargetId::Depth]).collect(),
         detail: format!("{objects} objects, {triangles} triangles"),
     }
 }
 
 /// Every object's lighting-model channel into the mask targets.
-fn mask_pass(models: &[LightingModel], masks: &[String]) -> PassSpec {
+fn mask_pass(models: &[LightingModel], masks: &[TargetId]) -> PassSpec {
     PassSpec {
-        name: "mask".to_owned(),
-        kind: PassKind::ShaderMask,
-        reads: vec![DEPTH.to_owned()],
+        id: PassId::ShaderMask,
+        reads: vec![TargetId::Depth],
         writes: masks.to_vec(),
         detail: format!(
             "{} models: {}",
@@ -306,23 +302,21 @@ fn mask_pass(models: &[LightingModel], masks: &[String]) -> PassSpec {
 }
 
 /// With an environment: the IBL precompute on the CPU and the skybox; none without.
-fn environment_passes(scene: &Scene, masks: &[String]) -> Vec<PassSpec> {
+fn environment_passes(scene: &Scene, masks: &[TargetId]) -> Vec<PassSpec> {
     let Some(environment) = &scene.environment else {
         return Vec::new();
     };
     vec![
         PassSpec {
-            name: "ibl_precompute".to_owned(),
-            kind: PassKind::IblPrecompute,
+            id: PassId::IblPrecompute,
             reads: vec![],
             writes: vec![],
             detail: format!("CPU, cached: {}", scene.quality.ibl.describe()),
         },
         PassSpec {
-            name: "skybox".to_owned(),
-            kind: PassKind::Skybox,
+            id: PassId::Skybox,
             reads: masks.to_vec(),
-            writes: vec![LIGHT.to_owned()],
+            writes: vec![TargetId::Light],
             detail: format!(
                 "{}x{} equirectangular, rotation {} deg, intensity {}",
                 environment.image.width,
@@ -340,23 +334,22 @@ fn lighting_pass_specs(
     scene: &Scene,
     mask_channels: &[MaskChannel],
     lighting: &[LightingPass],
-    gbuffer: &[String],
-    shadow_maps: &[String],
+    gbuffer: &[TargetId],
+    shadow_maps: &[TargetId],
 ) -> Vec<PassSpec> {
     mask_channels
         .iter()
         .zip(lighting)
         .map(|(channel, pass)| {
             let mut reads = gbuffer.to_vec();
-            reads.push(mask_target_name(channel.target));
+            reads.push(TargetId::Mask(channel.target));
             if channel.model != LightingModel::Unlit {
-                reads.extend(shadow_maps.iter().cloned());
+                reads.extend(shadow_maps.iter().copied());
             }
             PassSpec {
-                name: format!("lighting_{}", channel.model.name().replace('-', "_")),
-                kind: PassKind::Lighting(channel.model),
+                id: PassId::Lighting(channel.model),
                 reads,
-                writes: vec![ROUTE.to_owned(), LIGHT.to_owned()],
+                writes: vec![TargetId::Route, TargetId::Light],
                 detail: if channel.model == LightingModel::Unlit {
                     "1 draw, no lights, routed by depth test".to_owned()
                 } else {
@@ -375,28 +368,27 @@ fn lighting_pass_specs(
 fn shadow_term_output(
     scene: &Scene,
     light: usize,
-    gbuffer: &[String],
-    shadow_maps: &[String],
+    gbuffer: &[TargetId],
+    shadow_maps: &[TargetId],
 ) -> (TargetSpec, PassSpec) {
-    let name = shadow_term_target_name(light);
+    let term = TargetId::ShadowTerm { light };
     let target = TargetSpec {
-        name: name.clone(),
+        id: term,
         format: TextureFormat::Rgba16Float,
         width: scene.quality.width,
         height: scene.quality.height,
         contents: format!("debug: light {light}'s shadow term (1 = lit)"),
     };
     let mut reads = gbuffer.to_vec();
-    reads.push(shadow_target_name(light));
-    let moments = shadow_moments_target_name(light);
+    reads.push(TargetId::Shadow { light });
+    let moments = TargetId::ShadowMoments { light };
     if shadow_maps.contains(&moments) {
         reads.push(moments);
     }
     let pass = PassSpec {
-        name: name.clone(),
-        kind: PassKind::ShadowTerm { light },
+        id: PassId::ShadowTerm { light },
         reads,
-        writes: vec![name],
+        writes: vec![term],
         detail: "debug output of the lighting pass's shadow lookup".to_owned(),
     };
     (target, pass)
@@ -405,18 +397,16 @@ fn shadow_term_output(
 /// Tone mapping into the final image, then the gizmos over it when the quality settings ask.
 fn output_passes(scene: &Scene) -> Vec<PassSpec> {
     let mut passes = vec![PassSpec {
-        name: "tonemap".to_owned(),
-        kind: PassKind::ToneMap,
-        reads: vec![LIGHT.to_owned()],
-        writes: vec![FINAL.to_owned()],
+        id: PassId::ToneMap,
+        reads: vec![TargetId::Light],
+        writes: vec![TargetId::Final],
         detail: scene.quality.tone_map.name().to_owned(),
     }];
     if scene.quality.gizmos {
         passes.push(PassSpec {
-            name: "gizmos".to_owned(),
-            kind: PassKind::Gizmos,
+            id: PassId::Gizmos,
             reads: vec![],
-            writes: vec![FINAL.to_owned()],
+            writes: vec![TargetId::Final],
             detail: "axes, light directions, point-light markers; no depth test".to_owned(),
         });
     }

@@ -6,7 +6,7 @@ use std::fmt;
 use crate::backend::TextureFormat;
 use crate::scene::ShadowFilter;
 
-use super::{LightingVariant, PassKind, RenderPlan, ShadowKind};
+use super::{LightingVariant, PassId, RenderPlan, ShadowKind, TargetId};
 
 fn format_name(format: TextureFormat) -> &'static str {
     match format {
@@ -19,6 +19,12 @@ fn format_name(format: TextureFormat) -> &'static str {
     }
 }
 
+/// Targets' names, comma-separated.
+fn names(targets: &[TargetId]) -> String {
+    let names: Vec<String> = targets.iter().map(ToString::to_string).collect();
+    names.join(", ")
+}
+
 impl fmt::Display for RenderPlan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(f, "scene {} at {}x{}", self.scene, self.width, self.height)?;
@@ -27,7 +33,7 @@ impl fmt::Display for RenderPlan {
             writeln!(
                 f,
                 "  {:<17} {:<10} {:<9} {}",
-                t.name,
+                t.id.to_string(),
                 format_name(t.format),
                 format!("{}x{}", t.width, t.height),
                 t.contents
@@ -35,8 +41,8 @@ impl fmt::Display for RenderPlan {
         }
         writeln!(f, "passes:")?;
         for (i, p) in self.passes.iter().enumerate() {
-            writeln!(f, "  {}. {:<21} {}", i + 1, p.name, p.detail)?;
-            if let PassKind::Lighting(model) = p.kind {
+            writeln!(f, "  {}. {:<21} {}", i + 1, p.id.to_string(), p.detail)?;
+            if let PassId::Lighting(model) = p.id {
                 if let Some(r) = self
                     .lighting
                     .iter()
@@ -57,10 +63,10 @@ impl fmt::Display for RenderPlan {
                 }
             }
             if !p.reads.is_empty() {
-                writeln!(f, "       reads  {}", p.reads.join(", "))?;
+                writeln!(f, "       reads  {}", names(&p.reads))?;
             }
             if !p.writes.is_empty() {
-                writeln!(f, "       writes {}", p.writes.join(", "))?;
+                writeln!(f, "       writes {}", names(&p.writes))?;
             }
         }
         Ok(())

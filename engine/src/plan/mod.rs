@@ -7,30 +7,28 @@
 //! or IBL precompute without an environment, no gizmos unless the quality settings ask for them.
 //!
 //! Built stage by stage in `build`; the lighting draws and their shader variants are in
-//! `lighting`, the targets' names in `target_names`, the plan's text in `display`.
+//! `lighting`, the typed identities of targets and passes (and their names) in `ids`, the plan's
+//! text in `display`.
 
 use crate::backend::TextureFormat;
 use crate::scene::LightingModel;
 
 mod build;
 mod display;
+mod ids;
 mod lighting;
-mod target_names;
 
+pub use ids::{BlurAxis, GBufferTarget, PassId, TargetContent, TargetId, UnknownName};
 pub use lighting::{
     shadow_filter_code, LightingDraw, LightingFeature, LightingPass, LightingVariant, PixelRect,
     ShadowKind, MAX_LIGHTS_PER_DRAW,
 };
-pub use target_names::{
-    mask_target_name, shadow_blur_target_name, shadow_moments_target_name, shadow_target_name,
-    shadow_term_target_name, DEPTH, FINAL, GBUFFER_TARGETS, LIGHT, ROUTE,
-};
 
-/// A render target the plan allocates; every one can be read back by its name.
+/// A render target the plan allocates; every one can be read back.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TargetSpec {
-    /// Name used for readback, goldens and the CLI's `--pass`.
-    pub name: String,
+    /// Which target (its name, for readback, goldens and the CLI's `--pass`, is its `Display`).
+    pub id: TargetId,
     /// Texel format.
     pub format: TextureFormat,
     /// Width in texels.
@@ -41,55 +39,29 @@ pub struct TargetSpec {
     pub contents: String,
 }
 
-/// What a pass does.
-#[derive(Clone, Debug, PartialEq)]
-pub enum PassKind {
-    /// Draws the shadow casters into the depth map of light `light` (a point light's six atlas
-    /// faces are six passes, one viewport each), and for VSM into its moments too.
-    Shadow {
-        /// Index into the scene's lights.
-        light: usize,
-    },
-    /// VSM: one direction of the separable Gaussian blur of light `light`'s moments.
-    ShadowBlur {
-        /// Index into the scene's lights.
-        light: usize,
-    },
-    /// Draws every object into the G-buffer and depth.
-    Geometry,
-    /// Draws every object's one-hot lighting-model channel into the mask targets.
-    ShaderMask,
-    /// On the CPU, before any GPU pass: the environment's IBL maps (prefiltered specular,
-    /// irradiance, DFG), read by the lighting passes; cached in memory and on disk.
-    IblPrecompute,
-    /// Fills uncovered pixels of the light buffer from the environment.
-    Skybox,
-    /// Shades one lighting model's pixels into the light buffer.
-    Lighting(LightingModel),
-    /// Debug: writes light `light`'s shadow term per pixel.
-    ShadowTerm {
-        /// Index into the scene's lights.
-        light: usize,
-    },
-    /// Exposed HDR light buffer to the sRGB final image.
-    ToneMap,
-    /// Lines over the final image.
-    Gizmos,
-}
-
 /// One pass of the plan.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PassSpec {
-    /// Pass name (also the name of its GPU timing).
-    pub name: String,
-    /// What it does.
-    pub kind: PassKind,
+    /// Which pass, and what it does (its name, also that of its GPU timing, is its `Display`).
+    pub id: PassId,
     /// Targets it reads.
-    pub reads: Vec<String>,
+    pub reads: Vec<TargetId>,
     /// Targets it writes.
-    pub writes: Vec<String>,
+    pub writes: Vec<TargetId>,
     /// Draw count and other facts worth reviewing.
     pub detail: String,
+}
+
+/// A target name that a scene's plan does not have.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("scene `{scene}` has no pass output `{name}` (its outputs: {available})")]
+pub struct UnknownTarget {
+    /// Scene name.
+    pub scene: String,
+    /// The name asked for.
+    pub name: String,
+    /// The scene's targets, comma-separated.
+    pub available: String,
 }
 
 /// Where a lighting model's pixels are flagged.
@@ -123,13 +95,37 @@ pub struct RenderPlan {
 }
 
 impl RenderPlan {
-    /// The target with this name.
-    pub fn target(&self, name: &str) -> Option<&TargetSpec> {
-        self.targets.iter().find(|t| t.name == name)
+    /// The target `id`, if the plan has it.
+    pub fn target(&self, id: TargetId) -> Option<&TargetSpec> {
+        self.targets.iter().find(|t| t.id == id)
     }
 
-    /// Names of every target, in allocation order.
-    pub fn target_names(&self) -> Vec<&str> {
-        self.targets.iter().map(|t| t.name.as_str()).collect()
+    /// Every target, in allocation order.
+    pub fn target_ids(&self) -> Vec<TargetId> {
+        self.targets.iter().map(|t| t.id).collect()
+    }
+
+    /// The pass `id`, if the plan has it.
+    pub fn pass(&self, id: PassId) -> Option<&PassSpec> {
+        self.passes.iter().find(|p| p.id == id)
+    }
+
+    /// The target a name at an edge (the CLI, a file, a TOML key) stands for, if this plan has
+    /// it; the error lists the targets it has.
+    pub fn target_named(&self, name: &str) -> Result<TargetId, UnknownTarget> {
+        name.parse::<TargetId>()
+            .ok()
+            .filter(|id| self.target(*id).is_some())
+            .ok_or_else(|| UnknownTarget {
+                scene: self.scene.clone(),
+                name: name.to_owned(),
+                available: self.target_list(),
+            })
+    }
+
+    /// The targets' names, comma-separated, for messages.
+    pub fn target_list(&self) -> String {
+        let names: Vec<String> = self.targets.iter().map(|t| t.id.to_string()).collect();
+        names.join(", ")
     }
 }

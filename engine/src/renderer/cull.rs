@@ -11,8 +11,8 @@
 
 use crate::backend::{BindingResource, Handle, LoadOp, RenderPass, Texture};
 
-/// The passes of `passes` (in their order) that the `wanted` targets depend on.
-pub(super) fn needed(passes: Vec<RenderPass>, wanted: &[Handle<Texture>]) -> Vec<RenderPass> {
+/// Which of `passes` (in their order) the `wanted` targets depend on.
+pub(super) fn needed(passes: &[RenderPass], wanted: &[Handle<Texture>]) -> Vec<bool> {
     let mut needed: Vec<Handle<Texture>> = wanted.to_vec();
     let mut keep = vec![false; passes.len()];
     for (index, pass) in passes.iter().enumerate().rev() {
@@ -26,11 +26,7 @@ pub(super) fn needed(passes: Vec<RenderPass>, wanted: &[Handle<Texture>]) -> Vec
             }
         }
     }
-    passes
-        .into_iter()
-        .zip(keep)
-        .filter_map(|(pass, keep)| keep.then_some(pass))
-        .collect()
+    keep
 }
 
 /// The textures a pass renders to.
@@ -129,9 +125,12 @@ mod tests {
 
     fn kept(wanted: &[u32]) -> Vec<String> {
         let wanted: Vec<_> = wanted.iter().map(|&t| texture(t)).collect();
-        needed(frame(), &wanted)
+        let passes = frame();
+        let keep = needed(&passes, &wanted);
+        passes
             .into_iter()
-            .map(|p| p.name)
+            .zip(keep)
+            .filter_map(|(p, keep)| keep.then_some(p.name))
             .collect()
     }
 

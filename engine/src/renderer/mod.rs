@@ -19,12 +19,14 @@ mod uniforms;
 mod validate;
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use glam::{DMat4, DVec3, Mat3, Mat4};
 
 use crate::backend::*;
+use crate::ibl::IblMaps;
 use crate::image::Image;
-use crate::plan::{LightingFeature, RenderPlan};
+use crate::plan::{LightingFeature, PassId, RenderPlan, TargetId};
 use crate::scene::{Scene, Transform};
 use resources::FrameResources;
 
@@ -91,27 +93,64 @@ pub enum Readback<'a> {
     /// Every target of the plan.
     All,
     /// Only these targets; every pass of the plan still runs (what the bench times).
-    Only(&'a [&'a str]),
+    Only(&'a [TargetId]),
     /// Only these targets, and only the passes they depend on run: the others are culled before
     /// submission, so they take no GPU time and report no timing. The targets read back are the
     /// same, bit for bit, as with [`Readback::Only`].
-    Needed(&'a [&'a str]),
+    Needed(&'a [TargetId]),
 }
 
 /// A rendered frame: the plan it followed, the outputs read back, and GPU time per pass.
 pub struct Frame {
     /// The plan that was executed.
     pub plan: RenderPlan,
-    /// Read-back outputs by target name.
-    pub outputs: BTreeMap<String, Image>,
-    /// GPU time per pass, in plan order.
-    pub timings: Vec<PassTiming>,
+    /// Read-back outputs by target.
+    pub outputs: BTreeMap<TargetId, Image>,
+    /// GPU time of every submitted render pass, with the plan pass it belongs to.
+    pub timings: PassTimes,
 }
 
 impl Frame {
-    /// The output with this name, if it was read back.
-    pub fn output(&self, name: &str) -> Option<&Image> {
-        self.outputs.get(name)
+    /// The output of target `id`, if it was read back.
+    pub fn output(&self, id: TargetId) -> Option<&Image> {
+        self.outputs.get(&id)
+    }
+}
+
+/// A frame's GPU times: one per submitted render pass (a point light's faces are one render
+/// pass each), each with the plan pass it belongs to.
+#[derive(Clone, Debug, Default)]
+pub struct PassTimes {
+    /// Each submitted render pass's time, in submission order (names are debug labels).
+    pub passes: Vec<PassTiming>,
+    /// The plan pass each entry of `passes` belongs to (none for a pass the plan does not
+    /// list, such as the clear of an otherwise unwritten light buffer).
+    pub owners: Vec<Option<PassId>>,
+}
+
+impl PassTimes {
+    /// Whether the plan's pass `id` ran in this frame (it was not culled).
+    pub fn ran(&self, id: PassId) -> bool {
+        self.owners.contains(&Some(id))
+    }
+
+    /// GPU ns of the plan's pass `id`: the sum over its render passes (a point light's six
+    /// faces). None when the pass did not run (culled, or not in the plan) or the backend has
+    /// no timestamps.
+    pub fn pass_time(&self, id: PassId) -> Option<f64> {
+        let mut times = self
+            .passes
+            .iter()
+            .zip(&self.owners)
+            .filter(|(_, owner)| **owner == Some(id))
+            .map(|(timing, _)| timing.gpu_ns);
+        let first = times.next()??;
+        times.try_fold(first, |sum, ns| ns.map(|ns| sum + ns))
+    }
+
+    /// GPU ns of the whole frame: every render pass submitted (None without timestamps).
+    pub fn total(&self) -> Option<f64> {
+        self.passes.iter().map(|p| p.gpu_ns).sum()
     }
 }
 
@@ -133,6 +172,81 @@ pub struct Faults {
     pub light_radiance_scale: Option<f32>,
 }
 
+/// A scene made ready to draw, once: the scene as drawn (with `[quality.ibl] extract_sun`, the
+/// environment's sun added as a directional light), its IBL maps, and the plan of it. The plan
+/// is only ever built here, so whatever names a render's passes and targets (the renderer,
+/// the golden suite, `harness plan`, `render --pass`, the benches) sees the frame that runs.
+#[derive(Clone)]
+pub struct PreparedFrame {
+    scene: Scene,
+    plan: RenderPlan,
+    ibl_maps: Option<Arc<IblMaps>>,
+}
+
+impl PreparedFrame {
+    /// Validates `scene`, prepares its IBL maps (built, or read from their caches) and plans
+    /// the scene as drawn.
+    pub fn new(scene: &Scene) -> Result<Self, RenderError> {
+        validate(scene)?;
+        let ibl_maps = scene
+            .environment
+            .as_ref()
+            .map(|environment| crate::ibl::prepare(&environment.image, &scene.quality.ibl).0);
+        // With `extract_sun`, the maps lack the environment's sun: it is lit as a light instead.
+        let scene = crate::ibl::sun::scene_with_sun(scene, ibl_maps.as_deref())
+            .unwrap_or_else(|| scene.clone());
+        let plan = RenderPlan::new(&scene);
+        Ok(Self {
+            scene,
+            plan,
+            ibl_maps,
+        })
+    }
+
+    /// The scene as drawn: an extracted sun is its last light.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// This frame with `scene`, a variation of its scene as drawn (a light, a material, the
+    /// camera, a shadow setting changed: what the mutation self-test and the benches vary),
+    /// validated and planned again. The IBL maps are kept, so the variation must keep the
+    /// environment and the IBL settings as they are (an extracted sun's light follows both);
+    /// one that does not is refused: prepare the changed scene with [`PreparedFrame::new`].
+    pub fn varied(&self, scene: Scene) -> Result<Self, RenderError> {
+        let same_environment = match (&self.scene.environment, &scene.environment) {
+            (None, None) => true,
+            (Some(a), Some(b)) => {
+                Arc::ptr_eq(&a.image, &b.image)
+                    && a.rotation_degrees == b.rotation_degrees
+                    && a.intensity == b.intensity
+            }
+            _ => false,
+        };
+        if !same_environment || self.scene.quality.ibl != scene.quality.ibl {
+            return Err(RenderError::InvalidScene {
+                scene: scene.name,
+                problem: "a variation of a prepared frame changed its environment or IBL \
+                          settings, which its IBL maps (and an extracted sun) depend on; \
+                          prepare the changed scene anew"
+                    .to_owned(),
+            });
+        }
+        validate(&scene)?;
+        let plan = RenderPlan::new(&scene);
+        Ok(Self {
+            scene,
+            plan,
+            ibl_maps: self.ibl_maps.clone(),
+        })
+    }
+
+    /// The plan of the scene as drawn.
+    pub fn plan(&self) -> &RenderPlan {
+        &self.plan
+    }
+}
+
 /// Renders `scene` and reads back the requested outputs. Everything created is destroyed before
 /// returning, also on error.
 pub fn render(
@@ -140,23 +254,12 @@ pub fn render(
     scene: &Scene,
     readback: Readback<'_>,
 ) -> Result<Frame, RenderError> {
-    render_with_faults(backend, scene, readback, &Faults::default())
-}
-
-/// The scene as [`render`] draws it: with `[quality.ibl] extract_sun`, the environment's sun
-/// added as a directional light (finding it needs the IBL maps: built, or read from their
-/// caches); otherwise the scene itself. Whatever names a render's passes and targets
-/// (`harness plan`, `harness render --pass`) plans from this, so it lists what the render has.
-pub fn scene_as_drawn(scene: &Scene) -> std::borrow::Cow<'_, Scene> {
-    let maps = scene
-        .environment
-        .as_ref()
-        .filter(|_| scene.quality.ibl.extract_sun)
-        .map(|environment| crate::ibl::prepare(&environment.image, &scene.quality.ibl).0);
-    match crate::ibl::sun::scene_with_sun(scene, maps.as_deref()) {
-        Some(with_sun) => std::borrow::Cow::Owned(with_sun),
-        None => std::borrow::Cow::Borrowed(scene),
-    }
+    render_prepared(
+        backend,
+        &PreparedFrame::new(scene)?,
+        readback,
+        &Faults::default(),
+    )
 }
 
 /// [`render`] with deliberate faults injected (see [`Faults`]).
@@ -166,39 +269,37 @@ pub fn render_with_faults(
     readback: Readback<'_>,
     faults: &Faults,
 ) -> Result<Frame, RenderError> {
-    validate(scene)?;
-    let ibl_maps = scene
-        .environment
-        .as_ref()
-        .map(|environment| crate::ibl::prepare(&environment.image, &scene.quality.ibl).0);
-    // With `extract_sun`, the maps lack the environment's sun: it is lit as a light instead.
-    let with_sun = crate::ibl::sun::scene_with_sun(scene, ibl_maps.as_deref());
-    let scene = with_sun.as_ref().unwrap_or(scene);
-    let mut plan = RenderPlan::new(scene);
+    render_prepared(backend, &PreparedFrame::new(scene)?, readback, faults)
+}
+
+/// Renders a prepared frame (with `faults`; [`Faults::default`] for none) and reads back the
+/// requested outputs. Everything created is destroyed before returning, also on error.
+pub fn render_prepared(
+    backend: &mut dyn Backend,
+    prepared: &PreparedFrame,
+    readback: Readback<'_>,
+    faults: &Faults,
+) -> Result<Frame, RenderError> {
+    let scene = &prepared.scene;
+    let mut plan = prepared.plan.clone();
     if let Some(feature) = faults.remove_lighting {
         plan.remove_lighting_feature(feature, scene);
     }
-    let wanted: Vec<String> = match readback {
-        Readback::All => plan
-            .target_names()
-            .iter()
-            .map(|s| (*s).to_owned())
-            .collect(),
-        Readback::Only(names) | Readback::Needed(names) => {
-            for name in names {
-                if plan.target(name).is_none() {
-                    return Err(RenderError::UnknownOutput {
-                        scene: scene.name.clone(),
-                        name: (*name).to_owned(),
-                        available: plan.target_names().join(", "),
-                    });
-                }
+    let wanted: Vec<TargetId> = match readback {
+        Readback::All => plan.target_ids(),
+        Readback::Only(ids) | Readback::Needed(ids) => {
+            if let Some(missing) = ids.iter().find(|id| plan.target(**id).is_none()) {
+                return Err(RenderError::UnknownOutput {
+                    scene: scene.name.clone(),
+                    name: missing.to_string(),
+                    available: plan.target_list(),
+                });
             }
-            names.iter().map(|s| (*s).to_owned()).collect()
+            ids.to_vec()
         }
     };
     let wanted = Wanted {
-        names: &wanted,
+        targets: &wanted,
         cull: matches!(readback, Readback::Needed(_)),
     };
     let mut scope = ResourceScope::default();
@@ -208,7 +309,7 @@ pub fn render_with_faults(
         &plan,
         wanted,
         faults,
-        ibl_maps.as_deref(),
+        prepared.ibl_maps.as_deref(),
         &mut scope,
     );
     scope.destroy(backend);
@@ -250,12 +351,12 @@ impl CameraMatrices {
     }
 }
 
-type Outputs = (BTreeMap<String, Image>, Vec<PassTiming>);
+type Outputs = (BTreeMap<TargetId, Image>, PassTimes);
 
 /// The targets a frame reads back, and whether the passes they do not depend on are culled.
 #[derive(Clone, Copy)]
 struct Wanted<'a> {
-    names: &'a [String],
+    targets: &'a [TargetId],
     cull: bool,
 }
 
@@ -271,11 +372,11 @@ fn record_and_submit(
     scope: &mut ResourceScope,
 ) -> Result<Outputs, RenderError> {
     let frame = FrameResources::create(backend, scope, scene, plan)?;
-    let mut passes = Vec::new();
+    let mut recorded = passes::Recorded::default();
     let views = shadows::shadow_views(scene);
-    passes::shadow::record(backend, scope, scene, &views, &frame, &mut passes)?;
-    passes::geometry::record(backend, scope, scene, plan, &frame, faults, &mut passes)?;
-    let light_cleared = passes::skybox::record(backend, scope, scene, &frame, &mut passes)?;
+    passes::shadow::record(backend, scope, scene, &views, &frame, &mut recorded)?;
+    passes::geometry::record(backend, scope, scene, plan, &frame, faults, &mut recorded)?;
+    let light_cleared = passes::skybox::record(backend, scope, scene, &frame, &mut recorded)?;
     passes::lighting::record(
         backend,
         scope,
@@ -286,39 +387,54 @@ fn record_and_submit(
         faults,
         ibl_maps,
         light_cleared,
-        &mut passes,
+        &mut recorded,
     )?;
-    passes::tonemap::record(backend, scope, scene, &frame, faults, &mut passes)?;
+    passes::tonemap::record(backend, scope, scene, &frame, faults, &mut recorded)?;
     if scene.quality.gizmos {
-        passes.push(passes::gizmos::pass(
+        let gizmos = passes::gizmos::pass(
             backend,
             scope,
             scene,
             frame.view_projection,
-            frame.target(crate::plan::FINAL),
-        )?);
+            frame.target(TargetId::Final),
+        )?;
+        recorded.push(PassId::Gizmos, gizmos);
     }
 
+    let passes::Recorded {
+        mut passes,
+        mut owners,
+    } = recorded;
     if wanted.cull {
         let targets: Vec<Handle<Texture>> =
-            wanted.names.iter().map(|name| frame.target(name)).collect();
-        passes = cull::needed(passes, &targets);
+            wanted.targets.iter().map(|id| frame.target(*id)).collect();
+        let keep = cull::needed(&passes, &targets);
+        let mut kept = keep.iter().copied();
+        passes.retain(|_| kept.next().unwrap_or(false));
+        let mut kept = keep.iter().copied();
+        owners.retain(|_| kept.next().unwrap_or(false));
     }
     let timings = backend.submit(&passes)?;
     let mut outputs = BTreeMap::new();
-    for name in wanted.names {
+    for &id in wanted.targets {
         outputs.insert(
-            name.clone(),
+            id,
             backend
-                .read_texture(frame.target(name), Subresource::default())
+                .read_texture(frame.target(id), Subresource::default())
                 .map_err(|source| RenderError::Readback {
                     scene: scene.name.clone(),
-                    output: name.clone(),
+                    output: id.to_string(),
                     source,
                 })?,
         );
     }
-    Ok((outputs, timings))
+    Ok((
+        outputs,
+        PassTimes {
+            passes: timings,
+            owners,
+        },
+    ))
 }
 
 /// Object-to-camera-relative matrix and its normal matrix, in f32.
@@ -326,4 +442,50 @@ pub fn object_matrices(transform: &Transform, camera_position: DVec3) -> (Mat4, 
     let model = transform.relative_to(camera_position).as_mat4();
     let normal = Mat3::from_mat4(model).inverse().transpose();
     (model, normal)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::BlurAxis;
+
+    fn times(entries: &[(Option<PassId>, Option<f64>)]) -> PassTimes {
+        PassTimes {
+            passes: entries
+                .iter()
+                .map(|(owner, ns)| PassTiming {
+                    name: owner.map_or("unplanned".to_owned(), |o| o.to_string()),
+                    gpu_ns: *ns,
+                })
+                .collect(),
+            owners: entries.iter().map(|(owner, _)| *owner).collect(),
+        }
+    }
+
+    #[test]
+    fn a_pass_time_sums_its_render_passes_and_nothing_else() {
+        let shadow_0 = PassId::Shadow { light: 0 };
+        let blur = PassId::ShadowBlur {
+            light: 0,
+            axis: BlurAxis::X,
+        };
+        let shadow_1 = PassId::Shadow { light: 1 };
+        let frame = times(&[
+            (Some(shadow_0), Some(1.0)),
+            (Some(shadow_0), Some(2.0)),
+            (Some(blur), Some(4.0)),
+            (Some(shadow_1), Some(8.0)),
+            (None, Some(32.0)),
+            (Some(PassId::Geometry), Some(16.0)),
+        ]);
+        assert_eq!(frame.pass_time(shadow_0), Some(3.0));
+        assert_eq!(frame.pass_time(blur), Some(4.0));
+        assert_eq!(frame.pass_time(shadow_1), Some(8.0));
+        assert_eq!(frame.pass_time(PassId::Skybox), None);
+        assert!(!frame.ran(PassId::Skybox) && frame.ran(PassId::Geometry));
+        assert_eq!(frame.total(), Some(63.0));
+        let untimed = times(&[(Some(PassId::Geometry), None)]);
+        assert_eq!(untimed.pass_time(PassId::Geometry), None);
+        assert_eq!(untimed.total(), None);
+    }
 }

@@ -10,7 +10,7 @@ use glam::Mat4;
 use super::{CameraMatrices, RenderError};
 use crate::backend::*;
 use crate::mesh::MeshData;
-use crate::plan::RenderPlan;
+use crate::plan::{RenderPlan, TargetContent, TargetId};
 use crate::scene::{Object, Scene};
 
 /// GPU copies of one mesh.
@@ -25,7 +25,7 @@ pub(super) struct GpuMesh {
 
 /// The resources shared by a frame's passes.
 pub(super) struct FrameResources {
-    targets: HashMap<String, Handle<Texture>>,
+    targets: HashMap<TargetId, Handle<Texture>>,
     meshes: HashMap<*const MeshData, GpuMesh>,
     /// The scene's material textures, by index.
     pub textures: Vec<Handle<Texture>>,
@@ -52,13 +52,13 @@ impl FrameResources {
         scene: &Scene,
         plan: &RenderPlan,
     ) -> Result<Self, RenderError> {
-        let mut targets: HashMap<String, Handle<Texture>> = HashMap::new();
+        let mut targets: HashMap<TargetId, Handle<Texture>> = HashMap::new();
         for spec in &plan.targets {
             let handle = scope.texture(
                 backend,
-                &TextureDesc::d2(&spec.name, spec.width, spec.height, spec.format),
+                &TextureDesc::d2(&spec.id.to_string(), spec.width, spec.height, spec.format),
             )?;
-            targets.insert(spec.name.clone(), handle);
+            targets.insert(spec.id, handle);
         }
         let meshes = upload_meshes(backend, scope, scene)?;
         let textures = upload_textures(backend, scope, scene)?;
@@ -81,8 +81,8 @@ impl FrameResources {
         let mask_targets: Vec<Handle<Texture>> = plan
             .targets
             .iter()
-            .filter(|t| t.name.starts_with("mask"))
-            .map(|t| targets[&t.name])
+            .filter(|t| t.id.content() == TargetContent::Mask)
+            .map(|t| targets[&t.id])
             .collect();
         Ok(Self {
             targets,
@@ -97,14 +97,14 @@ impl FrameResources {
         })
     }
 
-    /// The plan's target called `name` (the plan names every target a pass uses).
-    pub fn target(&self, name: &str) -> Handle<Texture> {
-        self.targets[name]
+    /// The plan's target `id` (the plan has every target a pass uses).
+    pub fn target(&self, id: TargetId) -> Handle<Texture> {
+        self.targets[&id]
     }
 
-    /// The plan's target called `name`, if the plan has one.
-    pub fn optional_target(&self, name: &str) -> Option<Handle<Texture>> {
-        self.targets.get(name).copied()
+    /// The plan's target `id`, if the plan has it.
+    pub fn optional_target(&self, id: TargetId) -> Option<Handle<Texture>> {
+        self.targets.get(&id).copied()
     }
 
     /// The GPU copy of `object`'s mesh.

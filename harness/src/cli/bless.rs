@@ -3,6 +3,9 @@
 use std::process::ExitCode;
 
 use engine::backend::BackendKind;
+use engine::plan::TargetId;
+use engine::renderer::{Faults, Readback};
+use harness::golden::bless::{bless_pass, BlessOutcome, BlessRequest};
 
 use super::load_cases;
 
@@ -24,50 +27,49 @@ pub(crate) fn run(
     let mut backend = engine::backend::create(kind)?;
     let driver = harness::golden::fingerprint(backend.info());
     for case in &cases {
-        for pass in passes {
-            if !case.passes.contains(pass) {
-                anyhow::bail!(
-                    "scene {} has no golden pass `{pass}` (it has: {})",
+        // Names given on the command line, as the case's golden passes.
+        let mut named: Vec<TargetId> = Vec::new();
+        for name in passes {
+            match case.passes.iter().find(|p| p.to_string() == *name) {
+                Some(&pass) => named.push(pass),
+                None => anyhow::bail!(
+                    "scene {} has no golden pass `{name}` (it has: {})",
                     case.name(),
-                    case.passes.join(", ")
-                );
+                    harness::names(&case.passes)
+                ),
             }
         }
-        let wanted: Vec<&str> = case
-            .passes
-            .iter()
-            .filter(|p| passes.is_empty() || passes.contains(p))
-            .map(String::as_str)
-            .collect();
+        let wanted: Vec<TargetId> = if named.is_empty() {
+            case.passes.clone()
+        } else {
+            named.clone()
+        };
         eprintln!("rendering {} on {kind} ...", case.name());
-        let frame = engine::renderer::render(
+        let frame = engine::renderer::render_prepared(
             backend.as_mut(),
-            &case.loaded.scene,
-            engine::renderer::Readback::Only(&wanted),
+            &case.frame,
+            Readback::Only(&wanted),
+            &Faults::default(),
         )?;
+        let request = BlessRequest {
+            named: &named,
+            every_pass,
+            dry_run,
+        };
         let mut kept = 0;
         for pass in wanted {
-            let image = &frame.outputs[pass];
-            let change = harness::golden::suite::bless_change(&store, case, pass, image);
-            // A pass named with --pass is rewritten even when it is within tolerance.
-            let write = change.changed || every_pass || passes.iter().any(|p| p == pass);
-            if !write {
+            let blessed = bless_pass(
+                &store,
+                case,
+                pass,
+                &frame.outputs[&pass],
+                (kind, &driver),
+                request,
+            )?;
+            if blessed.outcome == BlessOutcome::Kept {
                 kept += 1;
-                println!("{}/{pass}: {}; kept", case.name(), change.previous);
-                continue;
             }
-            println!("{}/{pass}: {}", case.name(), change.previous);
-            if !dry_run {
-                let path = store.bless(
-                    case.name(),
-                    pass,
-                    image,
-                    kind.name(),
-                    &driver,
-                    &change.previous,
-                )?;
-                println!("  wrote {}", path.display());
-            }
+            println!("{blessed}");
         }
         if kept > 0 {
             println!(

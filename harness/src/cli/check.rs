@@ -72,11 +72,11 @@ pub(crate) fn run(
 /// fallback) because golden/noise.toml has no figures for it, and how to measure its own.
 fn note_borrowed_limits(cases: &[Case]) {
     for case in cases {
-        let borrowed: Vec<&str> = case
+        let borrowed: Vec<String> = case
             .limit_sources
             .iter()
             .filter(|(_, s)| matches!(s, LimitSource::Borrowed | LimitSource::Fallback))
-            .map(|(p, _)| p.as_str())
+            .map(|(p, _)| p.to_string())
             .collect();
         if !borrowed.is_empty() {
             eprintln!(

@@ -81,11 +81,9 @@ pub(crate) fn inspect(path: &Path, json: bool) -> anyhow::Result<ExitCode> {
 
 /// `harness plan`: the render plan of a scene, the passes and targets it needs.
 pub(crate) fn plan(scene: &str) -> anyhow::Result<ExitCode> {
-    harness::load_scene(scene)
-        .map(|loaded| {
-            let scene = engine::renderer::scene_as_drawn(&loaded.scene);
-            print!("{}", engine::plan::RenderPlan::new(&scene));
-            ExitCode::SUCCESS
-        })
-        .map_err(Into::into)
+    let loaded = harness::load_scene(scene)?;
+    // The plan of the scene as drawn: an extracted sun's light and shadow map are in it.
+    let prepared = engine::renderer::PreparedFrame::new(&loaded.scene)?;
+    print!("{}", prepared.plan());
+    Ok(ExitCode::SUCCESS)
 }

@@ -241,7 +241,7 @@ fn print_table(
             r.source,
             r.scene,
             r.pass,
-            r.backend,
+            r.backend.map_or("-", BackendKind::name),
             r.value,
             r.ratio,
             r.limit

@@ -4,6 +4,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use engine::backend::BackendKind;
+use engine::plan::TargetId;
+use engine::renderer::{Faults, PreparedFrame, Readback};
 
 use super::{default_out_dir, print_load_warnings};
 
@@ -17,62 +19,56 @@ pub(crate) fn run(
 ) -> anyhow::Result<ExitCode> {
     let loaded = harness::load_scene(scene)?;
     print_load_warnings(&loaded);
-    let scene = &loaded.scene;
-    // The plan of the scene as drawn: an extracted sun's light and shadow map are outputs too.
-    let plan = engine::plan::RenderPlan::new(&engine::renderer::scene_as_drawn(scene));
-    let names: Vec<String> = if passes.is_empty() {
-        vec![engine::plan::FINAL.to_owned()]
+    // The scene as drawn and its plan: an extracted sun's light and shadow map are outputs too.
+    let prepared = PreparedFrame::new(&loaded.scene)?;
+    let (scene, plan) = (prepared.scene(), prepared.plan());
+    // Pass names (an edge) are checked against the plan before anything is rendered.
+    let targets: Vec<TargetId> = if passes.is_empty() {
+        vec![TargetId::Final]
     } else if passes.iter().any(|p| p == "all") {
-        plan.target_names()
-            .iter()
-            .map(|s| (*s).to_owned())
-            .collect()
+        plan.target_ids()
     } else {
-        passes.to_vec()
+        passes
+            .iter()
+            .map(|name| plan.target_named(name))
+            .collect::<Result<_, _>>()
+            .map_err(|e| anyhow::anyhow!("{e}, or `all`"))?
     };
-    // Pass names are checked against the plan before anything is rendered.
-    let known = plan.target_names();
-    if let Some(unknown) = names.iter().find(|n| !known.contains(&n.as_str())) {
-        anyhow::bail!(
-            "scene `{}` has no pass output `{unknown}` (its outputs: {}, or `all`)",
-            scene.name,
-            known.join(", ")
-        );
-    }
     let mut backend = engine::backend::create(kind)?;
-    let wanted: Vec<&str> = names.iter().map(String::as_str).collect();
     eprintln!(
         "rendering {} ({}x{}) on {kind} ...",
         scene.name, scene.quality.width, scene.quality.height
     );
     // Only the passes the asked-for outputs depend on run (`harness bench` times whole frames).
-    let frame = engine::renderer::render(
+    let frame = engine::renderer::render_prepared(
         backend.as_mut(),
-        scene,
-        engine::renderer::Readback::Needed(&wanted),
+        &prepared,
+        Readback::Needed(&targets),
+        &Faults::default(),
     )?;
     let default_dir = default_out_dir()
         .join("render")
         .join(&scene.name)
         .join(kind.name());
-    for name in &names {
-        let image = &frame.outputs[name];
+    for target in &targets {
+        let image = &frame.outputs[target];
         let extension = if image.as_u8().is_some() {
             "png"
         } else {
             "exr"
         };
+        let file = format!("{target}.{extension}");
         let path = match &out {
-            Some(path) if names.len() == 1 && path.extension().is_some() => path.clone(),
-            Some(dir) => dir.join(format!("{name}.{extension}")),
-            None => default_dir.join(format!("{name}.{extension}")),
+            Some(path) if targets.len() == 1 && path.extension().is_some() => path.clone(),
+            Some(dir) => dir.join(file),
+            None => default_dir.join(file),
         };
         harness::images::write_image(image, &path, harness::images::PngCompression::Fast)?;
-        println!("{name:<17} -> {}", path.display());
+        println!("{:<17} -> {}", target.to_string(), path.display());
     }
-    for timing in &frame.timings {
-        if let Some(ns) = timing.gpu_ns {
-            eprintln!("  {:<20} {:8.3} ms GPU", timing.name, ns / 1e6);
+    for pass in &plan.passes {
+        if let Some(ns) = frame.timings.pass_time(pass.id) {
+            eprintln!("  {:<20} {:8.3} ms GPU", pass.id.to_string(), ns / 1e6);
         }
     }
     Ok(ExitCode::SUCCESS)

@@ -70,7 +70,11 @@ pub(crate) fn run(json: bool) -> anyhow::Result<ExitCode> {
         for n in result.noisy() {
             println!(
                 "NOISY: unchanged {} under {} on {}: {} at {:.2} of its limit",
-                n.scene, n.source, n.backend, n.pass, n.ratio
+                n.scene,
+                n.source,
+                n.backend.map_or("-", engine::backend::BackendKind::name),
+                n.pass,
+                n.ratio
             );
         }
         for e in &result.errors {

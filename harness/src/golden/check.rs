@@ -5,6 +5,7 @@
 use std::collections::BTreeMap;
 
 use engine::backend::{self, BackendKind};
+use engine::plan::{PassId, TargetId};
 use engine::renderer::Frame;
 use engine::Image;
 
@@ -13,13 +14,13 @@ use crate::golden::suite::{self, Case, PassCheck};
 use crate::golden::{self, GoldenStore};
 
 /// Every golden pass output of a run, by (scene, pass, backend), for the review page.
-pub type Outputs = BTreeMap<(String, String, String), Image>;
+pub type Outputs = BTreeMap<(String, TargetId, BackendKind), Image>;
 
 /// A backend's status in a check run.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct BackendRun {
-    /// Backend name.
-    pub backend: String,
+    /// Backend.
+    pub backend: BackendKind,
     /// Driver fingerprint, when available.
     pub fingerprint: Option<String>,
     /// Why it was not run.
@@ -32,11 +33,11 @@ pub struct CrossBackend {
     /// Scene.
     pub scene: String,
     /// Pass.
-    pub pass: String,
+    pub pass: TargetId,
     /// First backend.
-    pub a: String,
+    pub a: BackendKind,
     /// Second backend.
-    pub b: String,
+    pub b: BackendKind,
     /// Largest channel difference (8-bit in 0..1 units).
     #[serde(deserialize_with = "crate::golden::tolerance::null_as_infinity")]
     pub max_abs: f64,
@@ -47,15 +48,15 @@ pub struct CrossBackend {
     pub within_tolerance: bool,
 }
 
-/// GPU time of one pass.
+/// GPU time of one pass of the plan (a point light's six faces summed).
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Timing {
     /// Scene.
     pub scene: String,
     /// Backend.
-    pub backend: String,
+    pub backend: BackendKind,
     /// Pass.
-    pub pass: String,
+    pub pass: PassId,
     /// Milliseconds, when the backend has timestamps.
     pub ms: Option<f64>,
 }
@@ -68,7 +69,7 @@ pub struct CheckRun {
     /// Scene x pass x backend results.
     pub results: Vec<PassCheck>,
     /// Render failures: (scene, backend, error).
-    pub render_errors: Vec<(String, String, String)>,
+    pub render_errors: Vec<(String, BackendKind, String)>,
     /// Scenes that did not load (each a failed case; the others are checked as usual).
     #[serde(default)]
     pub load_errors: Vec<crate::golden::suite::BrokenScene>,
@@ -109,7 +110,7 @@ impl CheckRun {
 /// absorb such differences.
 pub fn driver_notes(cases: &[Case], store: &GoldenStore, backends: &[BackendRun]) -> Vec<String> {
     // (backend, blessed driver) -> scenes.
-    let mut blessed: BTreeMap<(String, String), Vec<String>> = BTreeMap::new();
+    let mut blessed: BTreeMap<(BackendKind, String), Vec<String>> = BTreeMap::new();
     for case in cases {
         for record in store.records(case.name()).unwrap_or_default().into_values() {
             let scenes = blessed.entry((record.backend, record.driver)).or_default();
@@ -159,7 +160,7 @@ fn disagreement(a: &Image, b: &Image) -> Option<(f64, f64)> {
 /// disagreement figures of every pair together.
 fn worst_pair(
     scene: &str,
-    pass: &str,
+    pass: TargetId,
     outputs: &[(BackendKind, &Image)],
     within_tolerance: impl Fn(&Image, &Image) -> bool,
 ) -> Option<CrossBackend> {
@@ -181,9 +182,9 @@ fn worst_pair(
         let ((a, image_a), (b, image_b)) = (outputs[i], outputs[j]);
         CrossBackend {
             scene: scene.to_owned(),
-            pass: pass.to_owned(),
-            a: a.name().to_owned(),
-            b: b.name().to_owned(),
+            pass,
+            a,
+            b,
             max_abs,
             fraction_over,
             within_tolerance: within_tolerance(image_a, image_b),
@@ -241,7 +242,7 @@ pub fn run_with(
             available.push(kind);
         }
         backends.push(BackendRun {
-            backend: kind.name().to_owned(),
+            backend: kind,
             fingerprint: status.info.as_ref().map(golden::fingerprint),
             unavailable: (!status.available).then(|| {
                 format!(
@@ -267,45 +268,44 @@ pub fn run_with(
                 .and_then(|mut backend| case.render_on(backend.as_mut()));
             match rendered {
                 Ok(frame) => {
-                    for t in &frame.timings {
-                        timings.push(Timing {
-                            scene: case.name().to_owned(),
-                            backend: kind.name().to_owned(),
-                            pass: t.name.clone(),
-                            ms: t.gpu_ns.map(|ns| ns / 1e6),
-                        });
+                    for pass in frame.plan.passes.iter().map(|p| p.id) {
+                        if frame.timings.ran(pass) {
+                            timings.push(Timing {
+                                scene: case.name().to_owned(),
+                                backend: kind,
+                                pass,
+                                ms: frame.timings.pass_time(pass).map(|ns| ns / 1e6),
+                            });
+                        }
                     }
-                    for pass in &case.passes {
+                    for &pass in &case.passes {
                         results.push(suite::check_pass(
                             store,
                             case,
                             pass,
                             kind,
-                            &frame.outputs[pass],
+                            &frame.outputs[&pass],
                             failures,
                         ));
                     }
                     frames.insert(kind, frame);
                 }
-                Err(e) => render_errors.push((case.name().to_owned(), kind.name().to_owned(), e)),
+                Err(e) => render_errors.push((case.name().to_owned(), kind, e)),
             }
             done += 1;
         }
-        for pass in &case.passes {
+        for &pass in &case.passes {
             let outputs: Vec<(BackendKind, &Image)> = frames
                 .iter()
-                .map(|(&kind, frame)| (kind, &frame.outputs[pass]))
+                .map(|(&kind, frame)| (kind, &frame.outputs[&pass]))
                 .collect();
             cross.extend(worst_pair(case.name(), pass, &outputs, |a, b| {
-                golden::check(a, Some(b), &case.rules[pass]).passed()
+                golden::check(a, Some(b), &case.rules[&pass]).passed()
             }));
         }
         for (kind, frame) in frames {
             for (pass, image) in frame.outputs {
-                outputs.insert(
-                    (case.name().to_owned(), pass, kind.name().to_owned()),
-                    image,
-                );
+                outputs.insert((case.name().to_owned(), pass, kind), image);
             }
         }
     }
@@ -355,12 +355,12 @@ mod tests {
             (BackendKind::WgpuGl, &wgpu_gl),
         ];
         let evaluated = Cell::new(0);
-        let worst = worst_pair("s", "final", &outputs, |a, b| {
+        let worst = worst_pair("s", TargetId::Final, &outputs, |a, b| {
             evaluated.set(evaluated.get() + 1);
             a == &gl && b == &wgpu_gl
         })
         .unwrap();
-        assert_eq!((worst.a.as_str(), worst.b.as_str()), ("gl", "wgpu-gl"));
+        assert_eq!((worst.a, worst.b), (BackendKind::Gl, BackendKind::WgpuGl));
         assert_eq!(worst.fraction_over, 4.0 / 16.0);
         assert!(
             (worst.max_abs - 10.0 / 255.0).abs() < 1e-6,
@@ -383,8 +383,8 @@ mod tests {
             (BackendKind::WgpuVulkan, &vulkan),
             (BackendKind::WgpuGl, &brighter),
         ];
-        let worst = worst_pair("s", "final", &outputs, |_, _| false).unwrap();
-        assert_eq!((worst.a.as_str(), worst.b.as_str()), ("gl", "wgpu-gl"));
+        let worst = worst_pair("s", TargetId::Final, &outputs, |_, _| false).unwrap();
+        assert_eq!((worst.a, worst.b), (BackendKind::Gl, BackendKind::WgpuGl));
         assert!(!worst.within_tolerance);
     }
 }

@@ -23,6 +23,9 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+use engine::plan::TargetId;
+
+use crate::golden::pass_kind::pass_kind;
 use crate::golden::tolerance::Metric;
 use crate::golden::GoldenStore;
 
@@ -136,18 +139,19 @@ impl NoiseModel {
     }
 
     /// The recorded figures of one check.
-    pub fn figures(&self, scene: &str, pass: &str, metric: &str) -> Option<&CheckFigures> {
-        self.scenes.get(scene)?.get(pass)?.get(metric)
+    pub fn figures(&self, scene: &str, pass: TargetId, metric: &str) -> Option<&CheckFigures> {
+        self.scenes.get(scene)?.get(&pass.to_string())?.get(metric)
     }
 
     /// The largest limit any scene has for this kind of pass and metric: what a scene without
     /// figures of its own borrows.
-    pub fn borrowed_limit(&self, pass: &str, metric: &str) -> Option<f64> {
-        let kind = crate::golden::pass_kind::pass_kind(pass)?;
+    pub fn borrowed_limit(&self, pass: TargetId, metric: &str) -> Option<f64> {
+        let kind = pass_kind(pass)?;
         self.scenes
             .values()
             .flat_map(|passes| passes.iter())
-            .filter(|(p, _)| crate::golden::pass_kind::pass_kind(p) == Some(kind))
+            // The file's keys are names (an edge); one that names no target is no pass.
+            .filter(|(p, _)| p.parse().ok().and_then(pass_kind) == Some(kind))
             .filter_map(|(_, checks)| checks.get(metric))
             .map(|f| f.limit)
             .fold(None, |m: Option<f64>, l| Some(m.map_or(l, |m| m.max(l))))

@@ -1,46 +1,21 @@
-//! What a golden pass holds (its [`PassKind`], from its name) and the shape of the rule it is
-//! checked with: which metrics, and the limit each falls back to without noise figures.
+//! Which of a plan's targets get goldens (by what they hold, [`TargetContent`], which the plan
+//! gives every [`TargetId`]), and the shape of the rule each kind is checked with: which
+//! metrics, and the limit each falls back to without noise figures. A new target picks its
+//! content in the engine and needs nothing here.
 
-use engine::plan;
+use engine::plan::{TargetContent, TargetId};
 
 use crate::golden::metrics::Channels;
 use crate::golden::tolerance::Metric;
 
-/// What a golden pass holds, which decides the shape of its rule.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
-pub enum PassKind {
-    /// A G-buffer target (RGBA16F): positions, normals, tangents, albedo, material.
-    GBuffer,
-    /// Depth: the camera's (`depth`) or a light's shadow map (`shadow_<light>`), D32F.
-    Depth,
-    /// The lighting-model mask (RGBA8, one-hot).
-    Mask,
-    /// A shadowed light's visibility per pixel (`shadow_term_<light>`).
-    ShadowTerm,
-    /// The HDR light buffer (RGBA16F).
-    Light,
-    /// The tone-mapped sRGB image.
-    Final,
-}
+/// What a golden pass holds, which decides the shape of its rule: the plan's
+/// [`TargetContent`] of every target but intermediates.
+pub type PassKind = TargetContent;
 
-fn numbered(pass: &str, prefix: &str) -> bool {
-    pass.strip_prefix(prefix)
-        .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()))
-}
-
-/// The kind of a golden pass, or `None` for an output that gets no golden (VSM moments, blur
-/// targets, ...).
-pub fn pass_kind(pass: &str) -> Option<PassKind> {
-    Some(match pass {
-        p if p.starts_with("gbuffer_") => PassKind::GBuffer,
-        plan::DEPTH => PassKind::Depth,
-        p if numbered(p, "shadow_") => PassKind::Depth,
-        p if numbered(p, "shadow_term_") => PassKind::ShadowTerm,
-        "mask" | "mask_1" => PassKind::Mask,
-        plan::LIGHT => PassKind::Light,
-        plan::FINAL => PassKind::Final,
-        _ => return None,
-    })
+/// The kind of a golden pass, or `None` for an output that gets no golden (the routing depth,
+/// VSM moments, blur targets: scratch data between passes).
+pub fn pass_kind(target: TargetId) -> Option<PassKind> {
+    Some(target.content()).filter(|c| *c != TargetContent::Intermediate)
 }
 
 /// The checks of a kind of pass (all must pass), each with the limit used when the noise model
@@ -68,14 +43,18 @@ pub fn rule_shape(kind: PassKind) -> Vec<(Metric, f64)> {
             channels,
         };
     match kind {
-        PassKind::GBuffer => vec![(pixels_over(0.01, Some(1.0), Channels::All), 1.2e-4)],
+        PassKind::SurfaceAttributes => {
+            vec![(pixels_over(0.01, Some(1.0), Channels::All), 1.2e-4)]
+        }
         PassKind::Depth => vec![(pixels_over(1e-4, Some(1e-3), Channels::All), 1.2e-4)],
         PassKind::Mask => vec![(pixels_over(0.5, None, Channels::All), 1.2e-4)],
-        PassKind::ShadowTerm => vec![(pixels_over(0.01, None, Channels::Rgb), 1.2e-4)],
-        PassKind::Light => vec![(pixels_over(0.005, Some(0.01), Channels::Rgb), 3.5e-4)],
-        PassKind::Final => vec![
+        PassKind::Visibility => vec![(pixels_over(0.01, None, Channels::Rgb), 1.2e-4)],
+        PassKind::Radiance => vec![(pixels_over(0.005, Some(0.01), Channels::Rgb), 3.5e-4)],
+        PassKind::Display => vec![
             (pixels_over(0.006, None, Channels::Rgb), 1.2e-4),
             (Metric::FlipMean, 0.021),
         ],
+        // Scratch data gets no golden (see `pass_kind`), so no rule either.
+        PassKind::Intermediate => Vec::new(),
     }
 }

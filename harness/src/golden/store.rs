@@ -11,7 +11,8 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use engine::backend::DriverInfo;
+use engine::backend::{BackendKind, DriverInfo};
+use engine::plan::TargetId;
 use engine::{Image, ImageData};
 
 use crate::golden::tolerance::{Rule, Verdict};
@@ -55,7 +56,7 @@ pub struct BlessRecord {
     /// UTC time of the bless (RFC 3339).
     pub blessed: String,
     /// Backend the golden was rendered on.
-    pub backend: String,
+    pub backend: BackendKind,
     /// Driver fingerprint of that backend.
     pub driver: String,
     /// Metrics against the golden it replaced, or "new".
@@ -108,7 +109,7 @@ impl GoldenStore {
     }
 
     /// Path of a golden; the extension follows the image kind.
-    pub fn path(&self, scene: &str, pass: &str, eight_bit: bool) -> PathBuf {
+    pub fn path(&self, scene: &str, pass: TargetId, eight_bit: bool) -> PathBuf {
         self.root
             .join(scene)
             .join(format!("{pass}.{}", if eight_bit { "png" } else { "exr" }))
@@ -118,7 +119,7 @@ impl GoldenStore {
     pub fn load(
         &self,
         scene: &str,
-        pass: &str,
+        pass: TargetId,
         eight_bit: bool,
     ) -> Result<Option<Image>, GoldenError> {
         let path = self.path(scene, pass, eight_bit);
@@ -136,7 +137,8 @@ impl GoldenStore {
         self.root.join(scene).join("blessed.toml")
     }
 
-    /// What blessed.toml says about each pass of a scene.
+    /// What blessed.toml says about each pass of a scene, by the pass's name as the file has it
+    /// (a file may name passes no plan has any more).
     pub fn records(&self, scene: &str) -> Result<BTreeMap<String, BlessRecord>, GoldenError> {
         let path = self.record_path(scene);
         if !path.exists() {
@@ -157,9 +159,9 @@ impl GoldenStore {
     pub fn bless(
         &self,
         scene: &str,
-        pass: &str,
+        pass: TargetId,
         image: &Image,
-        backend: &str,
+        backend: BackendKind,
         driver: &str,
         previous: &str,
     ) -> Result<PathBuf, GoldenError> {
@@ -168,7 +170,7 @@ impl GoldenStore {
             if count > 0 {
                 return Err(GoldenError::NonFinite {
                     scene: scene.to_owned(),
-                    pass: pass.to_owned(),
+                    pass: pass.to_string(),
                     count,
                 });
             }
@@ -183,11 +185,11 @@ impl GoldenStore {
         }
         let mut records = self.records(scene)?;
         records.insert(
-            pass.to_owned(),
+            pass.to_string(),
             BlessRecord {
                 blessed: humantime::format_rfc3339_seconds(std::time::SystemTime::now())
                     .to_string(),
-                backend: backend.to_owned(),
+                backend,
                 driver: driver.to_owned(),
                 previous: previous.to_owned(),
             },
@@ -289,26 +291,48 @@ mod tests {
             data: ImageData::F32(vec![1.0, 2.0, 3.0, 1.0]),
         };
         let path = store
-            .bless("s", "light", &image, "gl", "llvmpipe", "new")
+            .bless(
+                "s",
+                TargetId::Light,
+                &image,
+                BackendKind::Gl,
+                "llvmpipe",
+                "new",
+            )
             .unwrap();
         assert!(path.ends_with("s/light.exr"));
         assert_eq!(
-            store.load("s", "light", false).unwrap().unwrap().data,
+            store
+                .load("s", TargetId::Light, false)
+                .unwrap()
+                .unwrap()
+                .data,
             image.data
         );
         let records = store.records("s").unwrap();
-        assert_eq!(records["light"].backend, "gl");
+        assert_eq!(records["light"].backend, BackendKind::Gl);
         let bad = Image {
             data: ImageData::F32(vec![f32::NAN, 0.0, 0.0, 1.0]),
             ..image.clone()
         };
         let err = store
-            .bless("s", "light", &bad, "gl", "llvmpipe", "new")
+            .bless(
+                "s",
+                TargetId::Light,
+                &bad,
+                BackendKind::Gl,
+                "llvmpipe",
+                "new",
+            )
             .unwrap_err();
         assert!(err.to_string().contains("NaN/Inf"), "{err}");
         // The refused bless left the old golden untouched.
         assert_eq!(
-            store.load("s", "light", false).unwrap().unwrap().data,
+            store
+                .load("s", TargetId::Light, false)
+                .unwrap()
+                .unwrap()
+                .data,
             image.data
         );
         let _ = std::fs::remove_dir_all(store.root());

@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 
 use engine::backend::TextureFormat;
 use engine::backend::{self, BackendKind};
-use engine::plan::{RenderPlan, TargetSpec};
-use engine::renderer::{self, Frame, Readback};
+use engine::plan::{TargetId, TargetSpec};
+use engine::renderer::{self, Faults, Frame, PreparedFrame, Readback, RenderError};
 use engine::scene_file::LoadedScene;
 use engine::Image;
 
@@ -27,6 +27,14 @@ pub enum SuiteError {
     /// A scene failed to load.
     #[error(transparent)]
     Scene(#[from] engine::scene_file::SceneFileError),
+    /// A scene loaded but cannot be drawn (the renderer's validation refused it).
+    #[error("{path}: {source}")]
+    Unrenderable {
+        /// Scene file.
+        path: PathBuf,
+        /// Why.
+        source: Box<RenderError>,
+    },
     /// The noise model (golden/noise.toml) cannot be read.
     #[error(transparent)]
     Noise(#[from] NoiseError),
@@ -69,14 +77,17 @@ pub enum LimitSource {
 pub struct Case {
     /// The loaded scene (with its shadow terms turned on: they are golden outputs).
     pub loaded: LoadedScene,
+    /// The scene as drawn and its plan: every golden pass comes from here, so an extracted
+    /// sun's shadow map and shadow term are golden passes too.
+    pub frame: PreparedFrame,
     /// Golden passes, in plan order.
-    pub passes: Vec<String>,
+    pub passes: Vec<TargetId>,
     /// Rule per golden pass.
-    pub rules: BTreeMap<String, Rule>,
+    pub rules: BTreeMap<TargetId, Rule>,
     /// Where each pass's limits came from.
-    pub limit_sources: BTreeMap<String, LimitSource>,
+    pub limit_sources: BTreeMap<TargetId, LimitSource>,
     /// Size and format per pass output.
-    targets: BTreeMap<String, TargetSpec>,
+    targets: BTreeMap<TargetId, TargetSpec>,
 }
 
 impl Case {
@@ -93,37 +104,41 @@ impl Case {
         // A shadowed light's shadow term is where a shadow change first shows: golden renders
         // read it back (a full-screen pass per shadowed light).
         loaded.scene.quality.debug_shadow_terms = true;
-        let plan = RenderPlan::new(&loaded.scene);
-        let passes: Vec<String> = plan
-            .target_names()
+        let frame =
+            PreparedFrame::new(&loaded.scene).map_err(|source| SuiteError::Unrenderable {
+                path: loaded.path.clone(),
+                source: Box::new(source),
+            })?;
+        let plan = frame.plan();
+        let passes: Vec<TargetId> = plan
+            .target_ids()
             .into_iter()
-            .filter(|t| pass_kind(t).is_some())
-            .map(str::to_owned)
+            .filter(|t| pass_kind(*t).is_some())
             .collect();
         let targets = passes
             .iter()
-            .filter_map(|p| Some((p.clone(), plan.target(p)?.clone())))
+            .filter_map(|p| Some((*p, plan.target(*p)?.clone())))
             .collect();
         let mut rules = BTreeMap::new();
         let mut limit_sources = BTreeMap::new();
-        for (pass, value) in &loaded.tolerances {
-            if !passes.contains(pass) {
+        for (name, value) in &loaded.tolerances {
+            let Some(pass) = passes.iter().copied().find(|p| p.to_string() == *name) else {
                 return Err(SuiteError::UnknownPass {
                     path: loaded.path.clone(),
-                    pass: pass.clone(),
-                    known: passes.join(", "),
+                    pass: name.clone(),
+                    known: crate::names(&passes),
                 });
-            }
-            let rule = Rule::from_toml(value, pass).map_err(|source| SuiteError::Tolerance {
+            };
+            let rule = Rule::from_toml(value, name).map_err(|source| SuiteError::Tolerance {
                 path: loaded.path.clone(),
                 source,
             })?;
-            rules.insert(pass.clone(), rule);
-            limit_sources.insert(pass.clone(), LimitSource::SceneFile);
+            rules.insert(pass, rule);
+            limit_sources.insert(pass, LimitSource::SceneFile);
         }
         let scene = loaded.scene.name.clone();
-        for pass in &passes {
-            if rules.contains_key(pass) {
+        for &pass in &passes {
+            if rules.contains_key(&pass) {
                 continue;
             }
             let kind = pass_kind(pass).expect("golden passes have a kind");
@@ -148,11 +163,12 @@ impl Case {
                     Rule::Check { metric, limit }
                 })
                 .collect();
-            rules.insert(pass.clone(), Rule::All(checks));
-            limit_sources.insert(pass.clone(), source);
+            rules.insert(pass, Rule::All(checks));
+            limit_sources.insert(pass, source);
         }
         Ok(Case {
             loaded,
+            frame,
             passes,
             rules,
             limit_sources,
@@ -172,15 +188,15 @@ impl Case {
     }
 
     /// Pixels of a pass's output (0 for an unknown pass).
-    pub fn pixels(&self, pass: &str) -> usize {
+    pub fn pixels(&self, pass: TargetId) -> usize {
         self.targets
-            .get(pass)
+            .get(&pass)
             .map_or(0, |t| t.width as usize * t.height as usize)
     }
 
     /// Whether a pass's output is 8-bit (its golden a PNG).
-    pub fn is_eight_bit(&self, pass: &str) -> bool {
-        self.targets.get(pass).is_some_and(|t| {
+    pub fn is_eight_bit(&self, pass: TargetId) -> bool {
+        self.targets.get(&pass).is_some_and(|t| {
             matches!(
                 t.format,
                 TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb
@@ -196,8 +212,8 @@ impl Case {
 
     /// Renders the golden passes on a given backend.
     pub fn render_on(&self, backend: &mut dyn backend::Backend) -> Result<Frame, String> {
-        let wanted: Vec<&str> = self.passes.iter().map(String::as_str).collect();
-        renderer::render(backend, &self.loaded.scene, Readback::Only(&wanted))
+        let readback = Readback::Only(&self.passes);
+        renderer::render_prepared(backend, &self.frame, readback, &Faults::default())
             .map_err(|e| e.to_string())
     }
 }
@@ -265,9 +281,9 @@ pub struct PassCheck {
     /// The scene as the command line names it ([`Case::argument`]).
     pub scene_argument: String,
     /// Pass.
-    pub pass: String,
+    pub pass: TargetId,
     /// Backend.
-    pub backend: String,
+    pub backend: BackendKind,
     /// Result.
     pub outcome: Outcome,
     /// The golden file compared with (or missing).
@@ -369,7 +385,12 @@ pub struct BlessChange {
 
 /// Compares a fresh output of `case`'s `pass` with its golden, for `harness bless` and
 /// `UPDATE_GOLDENS=1`: a pass within tolerance is left alone unless asked for by name.
-pub fn bless_change(store: &GoldenStore, case: &Case, pass: &str, image: &Image) -> BlessChange {
+pub fn bless_change(
+    store: &GoldenStore,
+    case: &Case,
+    pass: TargetId,
+    image: &Image,
+) -> BlessChange {
     let old = match store.load(case.name(), pass, golden::is_eight_bit(image)) {
         Ok(Some(old)) => old,
         Ok(None) => {
@@ -386,7 +407,7 @@ pub fn bless_change(store: &GoldenStore, case: &Case, pass: &str, image: &Image)
             }
         }
     };
-    match golden::check(image, Some(&old), &case.rules[pass]) {
+    match golden::check(image, Some(&old), &case.rules[&pass]) {
         Outcome::Passed(v) | Outcome::Failed(v) => {
             let metrics = v
                 .checks
@@ -444,7 +465,7 @@ pub fn clear_artifacts(failures: &Path, scene: &str) {
 pub fn check_pass(
     store: &GoldenStore,
     case: &Case,
-    pass: &str,
+    pass: TargetId,
     backend: BackendKind,
     actual: &Image,
     failures: &Path,
@@ -453,7 +474,7 @@ pub fn check_pass(
     let scene = case.name();
     let (golden_image, outcome) = match store.load(scene, pass, eight_bit) {
         Ok(golden_image) => {
-            let rule = &case.rules[pass];
+            let rule = &case.rules[&pass];
             let outcome = golden::check(actual, golden_image.as_ref(), rule);
             (golden_image, outcome)
         }
@@ -467,19 +488,19 @@ pub fn check_pass(
     PassCheck {
         scene: scene.to_owned(),
         scene_argument: case.argument(),
-        pass: pass.to_owned(),
-        backend: backend.name().to_owned(),
+        pass,
+        backend,
         outcome,
         golden_path: store.path(scene, pass, eight_bit),
         artifacts,
-        criterion: case.rules.get(pass).and_then(Rule::pixel_criterion),
+        criterion: case.rules.get(&pass).and_then(Rule::pixel_criterion),
     }
 }
 
 /// Writes actual, golden (as PNG) and diff heatmap for a pass into `dir`.
 pub fn write_artifacts(
     dir: &Path,
-    pass: &str,
+    pass: TargetId,
     actual: &Image,
     golden: Option<&Image>,
 ) -> Artifacts {

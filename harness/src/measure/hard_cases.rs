@@ -43,7 +43,7 @@ pub struct HardCaseRow {
     /// Case name.
     pub case: String,
     /// Backend.
-    pub backend: String,
+    pub backend: BackendKind,
     /// Non-finite values over every float pass.
     pub non_finite: usize,
     /// Light buffer range.
@@ -81,7 +81,7 @@ pub fn finiteness(frame: &Frame) -> (usize, f32, f32) {
             continue;
         };
         bad += data.iter().filter(|v| !v.is_finite()).count();
-        if name == engine::plan::LIGHT {
+        if *name == engine::plan::TargetId::Light {
             (min, max) = data
                 .iter()
                 .filter(|v| v.is_finite())
@@ -129,7 +129,7 @@ pub fn scaled(scene: &Scene, factor: f64) -> Scene {
 
 fn light(frame: &Frame) -> &[f32] {
     frame
-        .output(engine::plan::LIGHT)
+        .output(engine::plan::TargetId::Light)
         .and_then(|i| i.as_f32())
         .unwrap_or(&[])
 }
@@ -151,7 +151,7 @@ fn furnace_error(frame: &Frame) -> f64 {
     let mut pixels = 0;
     for channel in &frame.plan.mask_channels {
         let Some(mask) = frame
-            .output(&engine::plan::mask_target_name(channel.target))
+            .output(engine::plan::TargetId::Mask(channel.target))
             .and_then(|m| m.as_u8())
         else {
             return f64::NAN;
@@ -183,7 +183,7 @@ fn row(
     let (non_finite, light_min, light_max) = finiteness(frame);
     HardCaseRow {
         case: case.to_owned(),
-        backend: kind.name().to_owned(),
+        backend: kind,
         non_finite,
         light_min,
         light_max,
@@ -278,8 +278,12 @@ pub fn run(kind: BackendKind, mut progress: impl FnMut(&str)) -> Result<Vec<Hard
     ] {
         let frame = render(backend.as_mut(), &moved)?;
         let diff = crate::golden::metrics::compare::u8_difference(
-            reference.output("final").ok_or("no final image")?,
-            frame.output("final").ok_or("no final image")?,
+            reference
+                .output(engine::plan::TargetId::Final)
+                .ok_or("no final image")?,
+            frame
+                .output(engine::plan::TargetId::Final)
+                .ok_or("no final image")?,
             1,
         )
         .map_err(|e| e.to_string())?;

@@ -319,19 +319,10 @@ pub fn reference_pixels(
         .environment
         .as_ref()
         .ok_or_else(|| format!("scene `{}` has no environment", scene.name))?;
-    let image = |name: &str| {
-        frame
-            .output(name)
-            .ok_or_else(|| format!("frame has no `{name}` output"))
-    };
-    let gbuffer = [
-        image(plan::GBUFFER_TARGETS[0])?,
-        image(plan::GBUFFER_TARGETS[1])?,
-        image(plan::GBUFFER_TARGETS[2])?,
-        image(plan::GBUFFER_TARGETS[3])?,
-        image(plan::GBUFFER_TARGETS[4])?,
-    ];
-    let mask = image(&plan::mask_target_name(0))?
+    let gbuffer = crate::reference::lighting::gbuffer_images(frame).map_err(|e| e.to_string())?;
+    let mask = frame
+        .output(plan::TargetId::Mask(0))
+        .ok_or("frame has no `mask` output")?
         .as_u8()
         .ok_or("mask is not 8-bit")?;
     let channel = frame
@@ -391,7 +382,7 @@ pub fn reference_pixels(
 
 fn light_buffer(frame: &Frame) -> &[f32] {
     frame
-        .output(plan::LIGHT)
+        .output(plan::TargetId::Light)
         .and_then(|i| i.as_f32())
         .unwrap_or(&[])
 }

@@ -10,7 +10,7 @@
 
 use std::f64::consts::PI;
 
-use engine::plan;
+use engine::plan::TargetId;
 use engine::renderer::Frame;
 use engine::scene::{Light, LightingModel, Scene};
 use engine::Image;
@@ -280,10 +280,10 @@ pub struct LightingError {
 #[error("reference comparison: {0}")]
 pub struct ReferenceError(String);
 
-fn f32_image<'a>(frame: &'a Frame, name: &str) -> Result<&'a Image, ReferenceError> {
+fn f32_image(frame: &Frame, target: TargetId) -> Result<&Image, ReferenceError> {
     frame
-        .output(name)
-        .ok_or_else(|| ReferenceError(format!("frame has no `{name}` output")))
+        .output(target)
+        .ok_or_else(|| ReferenceError(format!("frame has no `{target}` output")))
 }
 
 fn sample(image: &Image, index: usize) -> [f64; 4] {
@@ -302,6 +302,18 @@ fn sample(image: &Image, index: usize) -> [f64; 4] {
             ]
         }
     }
+}
+
+/// The frame's five G-buffer outputs, in attachment order.
+pub fn gbuffer_images(frame: &Frame) -> Result<[&Image; 5], ReferenceError> {
+    let [p, n, t, a, m] = TargetId::GBUFFER;
+    Ok([
+        f32_image(frame, p)?,
+        f32_image(frame, n)?,
+        f32_image(frame, t)?,
+        f32_image(frame, a)?,
+        f32_image(frame, m)?,
+    ])
 }
 
 /// The G-buffer surface at pixel `index`.
@@ -327,16 +339,10 @@ pub fn reference_light_buffer(
     scene: &Scene,
     frame: &Frame,
 ) -> Result<Vec<(usize, LightingModel, DVec3)>, ReferenceError> {
-    let gbuffer = [
-        f32_image(frame, plan::GBUFFER_TARGETS[0])?,
-        f32_image(frame, plan::GBUFFER_TARGETS[1])?,
-        f32_image(frame, plan::GBUFFER_TARGETS[2])?,
-        f32_image(frame, plan::GBUFFER_TARGETS[3])?,
-        f32_image(frame, plan::GBUFFER_TARGETS[4])?,
-    ];
+    let gbuffer = gbuffer_images(frame)?;
     let masks: Vec<&Image> = (0..2)
-        .map(plan::mask_target_name)
-        .filter_map(|name| frame.output(&name))
+        .map(TargetId::Mask)
+        .filter_map(|mask| frame.output(mask))
         .collect();
     if masks.is_empty() {
         return Err(ReferenceError("frame has no mask output".into()));
@@ -365,7 +371,7 @@ pub fn reference_light_buffer(
 
 /// Compares the frame's light buffer with the reference (the metric of the module docs).
 pub fn lighting_error(scene: &Scene, frame: &Frame) -> Result<LightingError, ReferenceError> {
-    let light = f32_image(frame, plan::LIGHT)?;
+    let light = f32_image(frame, TargetId::Light)?;
     let reference = reference_light_buffer(scene, frame)?;
     let image_max = reference
         .iter()

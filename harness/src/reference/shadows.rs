@@ -3,7 +3,7 @@
 //! small bounding-volume hierarchy), compared with the GPU's shadow term read back from the
 //! `shadow_term_<light>` debug output of the renderer.
 
-use engine::plan;
+use engine::plan::{self, GBufferTarget, TargetId};
 use engine::renderer::Frame;
 use engine::scene::{Light, Scene};
 use engine::Image;
@@ -230,19 +230,19 @@ pub struct VisibilityError {
 }
 
 /// The G-buffer targets the ray cast reads (`mask_1` only where the plan has it).
-const CAST_INPUTS: [&str; 4] = [
-    plan::GBUFFER_TARGETS[0],
-    plan::GBUFFER_TARGETS[1],
-    "mask",
-    "mask_1",
+const CAST_INPUTS: [TargetId; 4] = [
+    TargetId::GBuffer(GBufferTarget::Position),
+    TargetId::GBuffer(GBufferTarget::Normal),
+    TargetId::Mask(0),
+    TargetId::Mask(1),
 ];
 
 /// The targets [`visibility_error`] reads for `light`, of those `plan` has: what a render
 /// for it needs to read back (with [`engine::renderer::Readback::Needed`], nothing else runs).
-pub fn visibility_targets(plan: &plan::RenderPlan, light: usize) -> Vec<String> {
-    std::iter::once(plan::shadow_term_target_name(light))
-        .chain(CAST_INPUTS.map(str::to_owned))
-        .filter(|name| plan.target(name).is_some())
+pub fn visibility_targets(plan: &plan::RenderPlan, light: usize) -> Vec<TargetId> {
+    std::iter::once(TargetId::ShadowTerm { light })
+        .chain(CAST_INPUTS)
+        .filter(|id| plan.target(*id).is_some())
         .collect()
 }
 
@@ -267,20 +267,21 @@ struct GbufferInputs<'a> {
 
 impl<'a> GbufferInputs<'a> {
     fn of(frame: &'a Frame) -> Result<Self, String> {
-        let float = |name: &str| {
+        let float = |target: TargetId| {
             frame
-                .output(name)
+                .output(target)
                 .and_then(|i| i.as_f32())
-                .ok_or_else(|| format!("frame has no float output `{name}`"))
+                .ok_or_else(|| format!("frame has no float output `{target}`"))
         };
+        let [position, normal, mask, mask_1] = CAST_INPUTS;
         Ok(Self {
-            position: float(plan::GBUFFER_TARGETS[0])?,
-            normal: float(plan::GBUFFER_TARGETS[1])?,
+            position: float(position)?,
+            normal: float(normal)?,
             mask: frame
-                .output("mask")
+                .output(mask)
                 .and_then(|i| i.as_u8())
                 .ok_or("frame has no mask output")?,
-            mask_1: frame.output("mask_1").and_then(|i| i.as_u8()),
+            mask_1: frame.output(mask_1).and_then(|i| i.as_u8()),
         })
     }
 }
@@ -341,7 +342,7 @@ impl RayCastVisibility {
             .collect();
         Ok(Self {
             light,
-            gbuffer: CAST_INPUTS.map(|name| frame.output(name).cloned()).into(),
+            gbuffer: CAST_INPUTS.map(|id| frame.output(id).cloned()).into(),
             visible,
         })
     }
@@ -351,7 +352,7 @@ impl RayCastVisibility {
         CAST_INPUTS
             .iter()
             .zip(&self.gbuffer)
-            .all(|(name, own)| match (own, frame.output(name)) {
+            .all(|(id, own)| match (own, frame.output(*id)) {
                 (Some(own), Some(theirs)) => bitwise_equal(own, theirs),
                 (own, theirs) => own.is_none() && theirs.is_none(),
             })
@@ -360,9 +361,9 @@ impl RayCastVisibility {
     /// `frame`'s shadow term of this light against the cast (the frame must have the same
     /// G-buffer: see [`RayCastVisibility::holds_for`]).
     pub fn error(&self, frame: &Frame) -> Result<VisibilityError, String> {
-        let name = plan::shadow_term_target_name(self.light);
+        let name = TargetId::ShadowTerm { light: self.light };
         let term = frame
-            .output(&name)
+            .output(name)
             .and_then(|i| i.as_f32())
             .ok_or_else(|| format!("frame has no float output `{name}`"))?;
         if term.len() != self.visible.len() * 4 {

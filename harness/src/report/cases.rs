@@ -5,6 +5,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use engine::plan::TargetId;
 use engine::Image;
 
 use super::pixels::{display_mode, pixel_bytes, Blobs};
@@ -44,11 +45,11 @@ pub(super) fn cases(
     };
     let keys = case_keys(run);
     let failing =
-        |scene: &str, pass: &str| results_of(run, scene, pass).any(|r| !r.outcome.passed());
+        |scene: &str, pass: TargetId| results_of(run, scene, pass).any(|r| !r.outcome.passed());
 
     out.push_str("<h2 id=\"failing\">Failing passes</h2>");
     let mut any = false;
-    for &(scene, pass) in keys.iter().filter(|(s, p)| failing(s, p)) {
+    for &(scene, pass) in keys.iter().filter(|(s, p)| failing(s, *p)) {
         any = true;
         page.failing_case(out, blobs, scene, pass);
     }
@@ -57,18 +58,18 @@ pub(super) fn cases(
     }
 
     out.push_str("<h2 id=\"passing\">Passing passes</h2><div class=\"thumbs\">");
-    for &(scene, pass) in keys.iter().filter(|(s, p)| !failing(s, p)) {
+    for &(scene, pass) in keys.iter().filter(|(s, p)| !failing(s, *p)) {
         page.passing_case(out, scene, pass);
     }
     out.push_str("</div>");
 }
 
 /// Every scene's pass of the run, once each, in the order of the results.
-fn case_keys(run: &CheckRun) -> Vec<(&str, &str)> {
-    let mut keys: Vec<(&str, &str)> = Vec::new();
+fn case_keys(run: &CheckRun) -> Vec<(&str, TargetId)> {
+    let mut keys: Vec<(&str, TargetId)> = Vec::new();
     for r in &run.results {
-        if !keys.contains(&(r.scene.as_str(), r.pass.as_str())) {
-            keys.push((r.scene.as_str(), r.pass.as_str()));
+        if !keys.contains(&(r.scene.as_str(), r.pass)) {
+            keys.push((r.scene.as_str(), r.pass));
         }
     }
     keys
@@ -78,7 +79,7 @@ fn case_keys(run: &CheckRun) -> Vec<(&str, &str)> {
 fn results_of<'a>(
     run: &'a CheckRun,
     scene: &'a str,
-    pass: &'a str,
+    pass: TargetId,
 ) -> impl Iterator<Item = &'a PassCheck> + 'a {
     run.results
         .iter()
@@ -87,7 +88,7 @@ fn results_of<'a>(
 
 impl Page<'_> {
     /// The golden of a scene's pass, in the storage its results name.
-    fn golden(&self, scene: &str, pass: &str) -> Option<Image> {
+    fn golden(&self, scene: &str, pass: TargetId) -> Option<Image> {
         let eight_bit = results_of(self.run, scene, pass)
             .next()
             .map(|r| r.golden_path.extension().is_some_and(|e| e == "png"))
@@ -97,7 +98,7 @@ impl Page<'_> {
 
     /// A failing pass: its bless command, each backend's result, and a comparison for each
     /// backend that failed.
-    fn failing_case(&self, out: &mut String, blobs: &mut Blobs, scene: &str, pass: &str) {
+    fn failing_case(&self, out: &mut String, blobs: &mut Blobs, scene: &str, pass: TargetId) {
         let golden_image = self.golden(scene, pass);
         // Embedded once, when the first viewer needs it.
         let mut golden_blob = None;
@@ -106,7 +107,7 @@ impl Page<'_> {
             "<section class=\"case failing\" id=\"{}\"><h3>{} / {}</h3>",
             case_id(scene, pass),
             escape(scene),
-            escape(pass)
+            escape(&pass.to_string())
         );
         if let Some(first) = results_of(self.run, scene, pass).next() {
             let _ = write!(
@@ -135,7 +136,7 @@ impl Page<'_> {
             } else {
                 "failed"
             },
-            escape(&r.backend),
+            escape(r.backend.name()),
             result_label(&r.outcome),
             escape(&metrics_text(&r.outcome))
         );
@@ -170,8 +171,8 @@ impl Page<'_> {
         golden_image: Option<&Image>,
         golden_blob: &mut Option<usize>,
     ) {
-        let pass = r.pass.as_str();
-        let key = (r.scene.clone(), r.pass.clone(), r.backend.clone());
+        let pass = r.pass;
+        let key = (r.scene.clone(), r.pass, r.backend);
         let (Some(actual), Some(golden_image)) = (self.outputs.get(&key), golden_image) else {
             if let Some(actual) = self.outputs.get(&key) {
                 out.push_str(&thumbnail("actual (no golden to compare)", actual, pass));
@@ -207,9 +208,9 @@ impl Page<'_> {
     }
 
     /// A passing pass: a thumbnail of its golden, captioned with the backends it passed on.
-    fn passing_case(&self, out: &mut String, scene: &str, pass: &str) {
+    fn passing_case(&self, out: &mut String, scene: &str, pass: TargetId) {
         let backends: Vec<&str> = results_of(self.run, scene, pass)
-            .map(|r| r.backend.as_str())
+            .map(|r| r.backend.name())
             .collect();
         let _ = write!(
             out,
@@ -237,7 +238,7 @@ fn viewer(
     golden_image: &Image,
     golden_blob: &mut Option<usize>,
 ) {
-    let pass = r.pass.as_str();
+    let pass = r.pass;
     let (kind, bytes) = pixel_bytes(actual, actual);
     let actual_blob = blobs.add(&bytes);
     let golden_blob =
@@ -256,7 +257,7 @@ fn viewer(
          data-golden=\"{golden_blob}\" data-actual=\"{actual_blob}\" \
          data-threshold=\"{}\" data-floor=\"{}\" data-rgb=\"{}\"><noscript>The viewer \
          needs JavaScript.</noscript></div>",
-        escape(&r.backend),
+        escape(r.backend.name()),
         actual.width,
         actual.height,
         actual.channels(),

@@ -15,6 +15,7 @@
 //! `tables.rs` the summary and the backend tables, `pixels.rs` the embedded pixel data, and
 //! `thumbnails.rs` the small PNG previews.
 
+use engine::plan::TargetId;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -48,13 +49,13 @@ pub trait Section {
 }
 
 /// The anchor of a scene's pass on the page.
-fn case_id(scene: &str, pass: &str) -> String {
+fn case_id(scene: &str, pass: TargetId) -> String {
     let clean = |s: &str| {
         s.chars()
             .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
             .collect::<String>()
     };
-    format!("case-{}-{}", clean(scene), clean(pass))
+    format!("case-{}-{}", clean(scene), clean(&pass.to_string()))
 }
 
 /// The checks of a result as text, worst first, with the largest difference.
@@ -146,7 +147,7 @@ pub fn html(
             out,
             "<p class=\"failed\">render of {} on {} failed: {}</p>",
             escape(scene),
-            escape(backend),
+            backend,
             escape(error)
         );
     }

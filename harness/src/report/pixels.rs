@@ -4,20 +4,45 @@
 use std::fmt::Write as _;
 
 use base64::Engine as _;
+use engine::plan::{TargetContent, TargetId};
 use engine::{Image, ImageData};
 
-/// How the viewer maps a pass's values to the screen.
-pub(super) fn display_mode(image: &Image, pass: &str) -> &'static str {
-    match (&image.data, pass) {
-        (ImageData::U8(_), _) => "srgb8",
-        (ImageData::F32(_), "depth") => "depth",
-        (ImageData::F32(_), "light") => "hdr",
-        (ImageData::F32(_), p)
-            if p.starts_with("gbuffer_normal") || p.starts_with("gbuffer_tangent") =>
-        {
-            "signed"
-        }
-        (ImageData::F32(_), _) => "linear",
+/// How the page maps a pass's values to the screen, from what the plan says the target holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Display {
+    /// 8-bit values as they are.
+    Srgb8,
+    /// Depth stretched over its range (the camera's depth, shadow maps).
+    Depth,
+    /// HDR radiance, tone-mapped for viewing.
+    Hdr,
+    /// Unit vectors, [-1, 1] mapped to [0, 1].
+    Signed,
+    /// Float values as they are.
+    Linear,
+}
+
+/// How `image`, the output of `pass`, is shown.
+pub(super) fn display(image: &Image, pass: TargetId) -> Display {
+    if matches!(image.data, ImageData::U8(_)) {
+        return Display::Srgb8;
+    }
+    match (pass.content(), pass) {
+        (TargetContent::Depth, _) => Display::Depth,
+        (TargetContent::Radiance, _) => Display::Hdr,
+        (_, TargetId::GBuffer(g)) if g.holds_directions() => Display::Signed,
+        _ => Display::Linear,
+    }
+}
+
+/// The viewer's name of a pass's display mapping.
+pub(super) fn display_mode(image: &Image, pass: TargetId) -> &'static str {
+    match display(image, pass) {
+        Display::Srgb8 => "srgb8",
+        Display::Depth => "depth",
+        Display::Hdr => "hdr",
+        Display::Signed => "signed",
+        Display::Linear => "linear",
     }
 }
 

@@ -27,9 +27,9 @@ pub(super) fn summary(out: &mut String, run: &CheckRun) {
             "<tr class=\"{class}\"><td>{}</td><td><a href=\"#{}\">{}</a></td><td>{}</td>\
              <td>{}</td><td><code>{}</code></td></tr>",
             escape(&r.scene),
-            case_id(&r.scene, &r.pass),
-            escape(&r.pass),
-            escape(&r.backend),
+            case_id(&r.scene, r.pass),
+            r.pass,
+            r.backend,
             result_label(&r.outcome),
             escape(&metrics_text(&r.outcome)).replace('\n', "<br>")
         );
@@ -71,7 +71,7 @@ pub(super) fn details(out: &mut String, run: &CheckRun) {
             "<tr class=\"{}\"><td>{}</td><td>{}</td><td>{} vs {}</td><td>{:.3e}</td><td>{:.3e}</td><td>{}</td></tr>",
             if c.within_tolerance { "passed" } else { "failed" },
             escape(&c.scene),
-            escape(&c.pass),
+            c.pass,
             c.a,
             c.b,
             c.max_abs,
@@ -90,7 +90,7 @@ pub(super) fn details(out: &mut String, run: &CheckRun) {
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             escape(&t.scene),
             t.backend,
-            escape(&t.pass),
+            t.pass,
             t.ms.map_or("-".to_owned(), |ms| format!("{ms:.3}"))
         );
     }

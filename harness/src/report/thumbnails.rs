@@ -2,7 +2,10 @@
 //! embedded in the page as a PNG data URI with a caption.
 
 use base64::Engine as _;
+use engine::plan::TargetId;
 use engine::{Image, ImageData};
+
+use super::pixels::{display, Display};
 
 use crate::html::escape;
 use crate::images;
@@ -12,9 +15,9 @@ const PREVIEW: u32 = 160;
 
 /// An 8-bit thumbnail of a pass output: HDR values Reinhard-mapped, depth stretched over its
 /// range, 8-bit images as they are; box-downscaled to at most [`PREVIEW`] pixels.
-pub fn preview(image: &Image, pass: &str) -> Image {
-    let display = match (&image.data, pass) {
-        (ImageData::F32(data), "depth") => {
+pub fn preview(image: &Image, pass: TargetId) -> Image {
+    let display = match (&image.data, display(image, pass)) {
+        (ImageData::F32(data), Display::Depth) => {
             let finite = data.iter().copied().filter(|v| v.is_finite() && *v < 1.0);
             let (lo, hi) = finite.fold((f32::MAX, f32::MIN), |(lo, hi), v| (lo.min(v), hi.max(v)));
             let span = (hi - lo).max(1e-9);
@@ -27,16 +30,14 @@ pub fn preview(image: &Image, pass: &str) -> Image {
                 ..image.clone()
             })
         }
-        (ImageData::F32(data), "light") => images::display_u8(&Image {
+        (ImageData::F32(data), Display::Hdr) => images::display_u8(&Image {
             data: ImageData::F32(data.iter().map(|&v| v / (1.0 + v.abs())).collect()),
             ..image.clone()
         }),
-        (ImageData::F32(data), p) if p.starts_with("gbuffer_normal") => {
-            images::display_u8(&Image {
-                data: ImageData::F32(data.iter().map(|&v| v * 0.5 + 0.5).collect()),
-                ..image.clone()
-            })
-        }
+        (ImageData::F32(data), Display::Signed) => images::display_u8(&Image {
+            data: ImageData::F32(data.iter().map(|&v| v * 0.5 + 0.5).collect()),
+            ..image.clone()
+        }),
         _ => images::display_u8(image),
     };
     downscale(&display)
@@ -91,7 +92,7 @@ fn data_uri(image: &Image) -> String {
 }
 
 /// A small PNG thumbnail with a caption.
-pub(super) fn thumbnail(label: &str, image: &Image, pass: &str) -> String {
+pub(super) fn thumbnail(label: &str, image: &Image, pass: TargetId) -> String {
     format!(
         "<figure><img src=\"{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>",
         data_uri(&preview(image, pass)),

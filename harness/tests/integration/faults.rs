@@ -5,6 +5,7 @@
 //! half-written.
 
 use crate::common;
+use engine::plan::TargetId;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -149,7 +150,7 @@ fn a_failed_readback_names_the_scene_the_output_and_the_backend() {
     for kind in common::available_backends() {
         let mut backend = Faulty::new(kind);
         backend.fail_readback = true;
-        let error = renderer::render(&mut backend, &chess(), Readback::Only(&["light"]))
+        let error = renderer::render(&mut backend, &chess(), Readback::Only(&[TargetId::Light]))
             .err()
             .expect("a failed readback must fail the render")
             .to_string();
@@ -194,7 +195,7 @@ fn a_backend_lost_mid_run_fails_its_scene_and_the_run_goes_on() {
     assert_eq!(run.render_errors.len(), 1, "{:?}", run.render_errors);
     let (scene, backend, error) = &run.render_errors[0];
     eprintln!("{scene} on {backend}: {error}");
-    assert_eq!(backend, kind.name());
+    assert_eq!(*backend, kind);
     assert!(
         error.contains(&format!("scene `{scene}`"))
             && error.contains("device lost")
@@ -202,21 +203,15 @@ fn a_backend_lost_mid_run_fails_its_scene_and_the_run_goes_on() {
         "{error}"
     );
     // The lost scene's first pass is named.
-    let plan = engine::plan::RenderPlan::new(
-        &cases
-            .iter()
-            .find(|c| c.name() == scene)
-            .unwrap()
-            .loaded
-            .scene,
-    );
-    assert!(error.contains(&plan.passes[0].name), "{error}");
+    let case = cases.iter().find(|c| c.name() == scene).unwrap();
+    let first = case.frame.plan().passes[0].id;
+    assert!(error.contains(&first.to_string()), "{error}");
     // Everything else was rendered and checked, and passed.
     let renders = cases.len();
-    let checked: std::collections::BTreeSet<(&str, &str)> = run
+    let checked: std::collections::BTreeSet<(&str, engine::backend::BackendKind)> = run
         .results
         .iter()
-        .map(|r| (r.scene.as_str(), r.backend.as_str()))
+        .map(|r| (r.scene.as_str(), r.backend))
         .collect();
     assert_eq!(checked.len(), renders - 1);
     assert!(run.results.iter().all(|r| r.outcome.passed()));

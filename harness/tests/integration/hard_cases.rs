@@ -4,6 +4,7 @@
 //! against the f64 reference at p99.9 <= 2e-3 where that is defined).
 
 use crate::common;
+use engine::plan::{GBufferTarget, TargetId};
 use harness::measure::hard_cases;
 
 /// Every hard case holds its invariants on every available backend.
@@ -44,12 +45,12 @@ fn grazing_case_reaches_a_millionth() {
         let frame =
             engine::renderer::render(backend.as_mut(), &scene, engine::renderer::Readback::All)
                 .unwrap();
-        let get = |name: &str| frame.output(name).unwrap();
+        let get = |g| frame.output(TargetId::GBuffer(g)).unwrap();
         let (p, n) = (
-            get("gbuffer_position").as_f32().unwrap(),
-            get("gbuffer_normal").as_f32().unwrap(),
+            get(GBufferTarget::Position).as_f32().unwrap(),
+            get(GBufferTarget::Normal).as_f32().unwrap(),
         );
-        let mask = get("mask").as_u8().unwrap();
+        let mask = frame.output(TargetId::Mask(0)).unwrap().as_u8().unwrap();
         let min = (0..p.len() / 4)
             .filter(|i| mask[i * 4..i * 4 + 4].iter().any(|&m| m > 127))
             .map(|i| {

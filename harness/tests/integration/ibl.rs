@@ -2,6 +2,7 @@
 //! that do not depend on the prefilter's sample pattern.
 
 use crate::common;
+use engine::plan::{GBufferTarget, TargetId};
 use std::sync::Arc;
 
 use engine::renderer::{self, Frame, Readback};
@@ -18,10 +19,18 @@ fn render(backend: &mut dyn Backend, scene: &Scene) -> Frame {
 
 /// Covered pixels as (light rgb, n.v).
 fn covered(frame: &Frame) -> Vec<([f32; 3], f32)> {
-    let light = frame.output("light").unwrap().as_f32().unwrap();
-    let position = frame.output("gbuffer_position").unwrap().as_f32().unwrap();
-    let normal = frame.output("gbuffer_normal").unwrap().as_f32().unwrap();
-    let mask = frame.output("mask").unwrap().as_u8().unwrap();
+    let light = frame.output(TargetId::Light).unwrap().as_f32().unwrap();
+    let position = frame
+        .output(TargetId::GBuffer(GBufferTarget::Position))
+        .unwrap()
+        .as_f32()
+        .unwrap();
+    let normal = frame
+        .output(TargetId::GBuffer(GBufferTarget::Normal))
+        .unwrap()
+        .as_f32()
+        .unwrap();
+    let mask = frame.output(TargetId::Mask(0)).unwrap().as_u8().unwrap();
     (0..light.len() / 4)
         .filter(|&i| mask[i * 4..i * 4 + 4].iter().any(|&m| m > 127))
         .map(|i| {
@@ -137,8 +146,8 @@ fn sample_seeds_give_the_same_picture() {
     let a = render(backend.as_mut(), &loaded.scene);
     let b = render(backend.as_mut(), &other);
     let (la, lb) = (
-        a.output("light").unwrap().as_f32().unwrap(),
-        b.output("light").unwrap().as_f32().unwrap(),
+        a.output(TargetId::Light).unwrap().as_f32().unwrap(),
+        b.output(TargetId::Light).unwrap().as_f32().unwrap(),
     );
     let mut errors: Vec<f64> = la
         .iter()
@@ -233,8 +242,12 @@ fn extracted_sun_casts_a_shadow() {
     let camera = scene.camera.position;
     // Floor pixels, split by whether the unit sphere at the origin hides the sun from them.
     let floor_light = |frame: &Frame| {
-        let light = frame.output("light").unwrap().as_f32().unwrap();
-        let position = frame.output("gbuffer_position").unwrap().as_f32().unwrap();
+        let light = frame.output(TargetId::Light).unwrap().as_f32().unwrap();
+        let position = frame
+            .output(TargetId::GBuffer(GBufferTarget::Position))
+            .unwrap()
+            .as_f32()
+            .unwrap();
         let (mut shadowed, mut open) = (Vec::new(), Vec::new());
         for i in 0..light.len() / 4 {
             let p = glam::Vec3::from_slice(&position[i * 4..i * 4 + 3]).as_dvec3() + camera;
@@ -267,7 +280,7 @@ fn extracted_sun_casts_a_shadow() {
                 .plan
                 .passes
                 .iter()
-                .any(|p| p.name.starts_with("shadow")),
+                .any(|p| matches!(p.id, engine::plan::PassId::Shadow { .. })),
             "{kind}: no shadow pass for the sun"
         );
         let (shadowed, open) = floor_light(&frame);
@@ -317,15 +330,23 @@ fn extracted_sun_reflects_as_a_disc() {
     for kind in common::available_backends() {
         let mut backend = engine::backend::create(kind).unwrap();
         let frame = render(backend.as_mut(), &scene);
-        let light = frame.output("light").unwrap().as_f32().unwrap();
+        let light = frame.output(TargetId::Light).unwrap().as_f32().unwrap();
         let peak = light.chunks_exact(4).map(|p| p[1]).fold(0.0f32, f32::max);
         let bright = light
             .chunks_exact(4)
             .filter(|p| p[1] > 0.5 * expected)
             .count();
         // Pixels whose mirror direction falls inside the sun's disc, from the G-buffer.
-        let position = frame.output("gbuffer_position").unwrap().as_f32().unwrap();
-        let normal = frame.output("gbuffer_normal").unwrap().as_f32().unwrap();
+        let position = frame
+            .output(TargetId::GBuffer(GBufferTarget::Position))
+            .unwrap()
+            .as_f32()
+            .unwrap();
+        let normal = frame
+            .output(TargetId::GBuffer(GBufferTarget::Normal))
+            .unwrap()
+            .as_f32()
+            .unwrap();
         let cos_radius = 3f32.to_radians().cos();
         let inside = (0..light.len() / 4)
             .filter(|&i| {

@@ -7,6 +7,7 @@
 
 use crate::common;
 use engine::backend::*;
+use engine::plan::TargetId;
 use rusty_fork::rusty_fork_test;
 
 /// Resident set size of this process, in bytes.
@@ -204,7 +205,7 @@ rusty_fork_test! {
                 engine::renderer::render(
                     backend.as_mut(),
                     &scene,
-                    engine::renderer::Readback::Only(&["final"]),
+                    engine::renderer::Readback::Only(&[TargetId::Final]),
                 )
                 .unwrap();
                 if i + 1 == WARM_UP {

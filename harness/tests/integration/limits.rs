@@ -4,6 +4,7 @@
 
 use crate::common;
 use engine::assets::{self, AssetError, ColorSpace, Limits, TextureCache};
+use engine::plan::TargetId;
 use engine::renderer::{self, Readback};
 
 fn crc32(bytes: &[u8]) -> u32 {
@@ -136,13 +137,18 @@ fn with_limits_off_rendering_is_unchanged() {
     };
     let mut backend = engine::backend::create(kind).unwrap();
     let render = |backend: &mut dyn engine::Backend, scene| {
-        renderer::render(backend, scene, Readback::Only(&["final", "light"])).unwrap()
+        renderer::render(
+            backend,
+            scene,
+            Readback::Only(&[TargetId::Final, TargetId::Light]),
+        )
+        .unwrap()
     };
     let a = render(backend.as_mut(), &default.scene);
     let b = render(backend.as_mut(), &none.scene);
-    for name in ["final", "light"] {
+    for name in [TargetId::Final, TargetId::Light] {
         assert!(
-            a.outputs[name] == b.outputs[name],
+            a.outputs[&name] == b.outputs[&name],
             "{kind}: `{name}` differs with limits off"
         );
     }

@@ -5,6 +5,7 @@
 
 use crate::common;
 use engine::assets::{srgb_to_linear, ColorSpace, TextureCache};
+use engine::plan::{GBufferTarget, TargetId};
 use engine::renderer::{self, Readback};
 
 fn crate_scene() -> engine::scene_file::LoadedScene {
@@ -88,15 +89,19 @@ fn the_untidy_crate_renders_with_its_textures_on_every_backend() {
         let frame = renderer::render(
             backend.as_mut(),
             &loaded.scene,
-            Readback::Only(&["gbuffer_albedo", "light"]),
+            Readback::Only(&[TargetId::GBuffer(GBufferTarget::Albedo), TargetId::Light]),
         )
         .unwrap_or_else(|e| panic!("{kind}: {e}"));
-        let light = frame.output("light").unwrap().as_f32().unwrap();
+        let light = frame.output(TargetId::Light).unwrap().as_f32().unwrap();
         assert!(
             light.iter().all(|v| v.is_finite()),
             "{kind}: non-finite light"
         );
-        let albedo = frame.output("gbuffer_albedo").unwrap().as_f32().unwrap();
+        let albedo = frame
+            .output(TargetId::GBuffer(GBufferTarget::Albedo))
+            .unwrap()
+            .as_f32()
+            .unwrap();
         // Wood: clearly redder than blue (the floor is gray, the label the default white).
         let wood: Vec<&[f32]> = albedo
             .chunks_exact(4)

@@ -2,6 +2,7 @@
 //! limit derived from its figures as documented (margin x max(noise, resolution)); renders
 //! recorded on another host pass with room. None of this renders: it needs no backend.
 
+use engine::plan::TargetId;
 use harness::golden::noise::{self, NoiseModel, MAX_NOISE_RATIO};
 use harness::golden::portability;
 use harness::golden::suite::{self, LimitSource};
@@ -25,14 +26,14 @@ fn every_golden_check_has_figures_and_a_limit_derived_from_them() {
     assert_eq!(model.margin, noise::DEFAULT_MARGIN);
     let cases = suite::canonical_cases().unwrap();
     for case in &cases {
-        for pass in &case.passes {
+        for &pass in &case.passes {
             assert_eq!(
-                case.limit_sources[pass],
+                case.limit_sources[&pass],
                 LimitSource::NoiseModel,
                 "{}/{pass}: limits not from golden/noise.toml",
                 case.name()
             );
-            for (metric, limit) in case.rules[pass].checks() {
+            for (metric, limit) in case.rules[&pass].checks() {
                 let key = metric.to_string();
                 let figures = model
                     .figures(case.name(), pass, &key)
@@ -56,7 +57,7 @@ fn every_golden_check_has_figures_and_a_limit_derived_from_them() {
                 );
                 for required in REQUIRED_SOURCES {
                     // The mask's exact one-hot values have nothing to round.
-                    if required == "synthetic-rounding/" && pass.starts_with("mask") {
+                    if required == "synthetic-rounding/" && matches!(pass, TargetId::Mask(_)) {
                         continue;
                     }
                     assert!(
@@ -112,8 +113,8 @@ fn renders_recorded_on_another_host_pass_with_room() {
 fn synthetic_rounding_moves_the_final_image_by_one_step_on_many_pixels() {
     let store = GoldenStore::workspace();
     for scene in ["chess", "ibl"] {
-        let light = store.load(scene, "light", false).unwrap().unwrap();
-        let golden = store.load(scene, "final", true).unwrap().unwrap();
+        let light = store.load(scene, TargetId::Light, false).unwrap().unwrap();
+        let golden = store.load(scene, TargetId::Final, true).unwrap().unwrap();
         let requantized = portability::requantize_final(&light, engine::scene::ToneMap::Aces);
         let (a, g) = (requantized.as_u8().unwrap(), golden.as_u8().unwrap());
         let mut moved = 0;

@@ -3,17 +3,24 @@
 //! After an intended change: `INSTA_UPDATE=always cargo test -p harness --test integration
 //! plans::` (or `cargo insta review`), then read the diff.
 
-use engine::plan::RenderPlan;
+use engine::plan::{PassId, RenderPlan, TargetId};
+use engine::renderer::PreparedFrame;
+use engine::scene::{LightingModel, Scene};
 use harness::test_scenes;
+
+/// The plan of `scene` as drawn.
+fn plan_of(scene: &Scene) -> RenderPlan {
+    PreparedFrame::new(scene)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .plan()
+        .clone()
+}
 
 #[test]
 fn canonical_scene_plans() {
     for name in ["chess", "arrow", "ibl"] {
         let loaded = harness::load_scene(name).unwrap_or_else(|e| panic!("{e}"));
-        insta::assert_snapshot!(
-            format!("plan_{name}"),
-            RenderPlan::new(&loaded.scene).to_string()
-        );
+        insta::assert_snapshot!(format!("plan_{name}"), plan_of(&loaded.scene).to_string());
     }
 }
 
@@ -25,10 +32,7 @@ fn test_scene_plans() {
         test_scenes::five_models(160),
         test_scenes::many_point_lights(128, 64),
     ] {
-        insta::assert_snapshot!(
-            format!("plan_{}", scene.name),
-            RenderPlan::new(&scene).to_string()
-        );
+        insta::assert_snapshot!(format!("plan_{}", scene.name), plan_of(&scene).to_string());
     }
 }
 
@@ -36,21 +40,21 @@ fn test_scene_plans() {
 /// models, no lighting pass for an unused model, no gizmos unless asked.
 #[test]
 fn plans_contain_only_what_the_scene_needs() {
-    let grid = RenderPlan::new(&test_scenes::material_grid(64));
-    let names: Vec<&str> = grid.passes.iter().map(|p| p.name.as_str()).collect();
+    let grid = plan_of(&test_scenes::material_grid(64));
+    let passes: Vec<PassId> = grid.passes.iter().map(|p| p.id).collect();
     assert_eq!(
-        names,
+        passes,
         [
-            "geometry",
-            "mask",
-            "lighting_pbr",
-            "lighting_blinn_phong",
-            "tonemap"
+            PassId::Geometry,
+            PassId::ShaderMask,
+            PassId::Lighting(LightingModel::Pbr),
+            PassId::Lighting(LightingModel::BlinnPhong),
+            PassId::ToneMap
         ]
     );
-    assert!(grid.target("mask_1").is_none());
-    let five = RenderPlan::new(&test_scenes::five_models(64));
-    assert!(five.target("mask_1").is_some());
+    assert!(grid.target(TargetId::Mask(1)).is_none());
+    let five = plan_of(&test_scenes::five_models(64));
+    assert!(five.target(TargetId::Mask(1)).is_some());
     assert_eq!(five.mask_channels.len(), 5);
 }
 
@@ -67,11 +71,8 @@ fn shadow_variant_plans() {
             s.filter = engine::scene::ShadowFilter::Vsm;
         }
     }
-    insta::assert_snapshot!("plan_chess_vsm", RenderPlan::new(&chess).to_string());
+    insta::assert_snapshot!("plan_chess_vsm", plan_of(&chess).to_string());
     let mut arrow = harness::load_scene("arrow").unwrap().scene;
     arrow.quality.point_shadows = engine::scene::PointShadowPass::GeometryShader;
-    insta::assert_snapshot!(
-        "plan_arrow_geometry_shader",
-        RenderPlan::new(&arrow).to_string()
-    );
+    insta::assert_snapshot!("plan_arrow_geometry_shader", plan_of(&arrow).to_string());
 }

@@ -2,7 +2,8 @@
 //! renderer's invariants: white furnace, 10 km from the origin, five lighting models, 64 lights.
 
 use crate::common;
-use engine::renderer::{self, Frame, Readback};
+use engine::plan::{GBufferTarget, PassId, TargetId};
+use engine::renderer::{self, Frame, PreparedFrame, Readback};
 use engine::scene::Scene;
 use engine::{Backend, Image};
 use glam::DVec3;
@@ -30,7 +31,10 @@ fn lighting_pass_matches_the_f64_reference() {
     for kind in common::available_backends() {
         let mut backend = engine::backend::create(kind).unwrap();
         let frame = render(backend.as_mut(), &scene);
-        save(&format!("grid_{kind}"), frame.output("final").unwrap());
+        save(
+            &format!("grid_{kind}"),
+            frame.output(TargetId::Final).unwrap(),
+        );
         let error = reference::lighting_error(&scene, &frame).unwrap();
         eprintln!("{kind}: {error:?}");
         assert!(
@@ -84,8 +88,8 @@ fn white_furnace_returns_the_albedo() {
         for albedo in [1.0f32, 0.5] {
             let scene = test_scenes::white_furnace(128, albedo);
             let frame = render(backend.as_mut(), &scene);
-            let light = frame.output("light").unwrap().as_f32().unwrap();
-            let mask = frame.output("mask").unwrap().as_u8().unwrap();
+            let light = frame.output(TargetId::Light).unwrap().as_f32().unwrap();
+            let mask = frame.output(TargetId::Mask(0)).unwrap().as_u8().unwrap();
             let mut covered = 0;
             for (texel, m) in light.chunks_exact(4).zip(mask.chunks_exact(4)) {
                 if m[0] == 0 {
@@ -118,8 +122,8 @@ fn scene_far_from_the_origin_matches_the_scene_at_the_origin() {
         let a = render(backend.as_mut(), &near);
         let b = render(backend.as_mut(), &far);
         let diff = harness::golden::metrics::compare::u8_difference(
-            a.output("final").unwrap(),
-            b.output("final").unwrap(),
+            a.output(TargetId::Final).unwrap(),
+            b.output(TargetId::Final).unwrap(),
             1,
         )
         .unwrap();
@@ -142,12 +146,12 @@ fn five_models_route_every_pixel_to_exactly_one_model() {
         let frame = render(backend.as_mut(), &scene);
         save(
             &format!("five_models_{kind}"),
-            frame.output("final").unwrap(),
+            frame.output(TargetId::Final).unwrap(),
         );
         assert_eq!(frame.plan.mask_channels.len(), 5);
-        let mask0 = frame.output("mask").unwrap().as_u8().unwrap();
-        let mask1 = frame.output("mask_1").unwrap().as_u8().unwrap();
-        let depth = frame.output("depth").unwrap().as_f32().unwrap();
+        let mask0 = frame.output(TargetId::Mask(0)).unwrap().as_u8().unwrap();
+        let mask1 = frame.output(TargetId::Mask(1)).unwrap().as_u8().unwrap();
+        let depth = frame.output(TargetId::Depth).unwrap().as_f32().unwrap();
         let mut per_model = [0usize; 5];
         for i in 0..depth.len() {
             let flags: Vec<usize> = frame
@@ -188,11 +192,14 @@ fn sixty_four_point_lights() {
     for kind in common::available_backends() {
         let mut backend = engine::backend::create(kind).unwrap();
         let frame = render(backend.as_mut(), &scene);
-        save(&format!("lights64_{kind}"), frame.output("final").unwrap());
+        save(
+            &format!("lights64_{kind}"),
+            frame.output(TargetId::Final).unwrap(),
+        );
         let error = reference::lighting_error(&scene, &frame).unwrap();
         eprintln!("{kind}: {error:?}");
         assert!(error.p999_relative <= 2e-3, "{kind}: {error:?}");
-        let light = frame.output("light").unwrap().as_f32().unwrap();
+        let light = frame.output(TargetId::Light).unwrap().as_f32().unwrap();
         let lit = light
             .chunks_exact(4)
             .filter(|t| t[0] + t[1] + t[2] > 0.05)
@@ -213,15 +220,17 @@ fn additive_draws_of_overbright_lights_stay_finite() {
             *intensity = 1e9;
         }
     }
-    let plan = engine::plan::RenderPlan::new(&scene);
-    let draws = plan.lighting_draws(engine::scene::LightingModel::Pbr);
+    let prepared = PreparedFrame::new(&scene).unwrap();
+    let draws = prepared
+        .plan()
+        .lighting_draws(engine::scene::LightingModel::Pbr);
     assert_eq!(draws.len(), 2);
     assert!(draws.iter().all(|d| d.variant.draws == 2));
     for kind in common::available_backends() {
         let mut backend = engine::backend::create(kind).unwrap();
-        let frame = renderer::render(backend.as_mut(), &scene, Readback::Only(&["light"]))
+        let frame = renderer::render(backend.as_mut(), &scene, Readback::Only(&[TargetId::Light]))
             .unwrap_or_else(|e| panic!("{kind}: {e}"));
-        let light = frame.output("light").unwrap().as_f32().unwrap();
+        let light = frame.output(TargetId::Light).unwrap().as_f32().unwrap();
         let largest = light
             .iter()
             .fold(0.0f32, |m, &v| if v > m || v.is_nan() { v } else { m });
@@ -287,8 +296,14 @@ fn normal_and_parameter_maps_reach_the_gbuffer() {
                 ..Material::default()
             };
             let frame = render(backend.as_mut(), &scene);
-            let normal = frame.output("gbuffer_normal").unwrap().pixel(32, 32);
-            let position = frame.output("gbuffer_position").unwrap().pixel(32, 32);
+            let normal = frame
+                .output(TargetId::GBuffer(GBufferTarget::Normal))
+                .unwrap()
+                .pixel(32, 32);
+            let position = frame
+                .output(TargetId::GBuffer(GBufferTarget::Position))
+                .unwrap()
+                .pixel(32, 32);
             for i in 0..3 {
                 assert!(
                     (normal[i] - expected[i]).abs() < 0.01,
@@ -303,7 +318,10 @@ fn normal_and_parameter_maps_reach_the_gbuffer() {
 
             scene.objects[0].material.roughness_map = None;
             let frame = render(backend.as_mut(), &scene);
-            let position = frame.output("gbuffer_position").unwrap().pixel(32, 32);
+            let position = frame
+                .output(TargetId::GBuffer(GBufferTarget::Position))
+                .unwrap()
+                .pixel(32, 32);
             assert!(
                 (position[3] - 0.9).abs() < 0.001,
                 "{kind}: scalar roughness {}",
@@ -324,12 +342,16 @@ fn gizmos_are_optional_and_only_touch_the_final_image() {
         let plain = render(backend.as_mut(), &scene);
         scene.quality.gizmos = true;
         let with = render(backend.as_mut(), &scene);
-        assert!(!plain.plan.passes.iter().any(|p| p.name == "gizmos"));
-        assert!(with.plan.passes.iter().any(|p| p.name == "gizmos"));
-        assert_eq!(plain.outputs["light"], with.outputs["light"], "{kind}");
+        assert!(plain.plan.pass(PassId::Gizmos).is_none());
+        assert!(with.plan.pass(PassId::Gizmos).is_some());
+        assert_eq!(
+            plain.outputs[&TargetId::Light],
+            with.outputs[&TargetId::Light],
+            "{kind}"
+        );
         let changed = harness::golden::metrics::compare::u8_difference(
-            &plain.outputs["final"],
-            &with.outputs["final"],
+            &plain.outputs[&TargetId::Final],
+            &with.outputs[&TargetId::Final],
             0,
         )
         .unwrap()
@@ -347,8 +369,10 @@ fn lighting_variants_follow_the_scene_and_are_compiled_once() {
     let chess = harness::load_scene("chess").unwrap().scene;
     let ibl = harness::load_scene("ibl").unwrap().scene;
     let variants = |scene: &Scene| {
-        let plan = engine::plan::RenderPlan::new(scene);
-        plan.lighting
+        let prepared = PreparedFrame::new(scene).unwrap();
+        prepared
+            .plan()
+            .lighting
             .iter()
             .flat_map(|pass| pass.draws.iter().map(|d| d.variant))
             .collect::<Vec<_>>()
@@ -395,17 +419,17 @@ fn an_environment_without_objects_renders_the_sky_everywhere() {
     empty.objects.clear();
     for kind in common::available_backends() {
         let mut backend = engine::backend::create(kind).unwrap();
-        let sky = renderer::render(backend.as_mut(), &empty, Readback::Only(&["light"]))
+        let sky = renderer::render(backend.as_mut(), &empty, Readback::Only(&[TargetId::Light]))
             .unwrap_or_else(|e| panic!("{kind}: {e}"));
-        let sky = sky.output("light").unwrap().as_f32().unwrap();
+        let sky = sky.output(TargetId::Light).unwrap().as_f32().unwrap();
         assert!(
             sky.chunks_exact(4)
                 .all(|p| p[..3].iter().all(|v| v.is_finite() && *v > 0.0)),
             "{kind}: a pixel without sky"
         );
         let full = render(backend.as_mut(), &with_objects);
-        let light = full.output("light").unwrap().as_f32().unwrap();
-        let mask = full.output("mask").unwrap().as_u8().unwrap();
+        let light = full.output(TargetId::Light).unwrap().as_f32().unwrap();
+        let mask = full.output(TargetId::Mask(0)).unwrap().as_u8().unwrap();
         let mut compared = 0;
         for (i, (a, b)) in sky.chunks_exact(4).zip(light.chunks_exact(4)).enumerate() {
             if mask[i * 4..i * 4 + 4].iter().all(|&m| m == 0) {
@@ -440,23 +464,40 @@ fn culled_renders_give_the_whole_frame_s_targets() {
         let mut backend = engine::backend::create(kind).unwrap();
         for scene in &scenes {
             let name = &scene.name;
-            let plan = engine::plan::RenderPlan::new(scene);
-            let terms: Vec<&str> = plan
-                .target_names()
+            let prepared = PreparedFrame::new(scene).unwrap();
+            let plan = prepared.plan();
+            let terms: Vec<TargetId> = plan
+                .target_ids()
                 .into_iter()
-                .filter(|t| t.starts_with("shadow_term_"))
+                .filter(|t| matches!(t, TargetId::ShadowTerm { .. }))
                 .collect();
             assert!(!terms.is_empty(), "{name} has no shadow term");
-            let mut gbuffer = engine::plan::GBUFFER_TARGETS.to_vec();
-            gbuffer.extend(["depth", "mask"]);
+            let mut gbuffer = TargetId::GBUFFER.to_vec();
+            gbuffer.extend([TargetId::Depth, TargetId::Mask(0)]);
             // Each wanted set, and the passes that must not run for it.
-            let mut cases: Vec<(Vec<&str>, &[&str])> = vec![
-                (gbuffer, &["shadow_", "skybox", "lighting_", "tonemap"]),
-                (terms, &["skybox", "lighting_", "tonemap"]),
-                (vec!["light"], &["shadow_term_", "tonemap"]),
+            type Culled = fn(PassId) -> bool;
+            let mut cases: Vec<(Vec<TargetId>, Culled)> = vec![
+                (gbuffer, |p| {
+                    matches!(
+                        p,
+                        PassId::Shadow { .. }
+                            | PassId::ShadowBlur { .. }
+                            | PassId::ShadowTerm { .. }
+                            | PassId::Skybox
+                            | PassId::Lighting(_)
+                            | PassId::ToneMap
+                    )
+                }),
+                (terms, |p| {
+                    matches!(p, PassId::Skybox | PassId::Lighting(_) | PassId::ToneMap)
+                }),
+                (vec![TargetId::Light], |p| {
+                    matches!(p, PassId::ShadowTerm { .. } | PassId::ToneMap)
+                }),
             ];
             if first {
-                cases.extend(plan.target_names().into_iter().map(|t| (vec![t], &[][..])));
+                let nothing: Culled = |_| false;
+                cases.extend(plan.target_ids().into_iter().map(|t| (vec![t], nothing)));
             }
             let whole = render(backend.as_mut(), scene);
             for (wanted, culled) in &cases {
@@ -465,15 +506,13 @@ fn culled_renders_give_the_whole_frame_s_targets() {
                     .unwrap_or_else(|e| panic!("{name} on {kind}: {e}"));
                 for target in wanted {
                     assert!(
-                        bitwise_equal(&frame.outputs[*target], &whole.outputs[*target]),
+                        bitwise_equal(&frame.outputs[target], &whole.outputs[target]),
                         "{name} on {kind}: {target} differs when only {wanted:?} are rendered"
                     );
                 }
-                let ran: Vec<&str> = frame.timings.iter().map(|t| t.name.as_str()).collect();
+                let ran: Vec<PassId> = frame.timings.owners.iter().flatten().copied().collect();
                 assert!(
-                    ran.iter().all(|pass| !culled
-                        .iter()
-                        .any(|c| pass.starts_with(c) && !wanted.contains(pass))),
+                    ran.iter().all(|&pass| !culled(pass)),
                     "{name} on {kind}: for {wanted:?}, {ran:?} ran"
                 );
             }

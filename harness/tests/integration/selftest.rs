@@ -48,7 +48,11 @@ fn every_mutation_fails_where_it_originates_and_no_noise_source_comes_near_a_lim
         .map(|n| {
             format!(
                 "{} {} {} {}: {:.2}",
-                n.source, n.scene, n.backend, n.pass, n.ratio
+                n.source,
+                n.scene,
+                n.backend.map_or("-", engine::backend::BackendKind::name),
+                n.pass,
+                n.ratio
             )
         })
         .collect();

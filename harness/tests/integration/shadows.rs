@@ -2,6 +2,7 @@
 //! types, on every available backend.
 
 use crate::common;
+use engine::plan::{GBufferTarget, PassId, TargetId};
 use std::sync::Arc;
 
 use engine::mesh;
@@ -42,8 +43,9 @@ fn plane_scene(light: Light) -> Scene {
 }
 
 /// The targets the ray-cast comparison reads for `light` in `scene`.
-fn visibility_targets(scene: &engine::scene::Scene, light: usize) -> Vec<String> {
-    harness::reference::shadows::visibility_targets(&engine::plan::RenderPlan::new(scene), light)
+fn visibility_targets(scene: &engine::scene::Scene, light: usize) -> Vec<TargetId> {
+    let prepared = engine::renderer::PreparedFrame::new(scene).unwrap();
+    harness::reference::shadows::visibility_targets(prepared.plan(), light)
 }
 
 /// Renders the open plane under `light`: its light buffer and mask.
@@ -51,7 +53,7 @@ fn render_plane(backend: &mut dyn engine::Backend, light: Light) -> renderer::Fr
     renderer::render(
         backend,
         &plane_scene(light),
-        Readback::Needed(&["light", "mask"]),
+        Readback::Needed(&[TargetId::Light, TargetId::Mask(0)]),
     )
     .unwrap()
 }
@@ -59,10 +61,13 @@ fn render_plane(backend: &mut dyn engine::Backend, light: Light) -> renderer::Fr
 /// The fraction of covered pixels whose light-buffer value is unchanged by the shadow map (shadow
 /// term exactly 1): `shadowed` against `plain`, the same light without a shadow.
 fn fully_lit_fraction(shadowed: &renderer::Frame, plain: &renderer::Frame) -> f64 {
-    assert!(shadowed.plan.target("shadow_0").is_some());
-    let mask = plain.outputs["mask"].as_u8().unwrap();
-    let a = shadowed.outputs["light"].as_f32().unwrap();
-    let b = plain.outputs["light"].as_f32().unwrap();
+    assert!(shadowed
+        .plan
+        .target(TargetId::Shadow { light: 0 })
+        .is_some());
+    let mask = plain.outputs[&TargetId::Mask(0)].as_u8().unwrap();
+    let a = shadowed.outputs[&TargetId::Light].as_f32().unwrap();
+    let b = plain.outputs[&TargetId::Light].as_f32().unwrap();
     let (mut covered, mut same) = (0usize, 0usize);
     for i in 0..mask.len() / 4 {
         if mask[i * 4] == 0 {
@@ -180,7 +185,6 @@ fn hard_shadows_match_the_ray_cast_reference() {
             }
         }
         let wanted = visibility_targets(&scene, light);
-        let wanted: Vec<&str> = wanted.iter().map(String::as_str).collect();
         for kind in common::available_backends() {
             let mut backend = engine::backend::create(kind).unwrap();
             let frame =
@@ -246,11 +250,19 @@ fn box_on_a_plane_shows_at_most_a_two_texel_contact_gap() {
     let texel = renderer::shadows::shadow_views(&scene)[0].texel_world;
     for kind in common::available_backends() {
         let mut backend = engine::backend::create(kind).unwrap();
-        let wanted = ["shadow_term_0", "gbuffer_position", "depth"];
+        let wanted = [
+            TargetId::ShadowTerm { light: 0 },
+            TargetId::GBuffer(GBufferTarget::Position),
+            TargetId::Depth,
+        ];
         let frame = renderer::render(backend.as_mut(), &scene, Readback::Needed(&wanted)).unwrap();
-        let term = frame.outputs["shadow_term_0"].as_f32().unwrap();
-        let position = frame.outputs["gbuffer_position"].as_f32().unwrap();
-        let depth = frame.outputs["depth"].as_f32().unwrap();
+        let term = frame.outputs[&TargetId::ShadowTerm { light: 0 }]
+            .as_f32()
+            .unwrap();
+        let position = frame.outputs[&TargetId::GBuffer(GBufferTarget::Position)]
+            .as_f32()
+            .unwrap();
+        let depth = frame.outputs[&TargetId::Depth].as_f32().unwrap();
         let (mut gap, mut shadowed, mut pixel, mut contact) = (0.0f64, 0usize, 0.0f64, 0usize);
         for i in 0..depth.len() {
             if depth[i] >= 1.0 {
@@ -351,9 +363,16 @@ fn soft_shadow_early_out_matches_the_full_kernel_outside_penumbrae() {
                 s.filter = filter;
             }
         }
-        let frame =
-            renderer::render(backend, &scene, Readback::Needed(&["shadow_term_0"])).unwrap();
-        frame.outputs["shadow_term_0"].as_f32().unwrap().to_vec()
+        let frame = renderer::render(
+            backend,
+            &scene,
+            Readback::Needed(&[TargetId::ShadowTerm { light: 0 }]),
+        )
+        .unwrap();
+        frame.outputs[&TargetId::ShadowTerm { light: 0 }]
+            .as_f32()
+            .unwrap()
+            .to_vec()
     };
     for kind in common::available_backends() {
         let mut backend = engine::backend::create(kind).unwrap();
@@ -402,11 +421,12 @@ fn variance_shadow_maps_agree_with_the_ray_cast_reference() {
     }
     assert!(scene.lights[0].casts_shadows());
     let wanted = visibility_targets(&scene, 0);
-    let wanted: Vec<&str> = wanted.iter().map(String::as_str).collect();
     for kind in common::available_backends() {
         let mut backend = engine::backend::create(kind).unwrap();
         let frame = renderer::render(backend.as_mut(), &scene, Readback::Needed(&wanted)).unwrap();
-        let term = frame.outputs["shadow_term_0"].as_f32().unwrap();
+        let term = frame.outputs[&TargetId::ShadowTerm { light: 0 }]
+            .as_f32()
+            .unwrap();
         assert!(
             term.iter()
                 .all(|t| t.is_finite() && (0.0..=1.0).contains(t)),
@@ -463,7 +483,7 @@ fn geometry_shader_point_shadows_equal_six_passes() {
     assert!(six_passes.lights[0].casts_shadows());
     let mut single_pass = six_passes.clone();
     single_pass.quality.point_shadows = PointShadowPass::GeometryShader;
-    let wanted = ["shadow_0", "light"];
+    let wanted = [TargetId::Shadow { light: 0 }, TargetId::Light];
     for kind in common::available_backends() {
         let mut backend = engine::backend::create(kind).unwrap();
         if !backend.features().geometry_shaders {
@@ -476,16 +496,15 @@ fn geometry_shader_point_shadows_equal_six_passes() {
         let a = renderer::render(backend.as_mut(), &six_passes, Readback::Only(&wanted)).unwrap();
         let b = renderer::render(backend.as_mut(), &single_pass, Readback::Only(&wanted)).unwrap();
         let shadow_passes = |frame: &renderer::Frame| {
-            frame
-                .timings
-                .iter()
-                .filter(|t| t.name.starts_with("shadow_0"))
+            let owners = frame.timings.owners.iter();
+            owners
+                .filter(|o| **o == Some(PassId::Shadow { light: 0 }))
                 .count()
         };
         assert_eq!((shadow_passes(&a), shadow_passes(&b)), (6, 1), "{kind}");
         for name in wanted {
             assert!(
-                a.outputs[name].as_f32().unwrap() == b.outputs[name].as_f32().unwrap(),
+                a.outputs[&name].as_f32().unwrap() == b.outputs[&name].as_f32().unwrap(),
                 "{kind}: `{name}` differs between six passes and the geometry shader"
             );
         }

@@ -81,7 +81,6 @@ impl GlBackend {
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
             gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
             DriverInfo {
-                backend: BackendKind::Gl.name().to_owned(),
                 api: "OpenGL".to_owned(),
                 api_version: gl.get_parameter_string(glow::VERSION),
                 renderer: gl.get_parameter_string(glow::RENDERER),
@@ -91,7 +90,7 @@ impl GlBackend {
                     gl.get_parameter_string(glow::SHADING_LANGUAGE_VERSION)
                 ),
                 timestamps: true,
-                ..Default::default()
+                ..DriverInfo::new(BackendKind::Gl)
             }
             .complete()
         };

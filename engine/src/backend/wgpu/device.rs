@@ -79,7 +79,6 @@ impl WgpuBackend {
         }
         let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
         let info = DriverInfo {
-            backend: kind.name().to_owned(),
             // wgpu's GL backend takes a desktop core context where the driver offers one.
             api: if kind == BackendKind::WgpuGl && !adapter_info.driver_info.contains("OpenGL ES") {
                 "OpenGL".to_owned()
@@ -93,7 +92,7 @@ impl WgpuBackend {
                 .trim()
                 .to_owned(),
             timestamps,
-            ..Default::default()
+            ..DriverInfo::new(kind)
         }
         .complete();
         Ok(Self {

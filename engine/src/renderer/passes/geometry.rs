@@ -9,7 +9,7 @@ use super::super::resources::FrameResources;
 use super::super::{uniforms, Faults, RenderError};
 use crate::backend::*;
 use crate::mesh::Vertex;
-use crate::plan::{self, MaskChannel, RenderPlan};
+use crate::plan::{MaskChannel, PassId, RenderPlan, TargetId};
 use crate::scene::Scene;
 use crate::shaders;
 
@@ -64,7 +64,7 @@ fn pipelines(
             fragment_entry: Some("fs_gbuffer".to_owned()),
             vertex_buffers: vec![vertex_layout()],
             bindings: gbuffer_bindings,
-            color_targets: plan::GBUFFER_TARGETS
+            color_targets: TargetId::GBUFFER
                 .iter()
                 .map(|_| ColorTarget {
                     format: TextureFormat::Rgba16Float,
@@ -126,7 +126,7 @@ pub(in crate::renderer) fn record(
     plan: &RenderPlan,
     frame: &FrameResources,
     faults: &Faults,
-    passes: &mut Vec<RenderPass>,
+    passes: &mut super::Recorded,
 ) -> Result<(), RenderError> {
     let (geometry_pipeline, mask_pipeline) = pipelines(backend, scope, frame.mask_targets.len())?;
     let mut geometry_draws = Vec::new();
@@ -184,34 +184,40 @@ pub(in crate::renderer) fn record(
             count: mesh.count,
         });
     }
-    passes.push(RenderPass {
-        name: "geometry".to_owned(),
-        color_attachments: plan::GBUFFER_TARGETS
-            .iter()
-            .map(|name| attachment(frame.target(name), LoadOp::Clear([0.0; 4])))
-            .collect(),
-        depth_attachment: Some(DepthAttachment {
-            texture: frame.target(plan::DEPTH),
-            subresource: Subresource::default(),
-            load: LoadOp::Clear(1.0),
-        }),
-        viewports: vec![],
-        draws: geometry_draws,
-    });
-    passes.push(RenderPass {
-        name: "mask".to_owned(),
-        color_attachments: frame
-            .mask_targets
-            .iter()
-            .map(|&t| attachment(t, LoadOp::Clear([0.0; 4])))
-            .collect(),
-        depth_attachment: Some(DepthAttachment {
-            texture: frame.target(plan::DEPTH),
-            subresource: Subresource::default(),
-            load: LoadOp::Load,
-        }),
-        viewports: vec![],
-        draws: mask_draws,
-    });
+    passes.push(
+        PassId::Geometry,
+        RenderPass {
+            name: PassId::Geometry.to_string(),
+            color_attachments: TargetId::GBUFFER
+                .into_iter()
+                .map(|id| attachment(frame.target(id), LoadOp::Clear([0.0; 4])))
+                .collect(),
+            depth_attachment: Some(DepthAttachment {
+                texture: frame.target(TargetId::Depth),
+                subresource: Subresource::default(),
+                load: LoadOp::Clear(1.0),
+            }),
+            viewports: vec![],
+            draws: geometry_draws,
+        },
+    );
+    passes.push(
+        PassId::ShaderMask,
+        RenderPass {
+            name: PassId::ShaderMask.to_string(),
+            color_attachments: frame
+                .mask_targets
+                .iter()
+                .map(|&t| attachment(t, LoadOp::Clear([0.0; 4])))
+                .collect(),
+            depth_attachment: Some(DepthAttachment {
+                texture: frame.target(TargetId::Depth),
+                subresource: Subresource::default(),
+                load: LoadOp::Load,
+            }),
+            viewports: vec![],
+            draws: mask_draws,
+        },
+    );
     Ok(())
 }

@@ -114,7 +114,7 @@ pub(in crate::renderer) fn pass(
         bytemuck::cast_slice(&vertices),
     )?;
     Ok(RenderPass {
-        name: "gizmos".to_owned(),
+        name: crate::plan::PassId::Gizmos.to_string(),
         color_attachments: vec![ColorAttachment {
             texture: target,
             subresource: Subresource::default(),

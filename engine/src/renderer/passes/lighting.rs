@@ -15,7 +15,7 @@ use super::super::shadows::{self, ShadowView};
 use super::super::{light_uniforms, uniforms, Faults, RenderError};
 use crate::backend::*;
 use crate::plan::RenderPlan;
-use crate::plan::{self, LightingDraw, LightingPass, LightingVariant, MaskChannel, PassKind};
+use crate::plan::{LightingDraw, LightingPass, LightingVariant, MaskChannel, PassId, TargetId};
 use crate::scene::Scene;
 use crate::shaders;
 
@@ -114,7 +114,7 @@ struct ShadowBindings {
     sampler: Handle<Sampler>,
 }
 
-/// The resources of one lighting draw ([`plan::LightingDraw`]): its lights' uniforms, and the
+/// The resources of one lighting draw ([`crate::plan::LightingDraw`]): its lights' uniforms, and the
 /// maps of its shadowed light (placeholders when it has none).
 struct LightDraw {
     lights: Vec<uniforms::LightData>,
@@ -203,7 +203,6 @@ impl<'a> LightingResources<'a> {
                 BufferUsage::Uniform,
                 bytemuck::cast_slice(&shadows::shadow_uniforms(Some(view))),
             )?;
-            let moments = plan::shadow_moments_target_name(view.light);
             let sampler = if view.settings.filter.linear_comparison() {
                 linear_shadow_sampler
             } else {
@@ -212,8 +211,10 @@ impl<'a> LightingResources<'a> {
             shadowed.insert(
                 view.light,
                 ShadowBindings {
-                    map: frame.target(&plan::shadow_target_name(view.light)),
-                    moments: frame.optional_target(&moments).unwrap_or(no_moments),
+                    map: frame.target(TargetId::Shadow { light: view.light }),
+                    moments: frame
+                        .optional_target(TargetId::ShadowMoments { light: view.light })
+                        .unwrap_or(no_moments),
                     uniform,
                     sampler,
                 },
@@ -258,10 +259,10 @@ impl<'a> LightingResources<'a> {
         draw: &LightDraw,
     ) -> Vec<Binding> {
         let mut bindings = vec![binding(0, BindingResource::Buffer(uniform))];
-        bindings.extend(plan::GBUFFER_TARGETS.iter().enumerate().map(|(i, name)| {
+        bindings.extend(TargetId::GBUFFER.into_iter().enumerate().map(|(i, id)| {
             binding(
                 i as u32 + 1,
-                BindingResource::Texture(self.frame.target(name)),
+                BindingResource::Texture(self.frame.target(id)),
             )
         }));
         bindings.extend([
@@ -276,7 +277,10 @@ impl<'a> LightingResources<'a> {
             binding(14, BindingResource::Texture(self.ibl.specular)),
             binding(15, BindingResource::Texture(self.ibl.dfg)),
             binding(16, BindingResource::Sampler(self.ibl.sampler)),
-            binding(17, BindingResource::Texture(self.frame.target(plan::DEPTH))),
+            binding(
+                17,
+                BindingResource::Texture(self.frame.target(TargetId::Depth)),
+            ),
         ]);
         bindings
     }
@@ -365,7 +369,7 @@ pub(in crate::renderer) fn record(
     faults: &Faults,
     ibl_maps: Option<&crate::ibl::IblMaps>,
     mut light_cleared: bool,
-    passes: &mut Vec<RenderPass>,
+    passes: &mut super::Recorded,
 ) -> Result<(), RenderError> {
     let mut resources =
         LightingResources::create(backend, scope, scene, frame, views, faults, ibl_maps)?;
@@ -390,14 +394,15 @@ pub(in crate::renderer) fn record(
             LoadOp::Clear([0.0; 4])
         };
         light_cleared = true;
-        passes.push(model_pass(plan, frame, *channel, pass, load, draws));
+        let pass = model_pass(frame, *channel, pass, load, draws);
+        passes.push(PassId::Lighting(channel.model), pass);
     }
     if !light_cleared {
         // No objects and no environment: the light buffer is black.
-        passes.push(RenderPass {
+        passes.push_unplanned(RenderPass {
             name: "clear_light".to_owned(),
             color_attachments: vec![attachment(
-                frame.target(plan::LIGHT),
+                frame.target(TargetId::Light),
                 LoadOp::Clear([0.0; 4]),
             )],
             depth_attachment: None,
@@ -462,7 +467,6 @@ fn model_draws(
 /// One model's lighting pass over its `draws`: into the light buffer, routed through the
 /// cleared routing depth target, rasterising only the model's rectangle.
 fn model_pass(
-    plan: &RenderPlan,
     frame: &FrameResources,
     channel: MaskChannel,
     pass: &LightingPass,
@@ -471,14 +475,10 @@ fn model_pass(
 ) -> RenderPass {
     let model = channel.model;
     RenderPass {
-        name: plan
-            .passes
-            .iter()
-            .find(|p| p.kind == PassKind::Lighting(model))
-            .map_or_else(|| format!("lighting_{model}"), |p| p.name.clone()),
-        color_attachments: vec![attachment(frame.target(plan::LIGHT), load)],
+        name: PassId::Lighting(model).to_string(),
+        color_attachments: vec![attachment(frame.target(TargetId::Light), load)],
         depth_attachment: Some(DepthAttachment {
-            texture: frame.target(plan::ROUTE),
+            texture: frame.target(TargetId::Route),
             subresource: Subresource::default(),
             load: LoadOp::Clear(1.0),
         }),
@@ -508,10 +508,11 @@ fn record_shadow_terms(
     plan: &RenderPlan,
     views: &[ShadowView],
     resources: &mut LightingResources<'_>,
-    passes: &mut Vec<RenderPass>,
+    passes: &mut super::Recorded,
 ) -> Result<(), RenderError> {
     for view in views {
-        let name = plan::shadow_term_target_name(view.light);
+        let term = TargetId::ShadowTerm { light: view.light };
+        let name = PassId::ShadowTerm { light: view.light }.to_string();
         let mut draws = plan.lighting.iter().flat_map(|pass| &pass.draws);
         let Some(draw) = draws.find(|d| d.shadowed == Some(view.light)) else {
             continue;
@@ -535,16 +536,19 @@ fn record_shadow_terms(
             bytemuck::cast_slice(&data),
         )?;
         let bindings = resources.bind_group(uniform, resources.frame.mask_targets[0], &light_draw);
-        passes.push(RenderPass {
-            name: name.clone(),
-            color_attachments: vec![attachment(
-                resources.frame.target(&name),
-                LoadOp::Clear([0.0; 4]),
-            )],
-            depth_attachment: None,
-            viewports: vec![],
-            draws: vec![fullscreen_draw(pipeline, bindings)],
-        });
+        passes.push(
+            PassId::ShadowTerm { light: view.light },
+            RenderPass {
+                name,
+                color_attachments: vec![attachment(
+                    resources.frame.target(term),
+                    LoadOp::Clear([0.0; 4]),
+                )],
+                depth_attachment: None,
+                viewports: vec![],
+                draws: vec![fullscreen_draw(pipeline, bindings)],
+            },
+        );
     }
     Ok(())
 }

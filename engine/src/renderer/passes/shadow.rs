@@ -9,7 +9,7 @@ use super::super::resources::FrameResources;
 use super::super::shadows::{blur_weights, ShadowView};
 use super::super::RenderError;
 use crate::backend::*;
-use crate::plan;
+use crate::plan::{BlurAxis, PassId, TargetId};
 use crate::scene::{PointShadowPass, Scene, ShadowFilter};
 use crate::shaders;
 
@@ -139,7 +139,7 @@ pub(in crate::renderer) fn record(
     scene: &Scene,
     views: &[ShadowView],
     frame: &FrameResources,
-    passes: &mut Vec<RenderPass>,
+    passes: &mut super::Recorded,
 ) -> Result<(), RenderError> {
     if views.is_empty() {
         return Ok(());
@@ -162,15 +162,15 @@ fn record_view(
     view: &ShadowView,
     pipelines: &ShadowPipelines,
     frame: &FrameResources,
-    passes: &mut Vec<RenderPass>,
+    passes: &mut super::Recorded,
 ) -> Result<(), RenderError> {
-    let name = plan::shadow_target_name(view.light);
-    let texture = frame.target(&name);
+    let name = PassId::Shadow { light: view.light }.to_string();
+    let texture = frame.target(TargetId::Shadow { light: view.light });
     let (pipeline, color_attachments) = match pipelines.moments.filter(|_| uses_vsm(view)) {
         Some(pipeline) => (
             pipeline,
             vec![ColorAttachment {
-                texture: frame.target(&plan::shadow_moments_target_name(view.light)),
+                texture: frame.target(TargetId::ShadowMoments { light: view.light }),
                 subresource: Subresource::default(),
                 // Where no caster is drawn: depth 1 (the far plane), no variance.
                 load: LoadOp::Clear([1.0, 0.0, 1.0, 0.0]),
@@ -191,25 +191,28 @@ fn record_view(
     };
     for (group_index, faces) in groups.iter().enumerate() {
         let draws = caster_draws(backend, scope, scene, view, &name, faces, pipeline, frame)?;
-        passes.push(RenderPass {
-            name: if view.point && !single_pass {
-                format!("{name}{}", FACE_NAMES[faces[0]])
-            } else {
-                name.clone()
-            },
-            color_attachments: color_attachments.clone(),
-            depth_attachment: Some(DepthAttachment {
-                texture,
-                subresource: Subresource::default(),
-                load: if group_index == 0 {
-                    LoadOp::Clear(1.0)
+        passes.push(
+            PassId::Shadow { light: view.light },
+            RenderPass {
+                name: if view.point && !single_pass {
+                    format!("{name}{}", FACE_NAMES[faces[0]])
                 } else {
-                    LoadOp::Load
+                    name.clone()
                 },
-            }),
-            viewports: face_viewports(view, faces),
-            draws,
-        });
+                color_attachments: color_attachments.clone(),
+                depth_attachment: Some(DepthAttachment {
+                    texture,
+                    subresource: Subresource::default(),
+                    load: if group_index == 0 {
+                        LoadOp::Clear(1.0)
+                    } else {
+                        LoadOp::Load
+                    },
+                }),
+                viewports: face_viewports(view, faces),
+                draws,
+            },
+        );
     }
     Ok(())
 }
@@ -281,40 +284,44 @@ fn record_moments_blur(
     view: &ShadowView,
     pipeline: Handle<Pipeline>,
     frame: &FrameResources,
-    passes: &mut Vec<RenderPass>,
+    passes: &mut super::Recorded,
 ) -> Result<(), RenderError> {
     let radius = view.settings.vsm_blur_radius;
     if radius == 0 {
         return Ok(());
     }
-    let name = plan::shadow_target_name(view.light);
-    let moments = frame.target(&plan::shadow_moments_target_name(view.light));
-    let blurred_x = frame.target(&plan::shadow_blur_target_name(view.light));
+    let light = view.light;
+    let moments = frame.target(TargetId::ShadowMoments { light });
+    let blurred_x = frame.target(TargetId::ShadowBlur { light });
     for (axis, step, source, destination) in [
-        ("x", [1.0f32, 0.0], moments, blurred_x),
-        ("y", [0.0, 1.0], blurred_x, moments),
+        (BlurAxis::X, [1.0f32, 0.0], moments, blurred_x),
+        (BlurAxis::Y, [0.0, 1.0], blurred_x, moments),
     ] {
+        let pass = PassId::ShadowBlur { light, axis };
         let mut data = vec![step[0], step[1], radius as f32, 0.0];
         data.extend(blur_weights(radius));
         let uniform = scope.buffer(
             backend,
-            &format!("{name} blur {axis}"),
+            &format!("{pass} uniforms"),
             BufferUsage::Uniform,
             bytemuck::cast_slice(&data),
         )?;
-        passes.push(RenderPass {
-            name: format!("{name}_blur_{axis}"),
-            color_attachments: vec![attachment(destination, LoadOp::Clear([0.0; 4]))],
-            depth_attachment: None,
-            viewports: vec![],
-            draws: vec![fullscreen_draw(
-                pipeline,
-                vec![
-                    binding(1, BindingResource::Buffer(uniform)),
-                    binding(2, BindingResource::Texture(source)),
-                ],
-            )],
-        });
+        passes.push(
+            pass,
+            RenderPass {
+                name: pass.to_string(),
+                color_attachments: vec![attachment(destination, LoadOp::Clear([0.0; 4]))],
+                depth_attachment: None,
+                viewports: vec![],
+                draws: vec![fullscreen_draw(
+                    pipeline,
+                    vec![
+                        binding(1, BindingResource::Buffer(uniform)),
+                        binding(2, BindingResource::Texture(source)),
+                    ],
+                )],
+            },
+        );
     }
     Ok(())
 }

@@ -8,7 +8,7 @@ use super::super::builders::{
 use super::super::resources::FrameResources;
 use super::super::{uniforms, RenderError};
 use crate::backend::*;
-use crate::plan;
+use crate::plan::{PassId, TargetId};
 use crate::scene::Scene;
 use crate::shaders;
 
@@ -19,7 +19,7 @@ pub(in crate::renderer) fn record(
     scope: &mut ResourceScope,
     scene: &Scene,
     frame: &FrameResources,
-    passes: &mut Vec<RenderPass>,
+    passes: &mut super::Recorded,
 ) -> Result<bool, RenderError> {
     let Some(environment) = &scene.environment else {
         return Ok(false);
@@ -82,25 +82,28 @@ pub(in crate::renderer) fn record(
             .copied()
             .unwrap_or(frame.black)
     };
-    passes.push(RenderPass {
-        name: "skybox".to_owned(),
-        color_attachments: vec![attachment(
-            frame.target(plan::LIGHT),
-            LoadOp::Clear([0.0; 4]),
-        )],
-        depth_attachment: None,
-        viewports: vec![],
-        draws: vec![fullscreen_draw(
-            pipeline,
-            vec![
-                binding(0, BindingResource::Buffer(uniform)),
-                // No objects, no mask target: the black texel says nothing is covered.
-                binding(1, BindingResource::Texture(mask(0))),
-                binding(2, BindingResource::Texture(mask(1))),
-                binding(3, BindingResource::Texture(texture)),
-                binding(4, BindingResource::Sampler(sampler)),
-            ],
-        )],
-    });
+    passes.push(
+        PassId::Skybox,
+        RenderPass {
+            name: PassId::Skybox.to_string(),
+            color_attachments: vec![attachment(
+                frame.target(TargetId::Light),
+                LoadOp::Clear([0.0; 4]),
+            )],
+            depth_attachment: None,
+            viewports: vec![],
+            draws: vec![fullscreen_draw(
+                pipeline,
+                vec![
+                    binding(0, BindingResource::Buffer(uniform)),
+                    // No objects, no mask target: the black texel says nothing is covered.
+                    binding(1, BindingResource::Texture(mask(0))),
+                    binding(2, BindingResource::Texture(mask(1))),
+                    binding(3, BindingResource::Texture(texture)),
+                    binding(4, BindingResource::Sampler(sampler)),
+                ],
+            )],
+        },
+    );
     Ok(true)
 }

@@ -8,7 +8,7 @@ use super::super::builders::{
 use super::super::resources::FrameResources;
 use super::super::{Faults, RenderError};
 use crate::backend::*;
-use crate::plan;
+use crate::plan::{PassId, TargetId};
 use crate::scene::{Scene, ToneMap};
 use crate::shaders;
 
@@ -19,7 +19,7 @@ pub(in crate::renderer) fn record(
     scene: &Scene,
     frame: &FrameResources,
     faults: &Faults,
-    passes: &mut Vec<RenderPass>,
+    passes: &mut super::Recorded,
 ) -> Result<(), RenderError> {
     let tonemap_shader = shader(scope, backend, shaders::TONEMAP)?;
     let tonemap_pipeline = scope.pipeline(
@@ -45,21 +45,24 @@ pub(in crate::renderer) fn record(
         BufferUsage::Uniform,
         bytemuck::cast_slice(&[operator, 0, 0, 0, input_scale.to_bits(), 0, 0, 0]),
     )?;
-    passes.push(RenderPass {
-        name: "tonemap".to_owned(),
-        color_attachments: vec![attachment(
-            frame.target(plan::FINAL),
-            LoadOp::Clear([0.0; 4]),
-        )],
-        depth_attachment: None,
-        viewports: vec![],
-        draws: vec![fullscreen_draw(
-            tonemap_pipeline,
-            vec![
-                binding(0, BindingResource::Buffer(tonemap_uniform)),
-                binding(1, BindingResource::Texture(frame.target(plan::LIGHT))),
-            ],
-        )],
-    });
+    passes.push(
+        PassId::ToneMap,
+        RenderPass {
+            name: PassId::ToneMap.to_string(),
+            color_attachments: vec![attachment(
+                frame.target(TargetId::Final),
+                LoadOp::Clear([0.0; 4]),
+            )],
+            depth_attachment: None,
+            viewports: vec![],
+            draws: vec![fullscreen_draw(
+                tonemap_pipeline,
+                vec![
+                    binding(0, BindingResource::Buffer(tonemap_uniform)),
+                    binding(1, BindingResource::Texture(frame.target(TargetId::Light))),
+                ],
+            )],
+        },
+    );
     Ok(())
 }

@@ -7,6 +7,7 @@ use std::path::Path;
 use std::process::Command;
 
 use engine::backend::BackendKind;
+use engine::plan::TargetId;
 use engine::Image;
 
 use super::rounding::synthetic_rounding;
@@ -20,12 +21,14 @@ use crate::golden::{self, GoldenStore, Outcome};
 pub struct Measurement {
     /// Source name.
     pub source: String,
-    /// Backend (`-` for synthetic rounding, which derives from the reference backend).
-    pub backend: String,
+    /// Backend (none, `-` in JSON, for synthetic rounding, which derives from the reference
+    /// backend).
+    #[serde(serialize_with = "crate::backend_or_dash")]
+    pub backend: Option<BackendKind>,
     /// Scene.
     pub scene: String,
     /// Pass.
-    pub pass: String,
+    pub pass: TargetId,
     /// Metric (as printed) and its value.
     pub values: Vec<(String, f64)>,
 }
@@ -36,7 +39,7 @@ pub struct Missed {
     /// Source name.
     pub source: String,
     /// Backend.
-    pub backend: String,
+    pub backend: BackendKind,
     /// Scene.
     pub scene: String,
     /// What happened.
@@ -85,7 +88,7 @@ pub struct SourceRun {
     /// What could not be measured.
     pub missed: Vec<Missed>,
     /// Driver fingerprint per backend, as the source saw it.
-    pub drivers: BTreeMap<String, String>,
+    pub drivers: BTreeMap<BackendKind, String>,
 }
 
 /// Measures an environment source: `harness check --json` (the binary `exe`) in a child process
@@ -123,7 +126,7 @@ pub fn measure_environment(
                 let known = known_driver_crash(source, backend);
                 missed.push(Missed {
                     source: source.name.clone(),
-                    backend: backend.name().to_owned(),
+                    backend,
                     scene: case.name().to_owned(),
                     error: known.clone().unwrap_or(error),
                     known: known.is_some(),
@@ -154,16 +157,16 @@ pub fn measure_environment(
             }
             for b in &run.backends {
                 if let Some(fingerprint) = &b.fingerprint {
-                    drivers.insert(b.backend.clone(), fingerprint.clone());
+                    drivers.insert(b.backend, fingerprint.clone());
                 }
             }
             for result in &run.results {
                 if let Some(values) = values_of(&result.outcome) {
                     measurements.push(Measurement {
                         source: source.name.clone(),
-                        backend: result.backend.clone(),
+                        backend: Some(result.backend),
                         scene: result.scene.clone(),
-                        pass: result.pass.clone(),
+                        pass: result.pass,
                         values,
                     });
                 }
@@ -182,12 +185,12 @@ fn measure_outputs(
     store: &GoldenStore,
     case: &Case,
     source: &str,
-    backend: &str,
-    outputs: &BTreeMap<String, Image>,
+    backend: Option<BackendKind>,
+    outputs: &BTreeMap<TargetId, Image>,
 ) -> Vec<Measurement> {
     let mut measurements = Vec::new();
-    for (pass, image) in outputs {
-        let Some(rule) = case.rules.get(pass) else {
+    for (&pass, image) in outputs {
+        let Some(rule) = case.rules.get(&pass) else {
             continue;
         };
         let Ok(Some(golden)) = store.load(case.name(), pass, golden::is_eight_bit(image)) else {
@@ -196,9 +199,9 @@ fn measure_outputs(
         if let Some(values) = values_of(&golden::check(image, Some(&golden), rule)) {
             measurements.push(Measurement {
                 source: source.to_owned(),
-                backend: backend.to_owned(),
+                backend,
                 scene: case.name().to_owned(),
-                pass: pass.clone(),
+                pass,
                 values,
             });
         }
@@ -210,10 +213,16 @@ fn measure_outputs(
 pub fn measure_synthetic(
     store: &GoldenStore,
     case: &Case,
-    outputs: &BTreeMap<String, Image>,
+    outputs: &BTreeMap<TargetId, Image>,
     source: &str,
 ) -> Vec<Measurement> {
-    measure_outputs(store, case, source, "-", &synthetic_rounding(case, outputs))
+    measure_outputs(
+        store,
+        case,
+        source,
+        None,
+        &synthetic_rounding(case, outputs),
+    )
 }
 
 /// Measures renders recorded on another host: `<dir>/<scene>_<pass>_<backend>.png|exr`.
@@ -240,18 +249,18 @@ pub fn measure_recorded(
                 };
                 match read {
                     Ok(image) => {
-                        let outputs = BTreeMap::from([(pass.clone(), image)]);
+                        let outputs = BTreeMap::from([(*pass, image)]);
                         measurements.extend(measure_outputs(
                             store,
                             case,
                             source,
-                            backend.name(),
+                            Some(backend),
                             &outputs,
                         ));
                     }
                     Err(e) => missed.push(Missed {
                         source: source.to_owned(),
-                        backend: backend.name().to_owned(),
+                        backend,
                         scene: case.name().to_owned(),
                         error: e.to_string(),
                         known: false,
@@ -294,7 +303,7 @@ pub fn measure(
                         )),
                         Err(error) => run.missed.push(Missed {
                             source: source.name.clone(),
-                            backend: reference.name().to_owned(),
+                            backend: reference,
                             scene: case.name().to_owned(),
                             error,
                             known: false,

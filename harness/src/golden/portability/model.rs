@@ -3,6 +3,9 @@
 
 use std::collections::BTreeMap;
 
+use engine::backend::BackendKind;
+use engine::plan::TargetId;
+
 use super::measuring::{Measurement, Missed};
 use crate::golden::noise::{
     resolution, round_up, CheckFigures, NoiseModel, SceneFigures, MAX_NOISE_RATIO, REGENERATE,
@@ -15,10 +18,10 @@ use crate::golden::suite::Case;
 pub fn table(ratios: &[Ratio], sources: &[String]) -> String {
     // (scene, pass, metric) -> (limit, ratio per source).
     type Row = (f64, BTreeMap<String, f64>);
-    let mut rows: BTreeMap<(String, String, String), Row> = BTreeMap::new();
+    let mut rows: BTreeMap<(String, TargetId, String), Row> = BTreeMap::new();
     for r in ratios {
         let row = rows
-            .entry((r.scene.clone(), r.pass.clone(), r.metric.clone()))
+            .entry((r.scene.clone(), r.pass, r.metric.clone()))
             .or_insert((r.limit, BTreeMap::new()));
         row.1.insert(r.source.clone(), r.ratio);
     }
@@ -88,19 +91,23 @@ pub fn build_model(
     };
     for case in cases {
         let mut passes = SceneFigures::new();
-        for pass in &case.passes {
+        for &pass in &case.passes {
             let pixels = case.pixels(pass);
             let mut checks = BTreeMap::new();
-            for (metric, _) in case.rules[pass].checks() {
+            for (metric, _) in case.rules[&pass].checks() {
                 let key = metric.to_string();
                 let mut noise = BTreeMap::new();
                 for m in measurements
                     .iter()
-                    .filter(|m| m.scene == case.name() && &m.pass == pass)
+                    .filter(|m| m.scene == case.name() && m.pass == pass)
                 {
                     if let Some((_, v)) = m.values.iter().find(|(k, _)| *k == key) {
                         let slot = noise
-                            .entry(format!("{}/{}", m.source, m.backend))
+                            .entry(format!(
+                                "{}/{}",
+                                m.source,
+                                m.backend.map_or("-", BackendKind::name)
+                            ))
                             .or_insert(0.0f64);
                         *slot = slot.max(*v);
                     }
@@ -116,7 +123,7 @@ pub fn build_model(
                     },
                 );
             }
-            passes.insert(pass.clone(), checks);
+            passes.insert(pass.to_string(), checks);
         }
         model.scenes.insert(case.name().to_owned(), passes);
     }
@@ -126,7 +133,7 @@ pub fn build_model(
 /// The worst `value / limit` of each `(source, scene, pass)` over backends and metrics, with the
 /// limits of `cases`' rules.
 pub fn ratios(cases: &[Case], measurements: &[Measurement]) -> Vec<Ratio> {
-    let mut out: BTreeMap<(String, String, String, String), Ratio> = BTreeMap::new();
+    let mut out: BTreeMap<(String, String, TargetId, String), Ratio> = BTreeMap::new();
     for m in measurements {
         let Some(case) = cases.iter().find(|c| c.name() == m.scene) else {
             continue;
@@ -141,18 +148,13 @@ pub fn ratios(cases: &[Case], measurements: &[Measurement]) -> Vec<Ratio> {
             };
             let ratio = crate::golden::tolerance::ratio(*value, limit, false);
             let entry = out
-                .entry((
-                    m.source.clone(),
-                    m.scene.clone(),
-                    m.pass.clone(),
-                    key.clone(),
-                ))
+                .entry((m.source.clone(), m.scene.clone(), m.pass, key.clone()))
                 .or_insert(Ratio {
                     source: m.source.clone(),
                     scene: m.scene.clone(),
-                    pass: m.pass.clone(),
+                    pass: m.pass,
                     metric: key.clone(),
-                    backend: m.backend.clone(),
+                    backend: m.backend,
                     value: *value,
                     limit,
                     ratio,
@@ -160,7 +162,7 @@ pub fn ratios(cases: &[Case], measurements: &[Measurement]) -> Vec<Ratio> {
             if ratio > entry.ratio {
                 entry.ratio = ratio;
                 entry.value = *value;
-                entry.backend = m.backend.clone();
+                entry.backend = m.backend;
             }
         }
     }
@@ -175,11 +177,12 @@ pub struct Ratio {
     /// Scene.
     pub scene: String,
     /// Pass.
-    pub pass: String,
+    pub pass: TargetId,
     /// Metric, as printed.
     pub metric: String,
-    /// The backend with the worst value.
-    pub backend: String,
+    /// The backend with the worst value (none, `-` in JSON, for synthetic rounding).
+    #[serde(serialize_with = "crate::backend_or_dash")]
+    pub backend: Option<BackendKind>,
     /// The worst value.
     pub value: f64,
     /// The limit.
@@ -206,7 +209,7 @@ mod tests {
         };
         let missed = [Missed {
             source: "vector-128".to_owned(),
-            backend: "wgpu-vulkan".to_owned(),
+            backend: BackendKind::WgpuVulkan,
             scene: "ibl".to_owned(),
             error: why("new"),
             known: true,

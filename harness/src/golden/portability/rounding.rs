@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 
 use engine::assets::linear_to_srgb_u8;
 use engine::ibl::splitmix64;
+use engine::plan::TargetId;
 use engine::scene::ToneMap;
 use engine::{Image, ImageData};
 
@@ -18,18 +19,18 @@ use crate::golden::suite::Case;
 /// values, no arithmetic to round) and outputs drawn over by gizmos are left out.
 pub fn synthetic_rounding(
     case: &Case,
-    outputs: &BTreeMap<String, Image>,
-) -> BTreeMap<String, Image> {
+    outputs: &BTreeMap<TargetId, Image>,
+) -> BTreeMap<TargetId, Image> {
     let quality = &case.loaded.scene.quality;
     let mut out = BTreeMap::new();
     for (seed, (pass, image)) in outputs.iter().enumerate() {
         match &image.data {
             ImageData::F32(_) => {
-                out.insert(pass.clone(), ulp_noise(image, seed as u64));
+                out.insert(*pass, ulp_noise(image, seed as u64));
             }
-            ImageData::U8(_) if pass == engine::plan::FINAL && !quality.gizmos => {
-                if let Some(light) = outputs.get(engine::plan::LIGHT) {
-                    out.insert(pass.clone(), requantize_final(light, quality.tone_map));
+            ImageData::U8(_) if *pass == TargetId::Final && !quality.gizmos => {
+                if let Some(light) = outputs.get(&TargetId::Light) {
+                    out.insert(*pass, requantize_final(light, quality.tone_map));
                 }
             }
             ImageData::U8(_) => {}

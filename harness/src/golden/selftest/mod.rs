@@ -21,6 +21,9 @@
 
 use std::collections::BTreeMap;
 
+use engine::backend::BackendKind;
+use engine::plan::TargetId;
+
 use crate::golden::noise::{MAX_NOISE_RATIO, MIN_MUTATION_RATIO};
 
 mod mutations;
@@ -51,12 +54,12 @@ pub struct MutationResult {
     /// Mutation.
     pub mutation: Mutation,
     /// Backend.
-    pub backend: String,
+    pub backend: BackendKind,
     /// Whether the mutation applies to the scene (if not, nothing was rendered).
     pub applies: bool,
     /// `value / limit` of every checked golden pass's rule (see
     /// [`crate::golden::tolerance::Verdict::ratio`] and [`MutationChecks`]).
-    pub ratios: BTreeMap<String, f64>,
+    pub ratios: BTreeMap<TargetId, f64>,
     /// Why the render failed, if it did.
     pub error: Option<String>,
 }
@@ -67,17 +70,17 @@ impl MutationResult {
     pub fn origin_ratio(&self) -> Option<f64> {
         self.ratios
             .iter()
-            .filter(|(pass, _)| self.mutation.is_origin(pass))
+            .filter(|(pass, _)| self.mutation.is_origin(**pass))
             .map(|(_, &r)| r)
             .fold(None, |m: Option<f64>, r| Some(m.map_or(r, |m| m.max(r))))
     }
 
     /// Other passes that failed (ratio above 1).
-    pub fn also_failing(&self) -> Vec<&str> {
+    pub fn also_failing(&self) -> Vec<TargetId> {
         self.ratios
             .iter()
-            .filter(|(pass, &r)| r > 1.0 && !self.mutation.is_origin(pass))
-            .map(|(pass, _)| pass.as_str())
+            .filter(|(pass, &r)| r > 1.0 && !self.mutation.is_origin(**pass))
+            .map(|(pass, _)| *pass)
             .collect()
     }
 }
@@ -89,10 +92,11 @@ pub struct NoiseResult {
     pub source: String,
     /// Scene.
     pub scene: String,
-    /// Backend (`-` where the source has none).
-    pub backend: String,
+    /// Backend (none where the source has none; `-` in JSON).
+    #[serde(serialize_with = "crate::backend_or_dash")]
+    pub backend: Option<BackendKind>,
     /// Pass.
-    pub pass: String,
+    pub pass: TargetId,
     /// `value / limit` of the pass's rule (for recorded figures, the worst check's).
     pub ratio: f64,
     /// Rendered by this run (rather than read from golden/noise.toml).

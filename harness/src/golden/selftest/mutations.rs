@@ -1,7 +1,7 @@
 //! The known changes of the self-test: what each is, the pass where it must be caught, and how
 //! it changes a scene (or the renderer, through an injected fault).
 
-use engine::plan;
+use engine::plan::{GBufferTarget, TargetId};
 use engine::renderer::Faults;
 use engine::scene::{Light, LightingModel, Material, Scene};
 use glam::DQuat;
@@ -87,22 +87,34 @@ impl Mutation {
     /// The golden pass where the change first shows, and so must be caught: lighting changes in
     /// the light buffer, material changes in the G-buffer target that holds them, geometry in
     /// depth, the lighting model in the mask, tone mapping in the final image.
-    pub fn origin(self) -> &'static str {
+    pub fn origin(self) -> TargetId {
         match self {
             Mutation::LightIntensity
             | Mutation::Exposure
             | Mutation::PointLightMoved
             | Mutation::EnvironmentIntensity
             | Mutation::EnvironmentRotation
-            | Mutation::ShadowBias => plan::LIGHT,
-            Mutation::Roughness => "gbuffer_position",
-            Mutation::Metallic | Mutation::Clearcoat => "gbuffer_material",
-            Mutation::Specular => "gbuffer_normal",
-            Mutation::BaseColor | Mutation::GbufferChannelSwap => "gbuffer_albedo",
-            Mutation::CameraYaw => plan::DEPTH,
-            Mutation::LightingModel => "mask",
-            Mutation::ToneCurve => plan::FINAL,
+            | Mutation::ShadowBias => TargetId::Light,
+            Mutation::Roughness => TargetId::GBuffer(GBufferTarget::Position),
+            Mutation::Metallic | Mutation::Clearcoat => TargetId::GBuffer(GBufferTarget::Material),
+            Mutation::Specular => TargetId::GBuffer(GBufferTarget::Normal),
+            Mutation::BaseColor | Mutation::GbufferChannelSwap => {
+                TargetId::GBuffer(GBufferTarget::Albedo)
+            }
+            Mutation::CameraYaw => TargetId::Depth,
+            Mutation::LightingModel => TargetId::Mask(0),
+            Mutation::ToneCurve => TargetId::Final,
         }
+    }
+
+    /// Whether the mutation changes the environment, which the IBL maps and an extracted sun
+    /// derive from: it applies to the scene as loaded, which is then prepared anew. Every other
+    /// mutation applies to the scene as drawn, an extracted sun's light included.
+    pub fn changes_environment(self) -> bool {
+        matches!(
+            self,
+            Mutation::EnvironmentIntensity | Mutation::EnvironmentRotation
+        )
     }
 
     /// Applies the mutation; `None` when the scene has nothing it could change (no lights, no
@@ -212,9 +224,9 @@ fn scalar_material(scene: &mut Scene, scalar: impl Fn(&Material) -> bool) -> Opt
 
 impl Mutation {
     /// Whether `pass` is where this mutation originates (any shadow term, for the shadow bias).
-    pub fn is_origin(self, pass: &str) -> bool {
+    pub fn is_origin(self, pass: TargetId) -> bool {
         match self {
-            Mutation::ShadowBias => pass.starts_with("shadow_term_"),
+            Mutation::ShadowBias => matches!(pass, TargetId::ShadowTerm { .. }),
             _ => pass == self.origin(),
         }
     }

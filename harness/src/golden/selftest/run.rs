@@ -5,8 +5,8 @@
 use std::collections::BTreeMap;
 
 use engine::backend::{self, BackendKind};
-use engine::renderer::{self, Faults, Readback};
-use engine::scene::Scene;
+use engine::plan::TargetId;
+use engine::renderer::{self, Faults, PreparedFrame, Readback};
 use engine::Image;
 
 use super::{Mutation, MutationChecks, MutationResult, NoiseResult, SelfTest};
@@ -16,14 +16,14 @@ use crate::golden::suite::{self, Case};
 use crate::golden::{self, GoldenStore, Outcome};
 
 /// The golden of every pass of a case, by pass (`None` where there is none).
-type Goldens = BTreeMap<String, Option<Image>>;
+type Goldens = BTreeMap<TargetId, Option<Image>>;
 
 /// Ratios of every golden pass of `outputs` against the goldens.
 fn ratios(
     case: &Case,
     goldens: &Goldens,
-    outputs: &BTreeMap<String, Image>,
-) -> BTreeMap<String, f64> {
+    outputs: &BTreeMap<TargetId, Image>,
+) -> BTreeMap<TargetId, f64> {
     let mut out = BTreeMap::new();
     for pass in &case.passes {
         let (Some(actual), Some(golden)) = (outputs.get(pass), goldens.get(pass)) else {
@@ -33,7 +33,7 @@ fn ratios(
             Outcome::Passed(v) | Outcome::Failed(v) => v.ratio,
             Outcome::MissingGolden | Outcome::Incomparable(_) => f64::INFINITY,
         };
-        out.insert(pass.clone(), ratio);
+        out.insert(*pass, ratio);
     }
     out
 }
@@ -96,9 +96,9 @@ fn run_case(
     let goldens: Goldens = case
         .passes
         .iter()
-        .map(|pass| {
+        .map(|&pass| {
             let golden = store.load(case.name(), pass, case.is_eight_bit(pass));
-            (pass.clone(), golden.ok().flatten())
+            (pass, golden.ok().flatten())
         })
         .collect();
     let reference = backends
@@ -126,8 +126,7 @@ fn run_backend(
     checks: MutationChecks,
     result: &mut SelfTest,
 ) {
-    let scene = &case.loaded.scene;
-    let wanted: Vec<&str> = case.passes.iter().map(String::as_str).collect();
+    let wanted: &[TargetId] = &case.passes;
     let mut backend = match backend::create(kind) {
         Ok(backend) => backend,
         Err(e) => {
@@ -137,11 +136,11 @@ fn run_backend(
             return;
         }
     };
-    let mut render = |scene: &Scene, faults: &Faults, wanted: &[&str]| {
-        renderer::render_with_faults(backend.as_mut(), scene, Readback::Needed(wanted), faults)
+    let mut render = |frame: &PreparedFrame, faults: &Faults, wanted: &[TargetId]| {
+        renderer::render_prepared(backend.as_mut(), frame, Readback::Needed(wanted), faults)
             .map_err(|e| e.to_string())
     };
-    match render(scene, &Faults::default(), &wanted) {
+    match render(&case.frame, &Faults::default(), wanted) {
         Ok(frame) => unchanged_noise(case, kind, reference, goldens, &frame.outputs, result),
         Err(e) => result
             .errors
@@ -151,22 +150,36 @@ fn run_backend(
         let mut entry = MutationResult {
             scene: case.name().to_owned(),
             mutation,
-            backend: kind.name().to_owned(),
+            backend: kind,
             applies: false,
             ratios: BTreeMap::new(),
             error: None,
         };
-        if let Some((mutated, faults)) = mutation.apply(scene) {
+        // Environment changes apply to the scene as loaded, prepared anew; the others to the
+        // scene as drawn (an extracted sun's light too), re-planned with the same IBL maps.
+        let mutated = if mutation.changes_environment() {
+            mutation
+                .apply(&case.loaded.scene)
+                .map(|(scene, faults)| (PreparedFrame::new(&scene), faults))
+        } else {
+            mutation
+                .apply(case.frame.scene())
+                .map(|(scene, faults)| (case.frame.varied(scene), faults))
+        };
+        if let Some((mutated, faults)) = mutated {
             entry.applies = true;
-            let checked: Vec<&str> = match checks {
-                MutationChecks::EveryPass => wanted.clone(),
+            let checked: Vec<TargetId> = match checks {
+                MutationChecks::EveryPass => wanted.to_vec(),
                 MutationChecks::Origin => wanted
                     .iter()
                     .copied()
-                    .filter(|pass| mutation.is_origin(pass))
+                    .filter(|pass| mutation.is_origin(*pass))
                     .collect(),
             };
-            match render(&mutated, &faults, &checked) {
+            let rendered = mutated
+                .map_err(|e| e.to_string())
+                .and_then(|frame| render(&frame, &faults, &checked));
+            match rendered {
                 Ok(frame) => entry.ratios = ratios(case, goldens, &frame.outputs),
                 Err(e) => {
                     result.errors.push(format!(
@@ -189,14 +202,14 @@ fn unchanged_noise(
     kind: BackendKind,
     reference: bool,
     goldens: &Goldens,
-    outputs: &BTreeMap<String, Image>,
+    outputs: &BTreeMap<TargetId, Image>,
     result: &mut SelfTest,
 ) {
     for (pass, ratio) in ratios(case, goldens, outputs) {
         result.noise.push(NoiseResult {
             source: "drivers".to_owned(),
             scene: case.name().to_owned(),
-            backend: kind.name().to_owned(),
+            backend: Some(kind),
             pass,
             ratio,
             live: true,
@@ -208,7 +221,7 @@ fn unchanged_noise(
             result.noise.push(NoiseResult {
                 source: "synthetic-rounding".to_owned(),
                 scene: case.name().to_owned(),
-                backend: "-".to_owned(),
+                backend: None,
                 pass,
                 ratio,
                 live: true,
@@ -223,8 +236,9 @@ fn recorded_noise(case: &Case, model: &NoiseModel, noise: &mut Vec<NoiseResult>)
     let Some(passes) = model.scenes.get(case.name()) else {
         return;
     };
-    for (pass, checks) in passes {
-        let Some(rule) = case.rules.get(pass) else {
+    for (name, checks) in passes {
+        // The file's keys are names; one the case has no golden pass for is not its noise.
+        let Some((&pass, rule)) = case.rules.iter().find(|(p, _)| p.to_string() == *name) else {
             continue;
         };
         for (metric, limit) in rule.checks() {
@@ -239,8 +253,8 @@ fn recorded_noise(case: &Case, model: &NoiseModel, noise: &mut Vec<NoiseResult>)
                 noise.push(NoiseResult {
                     source: source.to_owned(),
                     scene: case.name().to_owned(),
-                    backend: backend.to_owned(),
-                    pass: pass.clone(),
+                    backend: backend.parse().ok(),
+                    pass,
                     ratio: crate::golden::tolerance::ratio(value, limit, false),
                     live: false,
                 });

@@ -1,21 +1,23 @@
 //! The self-test's findings as text: the margin table of the mutations and the noise table of
 //! the unchanged renders.
 
+use engine::backend::BackendKind;
+
 use super::{Mutation, MutationResult, SelfTest};
 use crate::golden::noise::{MAX_NOISE_RATIO, MIN_MUTATION_RATIO};
 
 impl SelfTest {
     /// The backends named in the findings, in order of first appearance.
-    fn backends(&self) -> Vec<String> {
-        let mut backends: Vec<String> = Vec::new();
+    fn backends(&self) -> Vec<BackendKind> {
+        let mut backends: Vec<BackendKind> = Vec::new();
         for b in self
             .mutations
             .iter()
-            .map(|m| &m.backend)
-            .chain(self.noise.iter().map(|n| &n.backend))
+            .map(|m| m.backend)
+            .chain(self.noise.iter().filter_map(|n| n.backend))
         {
-            if b != "-" && !backends.contains(b) {
-                backends.push(b.clone());
+            if !backends.contains(&b) {
+                backends.push(b);
             }
         }
         backends
@@ -47,18 +49,18 @@ impl SelfTest {
                 "{:<34} {scene:<7} {:<17}",
                 mutation.describe(),
                 if mutation == Mutation::ShadowBias {
-                    "shadow_term_*"
+                    "shadow_term_*".to_owned()
                 } else {
-                    mutation.origin()
+                    mutation.origin().to_string()
                 }
             ));
             if !rows.iter().any(|m| m.applies) {
                 out.push_str(" n/a\n");
                 continue;
             }
-            let mut also: Vec<&str> = Vec::new();
+            let mut also = Vec::new();
             for b in &backends {
-                let cell = match rows.iter().find(|m| &m.backend == b) {
+                let cell = match rows.iter().find(|m| m.backend == *b) {
                     None => "-".to_owned(),
                     Some(m) if m.error.is_some() => "ERROR".to_owned(),
                     Some(m) => {
@@ -76,6 +78,7 @@ impl SelfTest {
                 };
                 out.push_str(&format!(" {cell:>11}"));
             }
+            let also: Vec<String> = also.iter().map(ToString::to_string).collect();
             out.push_str(&format!("  {}\n", also.join(",")));
         }
         out
@@ -86,10 +89,12 @@ impl SelfTest {
     pub fn noise_table(&self) -> String {
         let backends = self.backends();
         let mut out = format!("{:<28} {:<7}", "unchanged render, source", "scene");
-        for b in backends.iter().chain(std::iter::once(&"-".to_owned())) {
+        let columns: Vec<Option<BackendKind>> =
+            backends.iter().copied().map(Some).chain([None]).collect();
+        for b in &columns {
             out.push_str(&format!(
                 " {:>26}",
-                if b == "-" { "(no backend)" } else { b }
+                b.map_or("(no backend)", BackendKind::name)
             ));
         }
         out.push('\n');
@@ -107,11 +112,11 @@ impl SelfTest {
                 source.to_owned()
             };
             out.push_str(&format!("{label:<28} {scene:<7}"));
-            for b in backends.iter().chain(std::iter::once(&"-".to_owned())) {
+            for b in &columns {
                 let worst = self
                     .noise
                     .iter()
-                    .filter(|n| n.source == source && n.scene == scene && &n.backend == b)
+                    .filter(|n| n.source == source && n.scene == scene && n.backend == *b)
                     .max_by(|x, y| x.ratio.total_cmp(&y.ratio));
                 let cell = worst.map_or("-".to_owned(), |n| {
                     if n.ratio == 0.0 {

@@ -8,13 +8,13 @@ use engine::backend::{
     DepthState, Draw, Handle, LoadOp, Pipeline, PipelineDesc, RenderPass, ResourceScope,
     ShaderDesc, Subresource, Texture, TextureDesc, Topology,
 };
-use engine::plan::RenderPlan;
+use engine::plan::{PassId, RenderPlan};
 use engine::shaders;
 
 /// Floor passes for every pass of a plan, created once on a backend and submitted on demand.
 pub struct Floors {
     scope: ResourceScope,
-    passes: BTreeMap<String, RenderPass>,
+    passes: BTreeMap<PassId, RenderPass>,
 }
 
 impl Floors {
@@ -35,7 +35,7 @@ impl Floors {
         backend: &mut dyn Backend,
         plan: &RenderPlan,
         scope: &mut ResourceScope,
-    ) -> backend::Result<BTreeMap<String, RenderPass>> {
+    ) -> backend::Result<BTreeMap<PassId, RenderPass>> {
         let shader = scope.shader(
             backend,
             &ShaderDesc {
@@ -46,7 +46,7 @@ impl Floors {
         let mut pipelines: BTreeMap<String, Handle<Pipeline>> = BTreeMap::new();
         let mut passes = BTreeMap::new();
         for spec in &plan.passes {
-            let targets: Vec<_> = spec.writes.iter().filter_map(|w| plan.target(w)).collect();
+            let targets: Vec<_> = spec.writes.iter().filter_map(|w| plan.target(*w)).collect();
             let colors: Vec<_> = targets.iter().filter(|t| !t.format.is_depth()).collect();
             let depth = targets.iter().find(|t| t.format.is_depth());
             if colors.len() > 5 || (colors.is_empty() && depth.is_none()) {
@@ -97,7 +97,7 @@ impl Floors {
                     scope.texture(
                         backend,
                         &TextureDesc::d2(
-                            &format!("floor {}", spec.name),
+                            &format!("floor {}", spec.id),
                             spec.width,
                             spec.height,
                             spec.format,
@@ -121,9 +121,9 @@ impl Floors {
                 None => None,
             };
             passes.insert(
-                spec.name.clone(),
+                spec.id,
                 RenderPass {
-                    name: format!("{} floor", spec.name),
+                    name: format!("{} floor", spec.id),
                     color_attachments,
                     depth_attachment,
                     viewports: vec![],
@@ -142,8 +142,8 @@ impl Floors {
 
     /// Submits the floor of plan pass `pass` once; its GPU ns (None without timestamps or when
     /// the pass has no floor).
-    pub fn time(&self, backend: &mut dyn Backend, pass: &str) -> backend::Result<Option<f64>> {
-        let Some(floor) = self.passes.get(pass) else {
+    pub fn time(&self, backend: &mut dyn Backend, pass: PassId) -> backend::Result<Option<f64>> {
+        let Some(floor) = self.passes.get(&pass) else {
             return Ok(None);
         };
         let timings = backend.submit(std::slice::from_ref(floor))?;

@@ -9,7 +9,8 @@
 //! 5 frames, three of 21). Scheduling only adds time, so the lower frames measure the work.
 
 use engine::backend::{self, Backend, BackendKind};
-use engine::plan::{LightingFeature, PassKind, PassSpec, RenderPlan};
+use engine::plan::{LightingFeature, PassId, PassSpec, RenderPlan};
+use engine::renderer::{PassTimes, PreparedFrame};
 use engine::scene::Scene;
 
 use super::timing::{percentile_pass_ms, time_frame};
@@ -41,10 +42,10 @@ pub struct BreakdownRow {
 pub struct PassBreakdown {
     /// Scene name.
     pub scene: String,
-    /// Backend name.
-    pub backend: String,
-    /// Plan pass name.
-    pub pass: String,
+    /// Backend.
+    pub backend: BackendKind,
+    /// Plan pass.
+    pub pass: PassId,
     /// Frames timed per variant (after a warm-up frame).
     pub frames: usize,
     /// The pass's GPU ms as it is (lower quartile of frames).
@@ -72,13 +73,18 @@ pub fn breakdown(
     progress: impl Fn(&str),
 ) -> Result<Vec<PassBreakdown>, BenchError> {
     let mut backend = backend::create(kind).map_err(|e| BenchError::Backend {
-        backend: kind.name().to_owned(),
+        backend: kind,
         message: e.to_string(),
     })?;
     let frames = frames.max(1);
-    let plan = RenderPlan::new(scene);
-    let removals = removals(scene, &plan);
-    let mut timings = time_variants(backend.as_mut(), scene, frames, &removals, progress)?;
+    let prepared = PreparedFrame::new(scene).map_err(|e| BenchError::Render {
+        scene: scene.name.clone(),
+        backend: kind,
+        message: e.to_string(),
+    })?;
+    let plan = prepared.plan();
+    let removals = removals(prepared.scene(), plan);
+    let mut timings = time_variants(backend.as_mut(), &prepared, frames, &removals, progress)?;
     let full = timings.remove(0);
     let kept_inputs = timings.remove(0);
     let frames = VariantFrames {
@@ -90,9 +96,9 @@ pub fn breakdown(
     for spec in plan
         .passes
         .iter()
-        .filter(|p| matches!(p.kind, PassKind::Lighting(_)))
+        .filter(|p| matches!(p.id, PassId::Lighting(_)))
     {
-        result.extend(pass_breakdown(scene, kind, &plan, spec, &removals, &frames));
+        result.extend(pass_breakdown(scene, kind, plan, spec, &removals, &frames));
     }
     Ok(result)
 }
@@ -100,9 +106,9 @@ pub fn breakdown(
 /// The frames' pass timings of every variant: as it is, the baseline that re-reads its inputs,
 /// and without each removal (in the removals' order).
 struct VariantFrames {
-    full: Vec<Vec<backend::PassTiming>>,
-    kept_inputs: Vec<Vec<backend::PassTiming>>,
-    without: Vec<Vec<Vec<backend::PassTiming>>>,
+    full: Vec<PassTimes>,
+    kept_inputs: Vec<PassTimes>,
+    without: Vec<Vec<PassTimes>>,
 }
 
 /// One part of the lighting passes' work to take away: the row's label, the part, and whether
@@ -173,25 +179,25 @@ fn removals(scene: &Scene, plan: &RenderPlan) -> Vec<Removal> {
 /// of `removals`): per variant, the pass timings of `frames` frames after a warm-up.
 fn time_variants(
     backend: &mut dyn Backend,
-    scene: &Scene,
+    prepared: &PreparedFrame,
     frames: usize,
     removals: &[Removal],
     progress: impl Fn(&str),
-) -> Result<Vec<Vec<Vec<backend::PassTiming>>>, BenchError> {
+) -> Result<Vec<Vec<PassTimes>>, BenchError> {
     // Frames are interleaved (one of each variant in turn, after one warm-up frame of each),
     // so that a drift of the machine's speed during the run falls on every variant alike.
     let variants: Vec<Option<LightingFeature>> = [None, Some(LightingFeature::KeptInputs)]
         .into_iter()
         .chain(removals.iter().map(|(_, feature, _)| Some(*feature)))
         .collect();
-    let mut timings: Vec<Vec<Vec<backend::PassTiming>>> = vec![Vec::new(); variants.len()];
+    let mut timings: Vec<Vec<PassTimes>> = vec![Vec::new(); variants.len()];
     for round in 0..=frames {
         progress(&format!(
             "round {round} of {frames}: {} variants",
             variants.len()
         ));
         for (variant, timed) in variants.iter().zip(&mut timings) {
-            let (frame, _) = time_frame(backend, scene, *variant)?;
+            let (frame, _) = time_frame(backend, prepared, *variant)?;
             if round > 0 {
                 timed.push(frame);
             }
@@ -211,7 +217,7 @@ fn pass_breakdown(
     frames: &VariantFrames,
 ) -> Option<PassBreakdown> {
     let (full, without) = (&frames.full, &frames.without);
-    let PassKind::Lighting(model) = spec.kind else {
+    let PassId::Lighting(model) = spec.id else {
         return None;
     };
     let pass_draws = plan.lighting_draws(model);
@@ -227,9 +233,8 @@ fn pass_breakdown(
         LightingFeature::Light(light) => pass_draws.iter().any(|d| d.lights.contains(&light)),
         LightingFeature::KeptInputs => false,
     };
-    let pass_ms = |timings: &[Vec<backend::PassTiming>]| {
-        percentile_pass_ms(plan, timings, &spec.name, BREAKDOWN_PERCENTILE)
-    };
+    let pass_ms =
+        |timings: &[PassTimes]| percentile_pass_ms(timings, spec.id, BREAKDOWN_PERCENTILE);
     let total_ms = pass_ms(full);
     // The differences are taken from the pass re-reading its inputs, as every variant does.
     let baseline_ms = pass_ms(&frames.kept_inputs);
@@ -282,8 +287,8 @@ fn pass_breakdown(
         .sum::<Option<f64>>();
     Some(PassBreakdown {
         scene: scene.name.clone(),
-        backend: kind.name().to_owned(),
-        pass: spec.name.clone(),
+        backend: kind,
+        pass: spec.id,
         frames: full.len(),
         total_ms,
         rows,
@@ -304,17 +309,20 @@ const SHARED_ROW: &str = "shared by IBL and the lights (surface, view)";
 mod tests {
     use super::*;
 
-    /// One frame's timings: the pass `name` took `ms`.
-    fn frame(name: &str, ms: f64) -> Vec<backend::PassTiming> {
-        vec![backend::PassTiming {
-            name: name.to_owned(),
-            gpu_ns: Some(ms * 1e6),
-        }]
+    /// One frame's timings: the pass `pass` took `ms`.
+    fn frame(pass: PassId, ms: f64) -> PassTimes {
+        PassTimes {
+            passes: vec![backend::PassTiming {
+                name: pass.to_string(),
+                gpu_ns: Some(ms * 1e6),
+            }],
+            owners: vec![Some(pass)],
+        }
     }
 
     /// Eight frames of a variant whose work takes `ms`: two at `ms`, the others in a slower
     /// cluster 0.2 ms up (scheduling), `slow` of them.
-    fn frames(name: &str, ms: f64, slow: usize) -> Vec<Vec<backend::PassTiming>> {
+    fn frames(name: PassId, ms: f64, slow: usize) -> Vec<PassTimes> {
         (0..8)
             .map(|i| {
                 frame(
@@ -338,14 +346,11 @@ mod tests {
     #[test]
     fn parts_add_up_over_bimodal_frames() {
         let scene = crate::load_scene("arrow").unwrap().scene;
-        let plan = RenderPlan::new(&scene);
-        let removals = removals(&scene, &plan);
-        let spec = plan
-            .passes
-            .iter()
-            .find(|p| p.name == "lighting_blinn_phong")
-            .unwrap();
-        let name = spec.name.as_str();
+        let prepared = PreparedFrame::new(&scene).unwrap();
+        let plan = prepared.plan();
+        let removals = removals(&scene, plan);
+        let name = PassId::Lighting(engine::scene::LightingModel::BlinnPhong);
+        let spec = plan.pass(name).unwrap();
         // (work ms, frames in the slow cluster) of each variant.
         let variant = |feature: LightingFeature| match feature {
             LightingFeature::Shading => (0.30, 3),
@@ -367,7 +372,7 @@ mod tests {
             full: full.clone(),
             without: without.clone(),
         };
-        let b = pass_breakdown(&scene, BackendKind::Gl, &plan, spec, &removals, &timed).unwrap();
+        let b = pass_breakdown(&scene, BackendKind::Gl, plan, spec, &removals, &timed).unwrap();
         assert_eq!(b.frames, 8);
         // Input floor, setup, the light (and, not summed, its shadow lookups), the re-reads.
         assert_eq!(b.rows.iter().filter(|r| r.summed).count(), 4, "{b:?}");
@@ -375,8 +380,11 @@ mod tests {
         assert!((b.sum_to_total.unwrap() - 1.0).abs() < 1e-9, "{b:?}");
         // The same frames by their medians (rank 4 of 8): the light-less variant is slow,
         // the pass without its light fast, and the parts come to 0.2 ms more than the pass.
-        let median = |timings: &[Vec<backend::PassTiming>]| {
-            let ms = timings.iter().map(|t| t[0].gpu_ns.unwrap() / 1e6).collect();
+        let median = |timings: &[PassTimes]| {
+            let ms = timings
+                .iter()
+                .map(|t| t.passes[0].gpu_ns.unwrap() / 1e6)
+                .collect();
             engine::stats::median(ms).unwrap()
         };
         let index = |feature| removals.iter().position(|(_, f, _)| *f == feature).unwrap();
@@ -402,7 +410,7 @@ mod tests {
                 })
                 .collect(),
         };
-        let b = pass_breakdown(&scene, BackendKind::Gl, &plan, spec, &removals, &timed).unwrap();
+        let b = pass_breakdown(&scene, BackendKind::Gl, plan, spec, &removals, &timed).unwrap();
         let light_row = b
             .rows
             .iter()

@@ -26,13 +26,15 @@ mod series;
 mod tables;
 mod timing;
 
+use engine::backend::BackendKind;
+
 pub use floors::Floors;
 pub use lighting_breakdown::{breakdown, BreakdownRow, PassBreakdown, BREAKDOWN_FRAMES};
 pub use precompute::{precompute, Precompute};
 pub use report::{report_sections, series_svg, BENCH_JSON, SERIES_JSON};
 pub use series::{series, SeriesPoint, SERIES};
 pub use tables::{breakdown_table, series_table, table};
-pub use timing::{bench_scene, pass_time, timed_render, PassBench, SceneBench};
+pub use timing::{bench_scene, timed_render, PassBench, SceneBench};
 
 /// Frames timed per scene and backend by `harness bench` and its series unless told otherwise.
 pub const BENCH_FRAMES: usize = 5;
@@ -43,8 +45,8 @@ pub enum BenchError {
     /// The backend is missing or failed.
     #[error("{backend}: {message}")]
     Backend {
-        /// Backend name.
-        backend: String,
+        /// Backend.
+        backend: BackendKind,
         /// What went wrong.
         message: String,
     },
@@ -53,8 +55,8 @@ pub enum BenchError {
     Render {
         /// Scene name.
         scene: String,
-        /// Backend name.
-        backend: String,
+        /// Backend.
+        backend: BackendKind,
         /// What went wrong.
         message: String,
     },
@@ -63,43 +65,6 @@ pub enum BenchError {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use engine::backend::PassTiming;
-    use engine::plan::PassSpec;
-
-    fn timing(name: &str, ns: f64) -> PassTiming {
-        PassTiming {
-            name: name.to_owned(),
-            gpu_ns: Some(ns),
-        }
-    }
-
-    #[test]
-    fn a_pass_time_sums_its_faces_and_nothing_else() {
-        let spec = |name: &str| PassSpec {
-            name: name.to_owned(),
-            kind: engine::plan::PassKind::Geometry,
-            reads: vec![],
-            writes: vec![],
-            detail: String::new(),
-        };
-        let timings = [
-            timing("shadow_0+x", 1.0),
-            timing("shadow_0-x", 2.0),
-            timing("shadow_0_blur_x", 4.0),
-            timing("shadow_1", 8.0),
-            timing("geometry", 16.0),
-        ];
-        assert_eq!(pass_time(&timings, &spec("shadow_0")), Some(3.0));
-        assert_eq!(pass_time(&timings, &spec("shadow_0_blur_x")), Some(4.0));
-        assert_eq!(pass_time(&timings, &spec("shadow_1")), Some(8.0));
-        assert_eq!(pass_time(&timings, &spec("lighting_pbr")), None);
-        let untimed = [PassTiming {
-            name: "geometry".to_owned(),
-            gpu_ns: None,
-        }];
-        assert_eq!(pass_time(&untimed, &spec("geometry")), None);
-    }
-
     #[test]
     fn series_plots_have_a_point_per_value() {
         let points: Vec<SeriesPoint> = [(1u64, 1.0), (8, 3.0), (64, 20.0)]
@@ -107,7 +72,7 @@ mod tests {
             .map(|(value, ms)| SeriesPoint {
                 series: "lights".to_owned(),
                 value,
-                pass: "lighting_pbr".to_owned(),
+                pass: engine::plan::PassId::Lighting(engine::scene::LightingModel::Pbr),
                 pass_ms: Some(ms),
                 frame_ms: Some(ms + 1.0),
             })

@@ -22,7 +22,7 @@ pub fn series_svg(points: &[SeriesPoint]) -> String {
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
          style=\"background:#fff;border:1px solid #ccc\">\
          <text x=\"{left}\" y=\"14\" font-size=\"12\">{} ms against {}</text>",
-        crate::html::escape(&first.pass),
+        crate::html::escape(&first.pass.to_string()),
         crate::html::escape(&first.series)
     );
     if data.is_empty() {

@@ -2,11 +2,15 @@
 //! triangles and shadow-map size.
 
 use engine::backend::{self, BackendKind};
-use engine::plan::RenderPlan;
-use engine::scene::Scene;
+use engine::plan::PassId;
+use engine::renderer::PreparedFrame;
+use engine::scene::{LightingModel, Scene};
 
 use super::timing::{median_frame_ms, median_pass_ms, time_frames};
 use super::BenchError;
+
+/// The PBR lighting pass, which the resolution and light series time.
+const PBR: PassId = PassId::Lighting(LightingModel::Pbr);
 
 /// The scaling series `harness bench --series` knows.
 pub const SERIES: [&str; 4] = ["resolution", "lights", "triangles", "shadow-map"];
@@ -19,7 +23,7 @@ pub struct SeriesPoint {
     /// The value varied: pixels per side, point lights, triangles, or shadow-map texels per side.
     pub value: u64,
     /// The pass the series is about.
-    pub pass: String,
+    pub pass: PassId,
     /// Its median GPU time, ms.
     pub pass_ms: Option<f64>,
     /// Median GPU time of the whole frame, ms.
@@ -40,29 +44,23 @@ pub fn series(
             .map(|l| l.scene)
             .map_err(|e| BenchError::Render {
                 scene: "chess".to_owned(),
-                backend: kind.name().to_owned(),
+                backend: kind,
                 message: e.to_string(),
             })
     };
-    let settings: Vec<(u64, Scene, &str)> = match name {
+    let settings: Vec<(u64, Scene, PassId)> = match name {
         "resolution" => [256u32, 512, 1024, 2048]
             .into_iter()
             .map(|size| {
                 let mut scene = chess()?;
                 scene.quality.width = size;
                 scene.quality.height = size;
-                Ok((u64::from(size), scene, "lighting_pbr"))
+                Ok((u64::from(size), scene, PBR))
             })
             .collect::<Result<_, BenchError>>()?,
         "lights" => [1usize, 8, 64, 256]
             .into_iter()
-            .map(|n| {
-                (
-                    n as u64,
-                    crate::test_scenes::many_point_lights(512, n),
-                    "lighting_pbr",
-                )
-            })
+            .map(|n| (n as u64, crate::test_scenes::many_point_lights(512, n), PBR))
             .collect(),
         "triangles" => {
             let mut scene = chess()?;
@@ -80,7 +78,7 @@ pub fn series(
                     }
                 }
                 let triangles: usize = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
-                points.push((triangles as u64, scene.clone(), "geometry"));
+                points.push((triangles as u64, scene.clone(), PassId::Geometry));
             }
             points
         }
@@ -96,31 +94,35 @@ pub fn series(
                         s.map_size = size;
                     }
                 }
-                Ok((u64::from(size), scene, "shadow_0"))
+                Ok((u64::from(size), scene, PassId::Shadow { light: 0 }))
             })
             .collect::<Result<_, BenchError>>()?,
         other => {
             return Err(BenchError::Render {
                 scene: "-".to_owned(),
-                backend: kind.name().to_owned(),
+                backend: kind,
                 message: format!("unknown series `{other}` (known: {})", SERIES.join(", ")),
             })
         }
     };
     let mut backend = backend::create(kind).map_err(|e| BenchError::Backend {
-        backend: kind.name().to_owned(),
+        backend: kind,
         message: e.to_string(),
     })?;
     let mut points = Vec::new();
     for (value, scene, pass) in settings {
         progress(&format!("{name} {value}"));
-        let plan = RenderPlan::new(&scene);
-        let (timings, _) = time_frames(backend.as_mut(), &scene, frames.max(1), None)?;
+        let prepared = PreparedFrame::new(&scene).map_err(|e| BenchError::Render {
+            scene: scene.name.clone(),
+            backend: kind,
+            message: e.to_string(),
+        })?;
+        let (timings, _) = time_frames(backend.as_mut(), &prepared, frames.max(1), None)?;
         points.push(SeriesPoint {
             series: name.to_owned(),
             value,
-            pass: pass.to_owned(),
-            pass_ms: median_pass_ms(&plan, &timings, pass),
+            pass,
+            pass_ms: median_pass_ms(&timings, pass),
             frame_ms: median_frame_ms(&timings),
         });
     }

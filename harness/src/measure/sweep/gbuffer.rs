@@ -2,11 +2,11 @@
 //! and moved far from it, timed and measured against the default storage at the origin.
 
 use engine::backend::{self, BackendKind};
-use engine::plan;
+use engine::plan::{PassId, TargetId};
 use engine::renderer::{self, Frame, Readback};
 use engine::scene::Scene;
 
-use super::{pareto_front, pass_ms, stats, SweepError};
+use super::{lighting, pareto_front, pass_ms, stats, SweepError};
 
 /// One setting and distance of the G-buffer sweep.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -52,14 +52,14 @@ pub const GBUFFER_DISTANCES: [f64; 3] = [0.0, 1e3, 1e4];
 
 fn relative_errors(reference: &Frame, frame: &Frame) -> (f64, f64, f64) {
     let (Some(a), Some(b)) = (
-        reference.output(plan::LIGHT).and_then(|i| i.as_f32()),
-        frame.output(plan::LIGHT).and_then(|i| i.as_f32()),
+        reference.output(TargetId::Light).and_then(|i| i.as_f32()),
+        frame.output(TargetId::Light).and_then(|i| i.as_f32()),
     ) else {
         return (f64::NAN, f64::NAN, f64::NAN);
     };
     let mask = reference
         .outputs
-        .get("mask")
+        .get(&TargetId::Mask(0))
         .and_then(|m| m.as_u8())
         .unwrap_or_default();
     let peak = a.iter().copied().fold(0.0f32, f32::max).max(1e-6);
@@ -90,7 +90,7 @@ pub fn gbuffer_sweep(
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<GbufferSweepRow>, SweepError> {
     let mut backend = backend::create(kind).map_err(|e| SweepError::Render(e.to_string()))?;
-    let wanted = [plan::LIGHT, "mask"];
+    let wanted = [TargetId::Light, TargetId::Mask(0)];
     let mut render = |scene: &Scene| {
         renderer::render(backend.as_mut(), scene, Readback::Only(&wanted))
             .map_err(|e| SweepError::Render(e.to_string()))
@@ -110,8 +110,8 @@ pub fn gbuffer_sweep(
                 .map(|_| render(&variant))
                 .collect::<Result<Vec<_>, _>>()?;
             let (mean, p99, max) = relative_errors(&reference, &frames[0]);
-            let gpu_ms = pass_ms(&frames, "geometry")
-                .zip(pass_ms(&frames, "lighting_"))
+            let gpu_ms = pass_ms(&frames, |p| p == PassId::Geometry)
+                .zip(pass_ms(&frames, lighting))
                 .map(|(g, l)| g + l);
             rows.push(GbufferSweepRow {
                 setting: settings.name(),

@@ -5,7 +5,7 @@ use engine::backend::{self, BackendKind};
 use engine::renderer::{self, Readback};
 use engine::scene::Scene;
 
-use super::{pareto_front_n, pass_ms, stats, SweepError};
+use super::{lighting, pareto_front_n, pass_ms, stats, SweepError};
 
 /// One setting of the IBL sweep.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -221,7 +221,7 @@ pub fn ibl_sweep_with(
             setting: name,
             settings,
             precompute_s,
-            lighting_ms: pass_ms(&frames, "lighting"),
+            lighting_ms: pass_ms(&frames, lighting),
             by_roughness,
             mean_relative,
             p99_max_relative: (p99, max),

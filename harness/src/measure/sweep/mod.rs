@@ -33,6 +33,7 @@ pub use tables::{
     table, worst_cells, IBL_GOAL_MEAN, IBL_GOAL_P95,
 };
 
+use engine::plan::PassId;
 use engine::renderer::Frame;
 use engine::stats::median;
 
@@ -53,21 +54,34 @@ pub enum SweepError {
     Render(String),
 }
 
-fn pass_ms(frames: &[Frame], prefix: &str) -> Option<f64> {
+/// Median over frames of the GPU ms of every pass `of` selects (summed in each frame).
+fn pass_ms(frames: &[Frame], of: impl Fn(PassId) -> bool) -> Option<f64> {
     median(
         frames
             .iter()
             .filter_map(|f| {
                 let ns: Vec<f64> = f
                     .timings
+                    .passes
                     .iter()
-                    .filter(|t| t.name.starts_with(prefix) && !t.name.starts_with("shadow_term"))
-                    .filter_map(|t| t.gpu_ns)
+                    .zip(&f.timings.owners)
+                    .filter(|(_, owner)| owner.is_some_and(&of))
+                    .filter_map(|(t, _)| t.gpu_ns)
                     .collect();
                 (!ns.is_empty()).then(|| ns.iter().sum::<f64>() / 1e6)
             })
             .collect(),
     )
+}
+
+/// The shadow maps' passes (casters and VSM blurs, not the shadow-term outputs).
+fn shadow_map(pass: PassId) -> bool {
+    matches!(pass, PassId::Shadow { .. } | PassId::ShadowBlur { .. })
+}
+
+/// The lighting passes, which the sweeps time.
+fn lighting(pass: PassId) -> bool {
+    matches!(pass, PassId::Lighting(_))
 }
 
 /// Mean, 99th percentile and maximum of some errors (zeros when there are none).

@@ -2,11 +2,12 @@
 //! measured against exact visibility by ray casting and against the converged soft filter.
 
 use engine::backend::{self, BackendKind};
-use engine::plan;
+use engine::plan::TargetId;
+use engine::renderer::PreparedFrame;
 use engine::renderer::{self, Frame, Readback};
 use engine::scene::{Light, Scene, ShadowFilter};
 
-use super::{pareto_front, pass_ms, stats, SweepError};
+use super::{lighting, pareto_front, pass_ms, shadow_map, stats, SweepError};
 use crate::reference::shadows;
 
 /// One setting of the sweep.
@@ -120,13 +121,11 @@ pub fn shadow_sweep_with(
         _ => None,
     };
     let mut backend = backend::create(kind).map_err(|e| SweepError::Render(e.to_string()))?;
-    let term_name = plan::shadow_term_target_name(light);
+    let term_name = TargetId::ShadowTerm { light };
     // What the ray-cast comparison reads (shadow settings change no target but the maps').
-    let targets = shadows::visibility_targets(
-        &plan::RenderPlan::new(&with_shadow(scene, ShadowFilter::Hard, 512)),
-        light,
-    );
-    let wanted: Vec<&str> = targets.iter().map(String::as_str).collect();
+    let hard = PreparedFrame::new(&with_shadow(scene, ShadowFilter::Hard, 512))
+        .map_err(|e| SweepError::Render(e.to_string()))?;
+    let wanted = shadows::visibility_targets(hard.plan(), light);
     let timed = cost == ShadowSweepCost::Timed;
     let readback = if timed {
         Readback::Only(&wanted)
@@ -196,8 +195,8 @@ pub fn shadow_sweep_with(
                 filter: label,
                 map_size,
                 fetches: filter.fetches(samples.unwrap_or(64)),
-                shadow_ms: timed.then(|| pass_ms(&frames, "shadow_")).flatten(),
-                lighting_ms: timed.then(|| pass_ms(&frames, "lighting_")).flatten(),
+                shadow_ms: timed.then(|| pass_ms(&frames, shadow_map)).flatten(),
+                lighting_ms: timed.then(|| pass_ms(&frames, lighting)).flatten(),
                 misclassified: visibility.fraction,
                 error_vs_soft_reference: soft.map(|s| s.0),
                 soft_reference_p99_max: soft.map(|s| (s.1, s.2)),
@@ -229,7 +228,7 @@ pub fn shadow_sweep_with(
 fn abs_difference_stats(a: &[f32], b: &[f32], frame: &Frame) -> (f64, f64, f64) {
     let mask = frame
         .outputs
-        .get("mask")
+        .get(&TargetId::Mask(0))
         .and_then(|m| m.as_u8())
         .unwrap_or_default();
     let mut differences = Vec::new();

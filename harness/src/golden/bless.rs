@@ -1,0 +1,95 @@
+//! Blessing: the one path by which a golden is rewritten, shared by `harness bless` and
+//! `UPDATE_GOLDENS=1 cargo test`. A pass is rewritten when it has no golden, cannot be compared
+//! with it, or is outside its tolerance; or when asked for by name or with every pass. Each
+//! write records the backend, its driver and the metrics against the golden it replaces.
+
+use std::fmt;
+use std::path::PathBuf;
+
+use engine::backend::BackendKind;
+use engine::plan::TargetId;
+use engine::Image;
+
+use super::suite::{bless_change, Case};
+use super::{GoldenError, GoldenStore};
+
+/// Which of a case's golden passes to rewrite beyond those that changed.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BlessRequest<'a> {
+    /// Passes to rewrite even when within tolerance.
+    pub named: &'a [TargetId],
+    /// Rewrite every pass.
+    pub every_pass: bool,
+    /// Decide, print, and write nothing.
+    pub dry_run: bool,
+}
+
+/// What blessing did to one pass.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BlessOutcome {
+    /// Within tolerance and not asked for: the golden stays.
+    Kept,
+    /// Would be rewritten (a dry run).
+    WouldWrite,
+    /// Rewritten at this path.
+    Written(PathBuf),
+}
+
+/// One pass of one scene after blessing.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlessedPass {
+    /// Scene.
+    pub scene: String,
+    /// Pass.
+    pub pass: TargetId,
+    /// The output against the golden it would replace: "new", or the metrics.
+    pub previous: String,
+    /// What was done.
+    pub outcome: BlessOutcome,
+}
+
+impl fmt::Display for BlessedPass {
+    /// One line per pass (two when written): the same words on every route.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}/{}: {}", self.scene, self.pass, self.previous)?;
+        match &self.outcome {
+            BlessOutcome::Kept => f.write_str("; kept"),
+            BlessOutcome::WouldWrite => f.write_str("; would be rewritten (dry run)"),
+            BlessOutcome::Written(path) => write!(f, "\n  wrote {}", path.display()),
+        }
+    }
+}
+
+/// Blesses `image`, the fresh output of `case`'s `pass` rendered on `backend` (whose driver
+/// fingerprint is `driver`), as `request` asks.
+pub fn bless_pass(
+    store: &GoldenStore,
+    case: &Case,
+    pass: TargetId,
+    image: &Image,
+    (backend, driver): (BackendKind, &str),
+    request: BlessRequest<'_>,
+) -> Result<BlessedPass, GoldenError> {
+    let change = bless_change(store, case, pass, image);
+    let write = change.changed || request.every_pass || request.named.contains(&pass);
+    let outcome = if !write {
+        BlessOutcome::Kept
+    } else if request.dry_run {
+        BlessOutcome::WouldWrite
+    } else {
+        BlessOutcome::Written(store.bless(
+            case.name(),
+            pass,
+            image,
+            backend,
+            driver,
+            &change.previous,
+        )?)
+    };
+    Ok(BlessedPass {
+        scene: case.name().to_owned(),
+        pass,
+        previous: change.previous,
+        outcome,
+    })
+}
