@@ -89,3 +89,25 @@ pub fn harness_command() -> std::process::Command {
     );
     command
 }
+
+/// Writes `<dir>/<name>.toml`: the canonical ibl scene with `[quality.ibl] extract_sun = true`
+/// (the environment's sun lit as a shadowed directional light), its asset paths made absolute
+/// so that it renders from any folder. Returns its path.
+pub fn ibl_with_extracted_sun(dir: &std::path::Path, name: &str) -> std::path::PathBuf {
+    let scenes = harness::scenes_dir();
+    let text = std::fs::read_to_string(scenes.join("ibl.toml")).unwrap();
+    assert!(
+        !text.contains("[quality.ibl]"),
+        "ibl.toml grew a [quality.ibl]"
+    );
+    let assets = scenes.join("assets");
+    let text = text
+        .replace("\"assets/", &format!("\"{}/", assets.display()))
+        .replace(
+            "\n[environment]",
+            "\n[quality.ibl]\nextract_sun = true\n\n[environment]",
+        );
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    path
+}

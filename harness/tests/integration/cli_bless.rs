@@ -189,3 +189,50 @@ fn bless_after_a_light_change_rewrites_only_the_changed_passes() {
     );
     assert!(stdout.lines().any(|l| l == suggestion), "{stdout}");
 }
+
+/// The plan is the frame: with `[quality.ibl] extract_sun`, the environment's sun is a shadowed
+/// light of the scene as drawn, so `bless` writes its shadow map and shadow term as goldens
+/// (they were missing when the suite planned the scene as loaded), and `check` checks them.
+#[test]
+fn an_extracted_sun_gets_its_shadow_goldens() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    common::ibl_with_extracted_sun(&root.path().join("scenes"), "ibl_sun");
+    let stdout = bless_in(root.path(), &["--scene", "ibl_sun"]);
+    let golden = root.path().join("golden/ibl_sun");
+    for file in [
+        "shadow_0.exr",
+        "shadow_term_0.exr",
+        "light.exr",
+        "final.png",
+    ] {
+        assert!(golden.join(file).is_file(), "no {file}:\n{stdout}");
+    }
+    assert!(stdout.contains("ibl_sun/shadow_term_0: new"), "{stdout}");
+    let records = std::fs::read_to_string(golden.join("blessed.toml")).unwrap();
+    for pass in ["shadow_0", "shadow_term_0"] {
+        assert!(records.contains(&format!("[passes.{pass}]")), "{records}");
+    }
+    let output = common::harness_command()
+        .args(["check", "--scene", "ibl_sun", "--backend", "gl", "--out"])
+        .arg(root.path().join("out"))
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    for pass in ["shadow_0", "shadow_term_0"] {
+        assert!(
+            stdout
+                .lines()
+                .any(|l| l.starts_with("ibl_sun") && l.contains(&format!(" {pass} "))),
+            "check did not check {pass}:\n{stdout}"
+        );
+    }
+}

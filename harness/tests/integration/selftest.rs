@@ -4,6 +4,9 @@
 //! stays at or below half of every limit. Prints the margin and noise tables.
 
 use crate::common;
+use engine::backend::BackendKind;
+use engine::plan::TargetId;
+use harness::golden::bless::{bless_pass, BlessOutcome, BlessRequest};
 use harness::golden::noise::NoiseModel;
 use harness::golden::selftest::{self, Mutation, MutationChecks};
 use harness::golden::GoldenStore;
@@ -77,4 +80,69 @@ fn every_mutation_fails_where_it_originates_and_no_noise_source_comes_near_a_lim
             "golden/noise.toml has no figures for {source}"
         );
     }
+}
+
+/// The self-test reaches an extracted sun: a scene with `[quality.ibl] extract_sun` has the
+/// sun's shadow map and shadow term among its golden passes, and the shadow-bias mutation,
+/// applied to the scene as drawn, fails in the sun's `shadow_term_0` by the self-test's margin.
+/// Its goldens are blessed here, into a temporary store, from the unchanged render on gl.
+#[test]
+fn a_mutation_of_an_extracted_suns_shadow_fails_in_its_shadow_term() {
+    if !common::gl_available() {
+        return;
+    }
+    harness::use_ibl_cache();
+    let dir = tempfile::tempdir().unwrap();
+    let path = common::ibl_with_extracted_sun(dir.path(), "ibl_sun");
+    let case = harness::golden::suite::Case::load(path.to_str().unwrap()).unwrap();
+    let term = TargetId::ShadowTerm { light: 0 };
+    assert!(
+        case.passes.contains(&TargetId::Shadow { light: 0 }) && case.passes.contains(&term),
+        "{:?}",
+        case.passes
+    );
+    let store = GoldenStore::new(dir.path().join("golden"));
+    let frame = case.render(BackendKind::Gl).unwrap();
+    for &pass in &case.passes {
+        let request = BlessRequest::default();
+        let blessed = bless_pass(
+            &store,
+            &case,
+            pass,
+            &frame.outputs[&pass],
+            (BackendKind::Gl, "test"),
+            request,
+        )
+        .unwrap();
+        assert!(
+            matches!(blessed.outcome, BlessOutcome::Written(_)),
+            "{blessed}"
+        );
+    }
+    let model = NoiseModel::load(&GoldenStore::workspace()).unwrap();
+    let cases = [case];
+    let result = selftest::run(
+        &cases,
+        &store,
+        &[BackendKind::Gl],
+        &model,
+        MutationChecks::Origin,
+    );
+    assert!(result.errors.is_empty(), "{:?}", result.errors);
+    let bias = result
+        .mutations
+        .iter()
+        .find(|m| m.mutation == Mutation::ShadowBias)
+        .unwrap();
+    assert!(
+        bias.applies,
+        "the shadow bias did not reach the extracted sun"
+    );
+    let ratio = bias.ratios.get(&term).copied().unwrap_or_default();
+    eprintln!("shadow bias x4 on the extracted sun: {ratio:.2} x the shadow term's limit");
+    assert!(
+        ratio >= harness::golden::noise::MIN_MUTATION_RATIO,
+        "{ratio} in {term}: {:?}",
+        bias.ratios
+    );
 }
