@@ -35,7 +35,7 @@ fn timed_render(
             .passes
             .iter()
             .zip(&timings.owners)
-            .filter(|(_, owner)| owner.is_some_and(&of))
+            .filter(|(_, owner)| of(**owner))
             .map(|(t, _)| t.gpu_ns)
             .sum()
     })

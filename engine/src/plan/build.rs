@@ -39,6 +39,14 @@ impl RenderPlan {
             &gbuffer,
             &shadow_maps,
         ));
+        if scene.environment.is_none() && models.is_empty() {
+            passes.push(PassSpec {
+                id: PassId::ClearLight,
+                reads: vec![],
+                writes: vec![TargetId::Light],
+                detail: "nothing else writes the light buffer: black".to_owned(),
+            });
+        }
         if scene.quality.debug_shadow_terms {
             for &light in &shadowed {
                 let (target, pass) = shadow_term_output(scene, light, &gbuffer, &shadow_maps);

@@ -288,6 +288,9 @@ pub enum PassId {
     Skybox,
     /// Shades one lighting model's pixels into the light buffer.
     Lighting(LightingModel),
+    /// Clears the light buffer to black where nothing else writes it (no objects, no
+    /// environment).
+    ClearLight,
     /// Debug: writes light `light`'s shadow term per pixel.
     ShadowTerm {
         /// Index into the scene's lights.
@@ -316,6 +319,7 @@ impl PassId {
             PassId::IblPrecompute => "ibl_precompute".to_owned(),
             PassId::Skybox => "skybox".to_owned(),
             PassId::Lighting(model) => format!("lighting_{}", model.name().replace('-', "_")),
+            PassId::ClearLight => "clear_light".to_owned(),
             PassId::ShadowTerm { light } => format!("shadow_term_{light}"),
             PassId::ToneMap => "tonemap".to_owned(),
             PassId::Gizmos => "gizmos".to_owned(),
@@ -339,6 +343,7 @@ impl FromStr for PassId {
             "mask" => Some(PassId::ShaderMask),
             "ibl_precompute" => Some(PassId::IblPrecompute),
             "skybox" => Some(PassId::Skybox),
+            "clear_light" => Some(PassId::ClearLight),
             "tonemap" => Some(PassId::ToneMap),
             "gizmos" => Some(PassId::Gizmos),
             _ => None,
@@ -434,6 +439,7 @@ mod tests {
             PassId::ShaderMask,
             PassId::IblPrecompute,
             PassId::Skybox,
+            PassId::ClearLight,
             PassId::ToneMap,
             PassId::Gizmos,
         ];

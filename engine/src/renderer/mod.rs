@@ -123,15 +123,14 @@ impl Frame {
 pub struct PassTimes {
     /// Each submitted render pass's time, in submission order (names are debug labels).
     pub passes: Vec<PassTiming>,
-    /// The plan pass each entry of `passes` belongs to (none for a pass the plan does not
-    /// list, such as the clear of an otherwise unwritten light buffer).
-    pub owners: Vec<Option<PassId>>,
+    /// The plan pass each entry of `passes` belongs to.
+    pub owners: Vec<PassId>,
 }
 
 impl PassTimes {
     /// Whether the plan's pass `id` ran in this frame (it was not culled).
     pub fn ran(&self, id: PassId) -> bool {
-        self.owners.contains(&Some(id))
+        self.owners.contains(&id)
     }
 
     /// GPU ns of the plan's pass `id`: the sum over its render passes (a point light's six
@@ -142,7 +141,7 @@ impl PassTimes {
             .passes
             .iter()
             .zip(&self.owners)
-            .filter(|(_, owner)| **owner == Some(id))
+            .filter(|(_, owner)| **owner == id)
             .map(|(timing, _)| timing.gpu_ns);
         let first = times.next()??;
         times.try_fold(first, |sum, ns| ns.map(|ns| sum + ns))
@@ -360,8 +359,10 @@ struct Wanted<'a> {
     cull: bool,
 }
 
-/// Records every pass of `plan` (in [`passes`], one file each), submits them at once (when
-/// `wanted` culls, only those its targets depend on) and reads back the `wanted` targets.
+/// Records the passes of `plan` in its order (each dispatched by its [`PassId`] in
+/// [`passes::record`], one file each, over one shared [`passes::FrameContext`]), submits them at
+/// once (when `wanted` culls, only those its targets depend on) and reads back the `wanted`
+/// targets.
 fn record_and_submit(
     backend: &mut dyn Backend,
     scene: &Scene,
@@ -372,39 +373,16 @@ fn record_and_submit(
     scope: &mut ResourceScope,
 ) -> Result<Outputs, RenderError> {
     let frame = FrameResources::create(backend, scope, scene, plan)?;
-    let mut recorded = passes::Recorded::default();
-    let views = shadows::shadow_views(scene);
-    passes::shadow::record(backend, scope, scene, &views, &frame, &mut recorded)?;
-    passes::geometry::record(backend, scope, scene, plan, &frame, faults, &mut recorded)?;
-    let light_cleared = passes::skybox::record(backend, scope, scene, &frame, &mut recorded)?;
-    passes::lighting::record(
-        backend,
-        scope,
-        scene,
-        plan,
-        &frame,
-        &views,
-        faults,
-        ibl_maps,
-        light_cleared,
-        &mut recorded,
-    )?;
-    passes::tonemap::record(backend, scope, scene, &frame, faults, &mut recorded)?;
-    if scene.quality.gizmos {
-        let gizmos = passes::gizmos::pass(
-            backend,
-            scope,
-            scene,
-            frame.view_projection,
-            frame.target(TargetId::Final),
-        )?;
-        recorded.push(PassId::Gizmos, gizmos);
+    let mut ctx =
+        passes::FrameContext::new(backend, scope, &frame, (scene, plan), faults, ibl_maps);
+    for spec in &plan.passes {
+        passes::record(&mut ctx, spec.id)?;
     }
-
     let passes::Recorded {
         mut passes,
         mut owners,
-    } = recorded;
+    } = std::mem::take(&mut ctx.recorded);
+    drop(ctx);
     if wanted.cull {
         let targets: Vec<Handle<Texture>> =
             wanted.targets.iter().map(|id| frame.target(*id)).collect();
@@ -449,12 +427,12 @@ mod tests {
     use super::*;
     use crate::plan::BlurAxis;
 
-    fn times(entries: &[(Option<PassId>, Option<f64>)]) -> PassTimes {
+    fn times(entries: &[(PassId, Option<f64>)]) -> PassTimes {
         PassTimes {
             passes: entries
                 .iter()
                 .map(|(owner, ns)| PassTiming {
-                    name: owner.map_or("unplanned".to_owned(), |o| o.to_string()),
+                    name: owner.to_string(),
                     gpu_ns: *ns,
                 })
                 .collect(),
@@ -471,12 +449,12 @@ mod tests {
         };
         let shadow_1 = PassId::Shadow { light: 1 };
         let frame = times(&[
-            (Some(shadow_0), Some(1.0)),
-            (Some(shadow_0), Some(2.0)),
-            (Some(blur), Some(4.0)),
-            (Some(shadow_1), Some(8.0)),
-            (None, Some(32.0)),
-            (Some(PassId::Geometry), Some(16.0)),
+            (shadow_0, Some(1.0)),
+            (shadow_0, Some(2.0)),
+            (blur, Some(4.0)),
+            (shadow_1, Some(8.0)),
+            (PassId::ClearLight, Some(32.0)),
+            (PassId::Geometry, Some(16.0)),
         ]);
         assert_eq!(frame.pass_time(shadow_0), Some(3.0));
         assert_eq!(frame.pass_time(blur), Some(4.0));
@@ -484,7 +462,7 @@ mod tests {
         assert_eq!(frame.pass_time(PassId::Skybox), None);
         assert!(!frame.ran(PassId::Skybox) && frame.ran(PassId::Geometry));
         assert_eq!(frame.total(), Some(63.0));
-        let untimed = times(&[(Some(PassId::Geometry), None)]);
+        let untimed = times(&[(PassId::Geometry, None)]);
         assert_eq!(untimed.pass_time(PassId::Geometry), None);
         assert_eq!(untimed.total(), None);
     }

@@ -130,20 +130,12 @@ pub fn d_ggx_anisotropic(at: f64, ab: f64, t_dot_h: f64, b_dot_h: f64, n_dot_h: 
     1.0 / (PI * at * ab * d * d)
 }
 
-/// Anisotropic height-correlated Smith-GGX visibility (Heitz; Filament's form).
-#[allow(clippy::too_many_arguments)]
-pub fn v_smith_ggx_correlated_anisotropic(
-    at: f64,
-    ab: f64,
-    t_dot_v: f64,
-    b_dot_v: f64,
-    t_dot_l: f64,
-    b_dot_l: f64,
-    n_dot_v: f64,
-    n_dot_l: f64,
-) -> f64 {
-    let lv = n_dot_l * DVec3::new(at * t_dot_v, ab * b_dot_v, n_dot_v).length();
-    let ll = n_dot_v * DVec3::new(at * t_dot_l, ab * b_dot_l, n_dot_l).length();
+/// Anisotropic height-correlated Smith-GGX visibility (Heitz; Filament's form), with `v` and
+/// `l` in the tangent frame: (T.x, B.x, N.x).
+pub fn v_smith_ggx_correlated_anisotropic(at: f64, ab: f64, v: DVec3, l: DVec3) -> f64 {
+    let (n_dot_v, n_dot_l) = (v.z, l.z);
+    let lv = n_dot_l * DVec3::new(at * v.x, ab * v.y, n_dot_v).length();
+    let ll = n_dot_v * DVec3::new(at * l.x, ab * l.y, n_dot_l).length();
     0.5 / (lv + ll)
 }
 
@@ -172,12 +164,8 @@ pub fn pbr(s: &Surface, v: DVec3, l: DVec3) -> DVec3 {
             v_smith_ggx_correlated_anisotropic(
                 at,
                 ab,
-                t.dot(v),
-                b.dot(v),
-                t.dot(l),
-                b.dot(l),
-                n_dot_v,
-                n_dot_l,
+                DVec3::new(t.dot(v), b.dot(v), n_dot_v),
+                DVec3::new(t.dot(l), b.dot(l), n_dot_l),
             ),
         )
     } else {
@@ -449,12 +437,8 @@ mod tests {
         let aniso_v = v_smith_ggx_correlated_anisotropic(
             alpha,
             alpha,
-            t.dot(v),
-            b.dot(v),
-            t.dot(l),
-            b.dot(l),
-            n.dot(v),
-            n.dot(l),
+            DVec3::new(t.dot(v), b.dot(v), n.dot(v)),
+            DVec3::new(t.dot(l), b.dot(l), n.dot(l)),
         );
         assert!((iso_v - aniso_v).abs() / iso_v < 1e-12);
     }

@@ -1,16 +1,16 @@
 //! The geometry pass (every object into the G-buffer targets and depth) and the shader-mask pass
 //! (every object's lighting model into its mask channel, at the geometry's depth). One draw per
-//! object in each; the two share the object's uniform buffer and the G-buffer shader.
+//! object in each; the mask pass reuses the uniform buffers the geometry pass made (left in the
+//! frame context) and the G-buffer shader.
 
 use super::super::builders::{
     attachment, binding, filterable_texture_layout, shader, uniform_layout,
 };
-use super::super::resources::FrameResources;
-use super::super::{uniforms, Faults, RenderError};
+use super::super::{uniforms, RenderError};
+use super::FrameContext;
 use crate::backend::*;
 use crate::mesh::Vertex;
-use crate::plan::{MaskChannel, PassId, RenderPlan, TargetId};
-use crate::scene::Scene;
+use crate::plan::{MaskChannel, PassId, TargetId};
 use crate::shaders;
 
 /// The vertex layout of [`Vertex`]: position, normal, uv, tangent.
@@ -42,28 +42,30 @@ fn vertex_layout() -> VertexBufferLayout {
     }
 }
 
-/// The geometry and mask pipelines.
-fn pipelines(
-    backend: &mut dyn Backend,
-    scope: &mut ResourceScope,
-    mask_targets: usize,
-) -> Result<(Handle<Pipeline>, Handle<Pipeline>), RenderError> {
-    let gbuffer_shader = shader(scope, backend, shaders::GBUFFER)?;
-    let mut gbuffer_bindings = vec![uniform_layout()];
-    gbuffer_bindings.extend((1..=6).map(filterable_texture_layout));
-    gbuffer_bindings.push(BindingLayout {
+/// The G-buffer shader, which the geometry and mask passes share.
+fn gbuffer_shader(ctx: &mut FrameContext<'_>) -> Result<Handle<Shader>, RenderError> {
+    shader(ctx.scope, ctx.backend, shaders::GBUFFER)
+}
+
+/// Every object into the G-buffer targets and depth; leaves each object's uniform buffer in
+/// `ctx` for the mask pass.
+pub(in crate::renderer) fn record_geometry(ctx: &mut FrameContext<'_>) -> Result<(), RenderError> {
+    let gbuffer_shader = gbuffer_shader(ctx)?;
+    let mut bindings = vec![uniform_layout()];
+    bindings.extend((1..=6).map(filterable_texture_layout));
+    bindings.push(BindingLayout {
         binding: 7,
         kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
     });
-    let geometry_pipeline = scope.pipeline(
-        backend,
+    let pipeline = ctx.scope.pipeline(
+        ctx.backend,
         &PipelineDesc {
             label: "geometry".to_owned(),
             shader: gbuffer_shader,
             vertex_entry: "vs_main".to_owned(),
             fragment_entry: Some("fs_gbuffer".to_owned()),
             vertex_buffers: vec![vertex_layout()],
-            bindings: gbuffer_bindings,
+            bindings,
             color_targets: TargetId::GBUFFER
                 .iter()
                 .map(|_| ColorTarget {
@@ -82,55 +84,9 @@ fn pipelines(
             constants: vec![],
         },
     )?;
-    let mask_pipeline = scope.pipeline(
-        backend,
-        &PipelineDesc {
-            label: "mask".to_owned(),
-            shader: gbuffer_shader,
-            vertex_entry: "vs_main".to_owned(),
-            fragment_entry: Some(
-                if mask_targets > 1 {
-                    "fs_mask_2"
-                } else {
-                    "fs_mask_1"
-                }
-                .to_owned(),
-            ),
-            vertex_buffers: vec![vertex_layout()],
-            bindings: vec![uniform_layout()],
-            color_targets: (0..mask_targets)
-                .map(|_| ColorTarget {
-                    format: TextureFormat::Rgba8Unorm,
-                    blend: None,
-                })
-                .collect(),
-            depth: Some(DepthState {
-                format: TextureFormat::Depth32Float,
-                write: false,
-                compare: CompareFunction::LessEqual,
-            }),
-            topology: Topology::TriangleList,
-            cull: CullMode::Back,
-            geometry: None,
-            constants: vec![],
-        },
-    )?;
-    Ok((geometry_pipeline, mask_pipeline))
-}
-
-/// Records the geometry pass, then the mask pass, into `passes`.
-pub(in crate::renderer) fn record(
-    backend: &mut dyn Backend,
-    scope: &mut ResourceScope,
-    scene: &Scene,
-    plan: &RenderPlan,
-    frame: &FrameResources,
-    faults: &Faults,
-    passes: &mut super::Recorded,
-) -> Result<(), RenderError> {
-    let (geometry_pipeline, mask_pipeline) = pipelines(backend, scope, frame.mask_targets.len())?;
-    let mut geometry_draws = Vec::new();
-    let mut mask_draws = Vec::new();
+    let (scene, frame, plan) = (ctx.scene, ctx.frame, ctx.plan);
+    let mut draws = Vec::new();
+    let mut object_uniforms = Vec::new();
     for object in &scene.objects {
         let channel = plan
             .mask_channels
@@ -148,20 +104,21 @@ pub(in crate::renderer) fn record(
             scene.camera.position,
             frame.view_projection,
             channel,
-            faults,
+            ctx.faults,
             &scene.quality.gbuffer,
         );
-        let uniform = scope.buffer(
-            backend,
+        let uniform = ctx.scope.buffer(
+            ctx.backend,
             &format!("{} uniforms", object.name),
             BufferUsage::Uniform,
             bytemuck::cast_slice(&data),
         )?;
+        object_uniforms.push(uniform);
         let m = &object.material;
         let map = |index: Option<usize>| index.map_or(frame.white, |i| frame.textures[i]);
         let mesh = frame.mesh(object);
-        geometry_draws.push(Draw {
-            pipeline: geometry_pipeline,
+        draws.push(Draw {
+            pipeline,
             bindings: vec![
                 binding(0, BindingResource::Buffer(uniform)),
                 binding(1, BindingResource::Texture(map(m.base_color_map))),
@@ -176,15 +133,9 @@ pub(in crate::renderer) fn record(
             index_buffer: Some((mesh.indices, IndexFormat::U32)),
             count: mesh.count,
         });
-        mask_draws.push(Draw {
-            pipeline: mask_pipeline,
-            bindings: vec![binding(0, BindingResource::Buffer(uniform))],
-            vertex_buffers: vec![mesh.vertices],
-            index_buffer: Some((mesh.indices, IndexFormat::U32)),
-            count: mesh.count,
-        });
     }
-    passes.push(
+    ctx.object_uniforms = object_uniforms;
+    ctx.recorded.push(
         PassId::Geometry,
         RenderPass {
             name: PassId::Geometry.to_string(),
@@ -198,10 +149,75 @@ pub(in crate::renderer) fn record(
                 load: LoadOp::Clear(1.0),
             }),
             viewports: vec![],
-            draws: geometry_draws,
+            draws,
         },
     );
-    passes.push(
+    Ok(())
+}
+
+/// Every object's one-hot lighting-model channel into the mask targets, at the geometry pass's
+/// depth, with the uniform buffers that pass made.
+pub(in crate::renderer) fn record_mask(ctx: &mut FrameContext<'_>) -> Result<(), RenderError> {
+    let gbuffer_shader = gbuffer_shader(ctx)?;
+    let frame = ctx.frame;
+    let pipeline = ctx.scope.pipeline(
+        ctx.backend,
+        &PipelineDesc {
+            label: "mask".to_owned(),
+            shader: gbuffer_shader,
+            vertex_entry: "vs_main".to_owned(),
+            fragment_entry: Some(
+                if frame.mask_targets.len() > 1 {
+                    "fs_mask_2"
+                } else {
+                    "fs_mask_1"
+                }
+                .to_owned(),
+            ),
+            vertex_buffers: vec![vertex_layout()],
+            bindings: vec![uniform_layout()],
+            color_targets: frame
+                .mask_targets
+                .iter()
+                .map(|_| ColorTarget {
+                    format: TextureFormat::Rgba8Unorm,
+                    blend: None,
+                })
+                .collect(),
+            depth: Some(DepthState {
+                format: TextureFormat::Depth32Float,
+                write: false,
+                compare: CompareFunction::LessEqual,
+            }),
+            topology: Topology::TriangleList,
+            cull: CullMode::Back,
+            geometry: None,
+            constants: vec![],
+        },
+    )?;
+    if ctx.object_uniforms.len() != ctx.scene.objects.len() {
+        return Err(RenderError::InvalidScene {
+            scene: ctx.scene.name.clone(),
+            problem: "the plan has a mask pass before its geometry pass".to_owned(),
+        });
+    }
+    let draws = ctx
+        .scene
+        .objects
+        .iter()
+        .zip(&ctx.object_uniforms)
+        .map(|(object, &uniform)| {
+            let mesh = frame.mesh(object);
+            Draw {
+                pipeline,
+                bindings: vec![binding(0, BindingResource::Buffer(uniform))],
+                vertex_buffers: vec![mesh.vertices],
+                index_buffer: Some((mesh.indices, IndexFormat::U32)),
+                count: mesh.count,
+            }
+        })
+        .collect();
+    ctx.recorded.push(
         PassId::ShaderMask,
         RenderPass {
             name: PassId::ShaderMask.to_string(),
@@ -216,7 +232,7 @@ pub(in crate::renderer) fn record(
                 load: LoadOp::Load,
             }),
             viewports: vec![],
-            draws: mask_draws,
+            draws,
         },
     );
     Ok(())

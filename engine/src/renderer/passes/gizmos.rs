@@ -48,8 +48,23 @@ pub fn lines(scene: &Scene) -> Vec<[f32; 6]> {
     vertices
 }
 
-/// Records the gizmos pass onto `target` (loaded, not cleared).
-pub(in crate::renderer) fn pass(
+/// Records the gizmos pass over the final image (loaded, not cleared).
+pub(in crate::renderer) fn record(
+    ctx: &mut super::FrameContext<'_>,
+) -> Result<(), super::super::RenderError> {
+    let pass = gizmos_pass(
+        ctx.backend,
+        ctx.scope,
+        ctx.scene,
+        ctx.frame.view_projection,
+        ctx.frame.target(crate::plan::TargetId::Final),
+    )?;
+    ctx.recorded.push(crate::plan::PassId::Gizmos, pass);
+    Ok(())
+}
+
+/// The gizmos pass onto `target`.
+fn gizmos_pass(
     backend: &mut dyn Backend,
     scope: &mut ResourceScope,
     scene: &Scene,

@@ -13,10 +13,10 @@ use super::super::ibl::{self, IblTextures};
 use super::super::resources::FrameResources;
 use super::super::shadows::{self, ShadowView};
 use super::super::{light_uniforms, uniforms, Faults, RenderError};
+use super::FrameContext;
 use crate::backend::*;
-use crate::plan::RenderPlan;
 use crate::plan::{LightingDraw, LightingPass, LightingVariant, MaskChannel, PassId, TargetId};
-use crate::scene::Scene;
+use crate::scene::{LightingModel, Scene};
 use crate::shaders;
 
 /// The layout of `lighting.wgsl`'s bindings 0..17. Parameters are in uniform buffers; nothing
@@ -122,7 +122,7 @@ struct LightDraw {
 }
 
 /// What every lighting draw of the frame binds, and the pipelines made so far.
-struct LightingResources<'a> {
+pub(in crate::renderer) struct LightingResources<'a> {
     frame: &'a FrameResources,
     shader: Handle<Shader>,
     layouts: Vec<BindingLayout>,
@@ -136,6 +136,8 @@ struct LightingResources<'a> {
     shadowed: HashMap<usize, ShadowBindings>,
     /// One pipeline per (entry point, variant, routed or not), created on first use.
     pipelines: HashMap<String, Handle<Pipeline>>,
+    /// The routing pipeline, made by the first lighting pass.
+    route: Option<Handle<Pipeline>>,
 }
 
 impl<'a> LightingResources<'a> {
@@ -236,6 +238,7 @@ impl<'a> LightingResources<'a> {
             },
             shadowed,
             pipelines: HashMap::new(),
+            route: None,
         })
     }
 
@@ -355,64 +358,87 @@ impl<'a> LightingResources<'a> {
     }
 }
 
-/// Records the lighting passes into `passes` (and a clear of the light buffer where nothing
-/// else writes it), then the debug shadow terms if the scene asks for them. `light_cleared`:
-/// whether an earlier pass (the skybox) cleared the light buffer.
-#[allow(clippy::too_many_arguments)]
-pub(in crate::renderer) fn record(
-    backend: &mut dyn Backend,
-    scope: &mut ResourceScope,
-    scene: &Scene,
-    plan: &RenderPlan,
-    frame: &FrameResources,
-    views: &[ShadowView],
-    faults: &Faults,
-    ibl_maps: Option<&crate::ibl::IblMaps>,
-    mut light_cleared: bool,
-    passes: &mut super::Recorded,
-) -> Result<(), RenderError> {
-    let mut resources =
-        LightingResources::create(backend, scope, scene, frame, views, faults, ibl_maps)?;
-    let route_pipeline = if plan.lighting.is_empty() {
-        None
-    } else {
-        Some(resources.route_pipeline(scope, backend)?)
-    };
-    for (channel, pass) in plan.mask_channels.iter().zip(&plan.lighting) {
-        let draws = model_draws(
-            backend,
-            scope,
-            scene,
-            &mut resources,
-            *channel,
-            pass,
-            route_pipeline,
+/// The frame's lighting resources, made by its first lighting pass or shadow term.
+fn resources<'c, 'a>(
+    ctx: &'c mut FrameContext<'a>,
+) -> Result<&'c mut LightingResources<'a>, RenderError> {
+    if ctx.lighting.is_none() {
+        let made = LightingResources::create(
+            ctx.backend,
+            ctx.scope,
+            ctx.scene,
+            ctx.frame,
+            &ctx.views,
+            ctx.faults,
+            ctx.ibl_maps,
         )?;
-        let load = if light_cleared {
-            LoadOp::Load
-        } else {
-            LoadOp::Clear([0.0; 4])
-        };
-        light_cleared = true;
-        let pass = model_pass(frame, *channel, pass, load, draws);
-        passes.push(PassId::Lighting(channel.model), pass);
+        ctx.lighting = Some(made);
     }
-    if !light_cleared {
-        // No objects and no environment: the light buffer is black.
-        passes.push_unplanned(RenderPass {
-            name: "clear_light".to_owned(),
+    Ok(ctx.lighting.as_mut().expect("made above"))
+}
+
+/// Records lighting model `model`'s pass: its routing draw, then one draw per batch of lights,
+/// added into the light buffer (cleared first when no pass before it wrote it).
+pub(in crate::renderer) fn record_model(
+    ctx: &mut FrameContext<'_>,
+    model: LightingModel,
+) -> Result<(), RenderError> {
+    let (scene, plan, frame) = (ctx.scene, ctx.plan, ctx.frame);
+    let Some((channel, pass)) = plan
+        .mask_channels
+        .iter()
+        .zip(&plan.lighting)
+        .find(|(channel, _)| channel.model == model)
+    else {
+        return Err(RenderError::InvalidScene {
+            scene: scene.name.clone(),
+            problem: format!("the plan has a {model} lighting pass but no mask channel for it"),
+        });
+    };
+    resources(ctx)?;
+    let FrameContext {
+        backend,
+        scope,
+        lighting,
+        ..
+    } = ctx;
+    let resources = lighting.as_mut().expect("made above");
+    let route = match resources.route {
+        Some(route) => route,
+        None => {
+            let route = resources.route_pipeline(scope, *backend)?;
+            resources.route = Some(route);
+            route
+        }
+    };
+    let draws = model_draws(*backend, scope, scene, resources, *channel, pass, route)?;
+    let load = if ctx.light_written {
+        LoadOp::Load
+    } else {
+        LoadOp::Clear([0.0; 4])
+    };
+    ctx.light_written = true;
+    let render_pass = model_pass(frame, *channel, pass, load, draws);
+    ctx.recorded.push(PassId::Lighting(model), render_pass);
+    Ok(())
+}
+
+/// Clears the light buffer where no pass writes it (no objects and no environment).
+pub(in crate::renderer) fn record_clear(ctx: &mut FrameContext<'_>) -> Result<(), RenderError> {
+    ctx.light_written = true;
+    ctx.recorded.push(
+        PassId::ClearLight,
+        RenderPass {
+            name: PassId::ClearLight.to_string(),
             color_attachments: vec![attachment(
-                frame.target(TargetId::Light),
+                ctx.frame.target(TargetId::Light),
                 LoadOp::Clear([0.0; 4]),
             )],
             depth_attachment: None,
             viewports: vec![],
             draws: vec![],
-        });
-    }
-    if scene.quality.debug_shadow_terms {
-        record_shadow_terms(backend, scope, scene, plan, views, &mut resources, passes)?;
-    }
+        },
+    );
     Ok(())
 }
 
@@ -424,7 +450,7 @@ fn model_draws(
     resources: &mut LightingResources<'_>,
     channel: MaskChannel,
     pass: &LightingPass,
-    route_pipeline: Option<Handle<Pipeline>>,
+    route_pipeline: Handle<Pipeline>,
 ) -> Result<Vec<Draw>, RenderError> {
     let model = channel.model;
     let mask = resources.frame.mask_targets[channel.target];
@@ -446,15 +472,13 @@ fn model_draws(
             bytemuck::cast_slice(&data),
         )?;
         if index == 0 {
-            if let Some(route) = route_pipeline {
-                draws.push(fullscreen_draw(
-                    route,
-                    vec![
-                        binding(0, BindingResource::Buffer(uniform)),
-                        binding(6, BindingResource::Texture(mask)),
-                    ],
-                ));
-            }
+            draws.push(fullscreen_draw(
+                route_pipeline,
+                vec![
+                    binding(0, BindingResource::Buffer(uniform)),
+                    binding(6, BindingResource::Texture(mask)),
+                ],
+            ));
         }
         let pipeline =
             resources.pipeline(scope, backend, model.entry_point(), &draw.variant, true)?;
@@ -500,55 +524,58 @@ fn model_pass(
     }
 }
 
-/// Debug: each shadowed light's shadow term, through the lighting shader's own lookup.
-fn record_shadow_terms(
-    backend: &mut dyn Backend,
-    scope: &mut ResourceScope,
-    scene: &Scene,
-    plan: &RenderPlan,
-    views: &[ShadowView],
-    resources: &mut LightingResources<'_>,
-    passes: &mut super::Recorded,
+/// Debug: light `light`'s shadow term, through the lighting shader's own lookup.
+pub(in crate::renderer) fn record_shadow_term(
+    ctx: &mut FrameContext<'_>,
+    light: usize,
 ) -> Result<(), RenderError> {
-    for view in views {
-        let term = TargetId::ShadowTerm { light: view.light };
-        let name = PassId::ShadowTerm { light: view.light }.to_string();
-        let mut draws = plan.lighting.iter().flat_map(|pass| &pass.draws);
-        let Some(draw) = draws.find(|d| d.shadowed == Some(view.light)) else {
-            continue;
-        };
-        let pipeline =
-            resources.pipeline(scope, backend, "fs_shadow_term", &draw.variant, false)?;
-        let light_draw = resources.light_draw(draw);
-        let channel = plan.mask_channels[0];
-        let data = uniforms::lighting_uniforms(
-            scene,
-            &resources.frame.camera,
-            channel,
-            &light_draw.lights,
-            false,
-            0.0,
-        );
-        let uniform = scope.buffer(
-            backend,
-            &format!("{name} uniforms"),
-            BufferUsage::Uniform,
-            bytemuck::cast_slice(&data),
-        )?;
-        let bindings = resources.bind_group(uniform, resources.frame.mask_targets[0], &light_draw);
-        passes.push(
-            PassId::ShadowTerm { light: view.light },
-            RenderPass {
-                name,
-                color_attachments: vec![attachment(
-                    resources.frame.target(term),
-                    LoadOp::Clear([0.0; 4]),
-                )],
-                depth_attachment: None,
-                viewports: vec![],
-                draws: vec![fullscreen_draw(pipeline, bindings)],
-            },
-        );
-    }
+    let (scene, plan) = (ctx.scene, ctx.plan);
+    let term = TargetId::ShadowTerm { light };
+    let pass = PassId::ShadowTerm { light };
+    let mut draws = plan.lighting.iter().flat_map(|pass| &pass.draws);
+    let Some(draw) = draws.find(|d| d.shadowed == Some(light)) else {
+        // No lighting draw looks this light's shadow up: nothing to show.
+        return Ok(());
+    };
+    resources(ctx)?;
+    let FrameContext {
+        backend,
+        scope,
+        lighting,
+        recorded,
+        ..
+    } = ctx;
+    let resources = lighting.as_mut().expect("made above");
+    let pipeline = resources.pipeline(scope, *backend, "fs_shadow_term", &draw.variant, false)?;
+    let light_draw = resources.light_draw(draw);
+    let channel = plan.mask_channels[0];
+    let data = uniforms::lighting_uniforms(
+        scene,
+        &resources.frame.camera,
+        channel,
+        &light_draw.lights,
+        false,
+        0.0,
+    );
+    let uniform = scope.buffer(
+        *backend,
+        &format!("{pass} uniforms"),
+        BufferUsage::Uniform,
+        bytemuck::cast_slice(&data),
+    )?;
+    let bindings = resources.bind_group(uniform, resources.frame.mask_targets[0], &light_draw);
+    recorded.push(
+        pass,
+        RenderPass {
+            name: pass.to_string(),
+            color_attachments: vec![attachment(
+                resources.frame.target(term),
+                LoadOp::Clear([0.0; 4]),
+            )],
+            depth_attachment: None,
+            viewports: vec![],
+            draws: vec![fullscreen_draw(pipeline, bindings)],
+        },
+    );
     Ok(())
 }

@@ -5,9 +5,9 @@
 use super::super::builders::{
     attachment, binding, fullscreen_draw, fullscreen_pipeline, texture_layout,
 };
-use super::super::resources::FrameResources;
 use super::super::shadows::{blur_weights, ShadowView};
 use super::super::RenderError;
+use super::FrameContext;
 use crate::backend::*;
 use crate::plan::{BlurAxis, PassId, TargetId};
 use crate::scene::{PointShadowPass, Scene, ShadowFilter};
@@ -17,8 +17,8 @@ use crate::shaders;
 const FACE_NAMES: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
 
 /// The pipelines the shadow passes draw with; the optional ones exist only when a view needs
-/// them.
-struct ShadowPipelines {
+/// them. Made once per frame, by its first shadow pass.
+pub(in crate::renderer) struct ShadowPipelines {
     /// Depth only.
     depth: Handle<Pipeline>,
     /// Depth through the geometry stage that draws a point light's six faces at once.
@@ -132,67 +132,56 @@ fn pipelines(
     })
 }
 
-/// Records the shadow passes of every view into `passes`.
-pub(in crate::renderer) fn record(
-    backend: &mut dyn Backend,
-    scope: &mut ResourceScope,
-    scene: &Scene,
-    views: &[ShadowView],
-    frame: &FrameResources,
-    passes: &mut super::Recorded,
-) -> Result<(), RenderError> {
-    if views.is_empty() {
-        return Ok(());
+/// The frame's shadow pipelines, made on first use.
+fn frame_pipelines<'c>(ctx: &'c mut FrameContext<'_>) -> Result<&'c ShadowPipelines, RenderError> {
+    if ctx.shadow.is_none() {
+        let made = pipelines(ctx.backend, ctx.scope, ctx.scene, &ctx.views)?;
+        ctx.shadow = Some(made);
     }
-    let pipelines = pipelines(backend, scope, scene, views)?;
-    for view in views {
-        record_view(backend, scope, scene, view, &pipelines, frame, passes)?;
-        if let Some(blur_pipeline) = pipelines.blur.filter(|_| uses_vsm(view)) {
-            record_moments_blur(backend, scope, view, blur_pipeline, frame, passes)?;
-        }
-    }
-    Ok(())
+    Ok(ctx.shadow.as_ref().expect("made above"))
 }
 
-/// One view's passes: one per face (or one for all six through the geometry stage).
-fn record_view(
-    backend: &mut dyn Backend,
-    scope: &mut ResourceScope,
-    scene: &Scene,
-    view: &ShadowView,
-    pipelines: &ShadowPipelines,
-    frame: &FrameResources,
-    passes: &mut super::Recorded,
+/// Light `light`'s shadow map: one pass per face (or one for all six through the geometry
+/// stage), and its VSM moments with it.
+pub(in crate::renderer) fn record_map(
+    ctx: &mut FrameContext<'_>,
+    light: usize,
 ) -> Result<(), RenderError> {
-    let name = PassId::Shadow { light: view.light }.to_string();
-    let texture = frame.target(TargetId::Shadow { light: view.light });
-    let (pipeline, color_attachments) = match pipelines.moments.filter(|_| uses_vsm(view)) {
+    let view = ctx.view(light)?;
+    let pipelines = frame_pipelines(ctx)?;
+    let (moments, depth, layered) = (pipelines.moments, pipelines.depth, pipelines.layered);
+    let frame = ctx.frame;
+    let pass = PassId::Shadow { light };
+    let name = pass.to_string();
+    let texture = frame.target(TargetId::Shadow { light });
+    let (pipeline, color_attachments) = match moments.filter(|_| uses_vsm(&view)) {
         Some(pipeline) => (
             pipeline,
             vec![ColorAttachment {
-                texture: frame.target(TargetId::ShadowMoments { light: view.light }),
+                texture: frame.target(TargetId::ShadowMoments { light }),
                 subresource: Subresource::default(),
                 // Where no caster is drawn: depth 1 (the far plane), no variance.
                 load: LoadOp::Clear([1.0, 0.0, 1.0, 0.0]),
             }],
         ),
-        None => (pipelines.depth, vec![]),
+        None => (depth, vec![]),
     };
     // Which faces each pass draws: one each, or all six through the geometry stage.
-    let single_pass = view.point && scene.quality.point_shadows == PointShadowPass::GeometryShader;
+    let single_pass =
+        view.point && ctx.scene.quality.point_shadows == PointShadowPass::GeometryShader;
     let groups: Vec<Vec<usize>> = if single_pass {
         vec![(0..view.faces.len()).collect()]
     } else {
         (0..view.faces.len()).map(|face| vec![face]).collect()
     };
-    let pipeline = match pipelines.layered.filter(|_| single_pass) {
+    let pipeline = match layered.filter(|_| single_pass) {
         Some(layered) => layered,
         None => pipeline,
     };
     for (group_index, faces) in groups.iter().enumerate() {
-        let draws = caster_draws(backend, scope, scene, view, &name, faces, pipeline, frame)?;
-        passes.push(
-            PassId::Shadow { light: view.light },
+        let draws = caster_draws(ctx, &view, faces, pipeline)?;
+        ctx.recorded.push(
+            pass,
             RenderPass {
                 name: if view.point && !single_pass {
                     format!("{name}{}", FACE_NAMES[faces[0]])
@@ -209,7 +198,7 @@ fn record_view(
                         LoadOp::Load
                     },
                 }),
-                viewports: face_viewports(view, faces),
+                viewports: face_viewports(&view, faces),
                 draws,
             },
         );
@@ -218,17 +207,14 @@ fn record_view(
 }
 
 /// One draw per shadow caster, with its matrices for `faces`.
-#[allow(clippy::too_many_arguments)]
 fn caster_draws(
-    backend: &mut dyn Backend,
-    scope: &mut ResourceScope,
-    scene: &Scene,
+    ctx: &mut FrameContext<'_>,
     view: &ShadowView,
-    name: &str,
     faces: &[usize],
     pipeline: Handle<Pipeline>,
-    frame: &FrameResources,
 ) -> Result<Vec<Draw>, RenderError> {
+    let scene = ctx.scene;
+    let name = PassId::Shadow { light: view.light };
     let mut draws = Vec::new();
     for object in scene.objects.iter().filter(|o| o.casts_shadows) {
         let model = object.transform.relative_to(scene.camera.position);
@@ -236,13 +222,13 @@ fn caster_draws(
             .iter()
             .flat_map(|&face| (view.faces[face] * model).as_mat4().to_cols_array())
             .collect();
-        let uniform = scope.buffer(
-            backend,
+        let uniform = ctx.scope.buffer(
+            ctx.backend,
             &format!("{name} {} faces {faces:?}", object.name),
             BufferUsage::Uniform,
             bytemuck::cast_slice(&matrices),
         )?;
-        let mesh = frame.mesh(object);
+        let mesh = ctx.frame.mesh(object);
         draws.push(Draw {
             pipeline,
             bindings: vec![binding(0, BindingResource::Buffer(uniform))],
@@ -276,52 +262,51 @@ fn face_viewports(view: &ShadowView, faces: &[usize]) -> Vec<Viewport> {
         .collect()
 }
 
-/// The separable Gaussian blur of a VSM light's moments: along x into the intermediate target,
-/// then along y back into the moments.
-fn record_moments_blur(
-    backend: &mut dyn Backend,
-    scope: &mut ResourceScope,
-    view: &ShadowView,
-    pipeline: Handle<Pipeline>,
-    frame: &FrameResources,
-    passes: &mut super::Recorded,
+/// One direction of the separable Gaussian blur of light `light`'s VSM moments: along x into
+/// the intermediate target, then along y back into the moments.
+pub(in crate::renderer) fn record_blur(
+    ctx: &mut FrameContext<'_>,
+    light: usize,
+    axis: BlurAxis,
 ) -> Result<(), RenderError> {
+    let view = ctx.view(light)?;
+    let Some(pipeline) = frame_pipelines(ctx)?.blur else {
+        return Err(RenderError::InvalidScene {
+            scene: ctx.scene.name.clone(),
+            problem: format!("the plan blurs light {light}'s moments, which has no VSM"),
+        });
+    };
     let radius = view.settings.vsm_blur_radius;
-    if radius == 0 {
-        return Ok(());
-    }
-    let light = view.light;
-    let moments = frame.target(TargetId::ShadowMoments { light });
-    let blurred_x = frame.target(TargetId::ShadowBlur { light });
-    for (axis, step, source, destination) in [
-        (BlurAxis::X, [1.0f32, 0.0], moments, blurred_x),
-        (BlurAxis::Y, [0.0, 1.0], blurred_x, moments),
-    ] {
-        let pass = PassId::ShadowBlur { light, axis };
-        let mut data = vec![step[0], step[1], radius as f32, 0.0];
-        data.extend(blur_weights(radius));
-        let uniform = scope.buffer(
-            backend,
-            &format!("{pass} uniforms"),
-            BufferUsage::Uniform,
-            bytemuck::cast_slice(&data),
-        )?;
-        passes.push(
-            pass,
-            RenderPass {
-                name: pass.to_string(),
-                color_attachments: vec![attachment(destination, LoadOp::Clear([0.0; 4]))],
-                depth_attachment: None,
-                viewports: vec![],
-                draws: vec![fullscreen_draw(
-                    pipeline,
-                    vec![
-                        binding(1, BindingResource::Buffer(uniform)),
-                        binding(2, BindingResource::Texture(source)),
-                    ],
-                )],
-            },
-        );
-    }
+    let moments = ctx.frame.target(TargetId::ShadowMoments { light });
+    let blurred_x = ctx.frame.target(TargetId::ShadowBlur { light });
+    let (step, source, destination) = match axis {
+        BlurAxis::X => ([1.0f32, 0.0], moments, blurred_x),
+        BlurAxis::Y => ([0.0, 1.0], blurred_x, moments),
+    };
+    let pass = PassId::ShadowBlur { light, axis };
+    let mut data = vec![step[0], step[1], radius as f32, 0.0];
+    data.extend(blur_weights(radius));
+    let uniform = ctx.scope.buffer(
+        ctx.backend,
+        &format!("{pass} uniforms"),
+        BufferUsage::Uniform,
+        bytemuck::cast_slice(&data),
+    )?;
+    ctx.recorded.push(
+        pass,
+        RenderPass {
+            name: pass.to_string(),
+            color_attachments: vec![attachment(destination, LoadOp::Clear([0.0; 4]))],
+            depth_attachment: None,
+            viewports: vec![],
+            draws: vec![fullscreen_draw(
+                pipeline,
+                vec![
+                    binding(1, BindingResource::Buffer(uniform)),
+                    binding(2, BindingResource::Texture(source)),
+                ],
+            )],
+        },
+    );
     Ok(())
 }

@@ -5,24 +5,22 @@ use super::super::builders::{
     attachment, binding, filterable_texture_layout, fullscreen_draw, fullscreen_pipeline, shader,
     texture_layout, uniform_layout,
 };
-use super::super::resources::FrameResources;
 use super::super::{uniforms, RenderError};
+use super::FrameContext;
 use crate::backend::*;
 use crate::plan::{PassId, TargetId};
-use crate::scene::Scene;
 use crate::shaders;
 
-/// Records the skybox pass into `passes` if the scene has an environment; returns whether it
-/// did (the pass clears the light buffer).
-pub(in crate::renderer) fn record(
-    backend: &mut dyn Backend,
-    scope: &mut ResourceScope,
-    scene: &Scene,
-    frame: &FrameResources,
-    passes: &mut super::Recorded,
-) -> Result<bool, RenderError> {
+/// Records the skybox pass (the plan has one only with an environment); it clears the light
+/// buffer, which the lighting passes then add to.
+pub(in crate::renderer) fn record(ctx: &mut FrameContext<'_>) -> Result<(), RenderError> {
+    let (scene, frame) = (ctx.scene, ctx.frame);
+    let (backend, scope) = (&mut *ctx.backend, &mut *ctx.scope);
     let Some(environment) = &scene.environment else {
-        return Ok(false);
+        return Err(RenderError::InvalidScene {
+            scene: scene.name.clone(),
+            problem: "the plan has a skybox but the scene no environment".to_owned(),
+        });
     };
     let image = &environment.image;
     let texture = scope.texture(
@@ -82,7 +80,8 @@ pub(in crate::renderer) fn record(
             .copied()
             .unwrap_or(frame.black)
     };
-    passes.push(
+    ctx.light_written = true;
+    ctx.recorded.push(
         PassId::Skybox,
         RenderPass {
             name: PassId::Skybox.to_string(),
@@ -105,5 +104,5 @@ pub(in crate::renderer) fn record(
             )],
         },
     );
-    Ok(true)
+    Ok(())
 }

@@ -5,22 +5,17 @@ use super::super::builders::{
     attachment, binding, fullscreen_draw, fullscreen_pipeline, shader, texture_layout,
     uniform_layout,
 };
-use super::super::resources::FrameResources;
-use super::super::{Faults, RenderError};
+use super::super::RenderError;
+use super::FrameContext;
 use crate::backend::*;
 use crate::plan::{PassId, TargetId};
-use crate::scene::{Scene, ToneMap};
+use crate::scene::ToneMap;
 use crate::shaders;
 
-/// Records the tone-mapping pass into `passes`.
-pub(in crate::renderer) fn record(
-    backend: &mut dyn Backend,
-    scope: &mut ResourceScope,
-    scene: &Scene,
-    frame: &FrameResources,
-    faults: &Faults,
-    passes: &mut super::Recorded,
-) -> Result<(), RenderError> {
+/// Records the tone-mapping pass: the exposed light buffer into the sRGB final image.
+pub(in crate::renderer) fn record(ctx: &mut FrameContext<'_>) -> Result<(), RenderError> {
+    let (scene, frame, faults) = (ctx.scene, ctx.frame, ctx.faults);
+    let (backend, scope) = (&mut *ctx.backend, &mut *ctx.scope);
     let tonemap_shader = shader(scope, backend, shaders::TONEMAP)?;
     let tonemap_pipeline = scope.pipeline(
         backend,
@@ -45,7 +40,7 @@ pub(in crate::renderer) fn record(
         BufferUsage::Uniform,
         bytemuck::cast_slice(&[operator, 0, 0, 0, input_scale.to_bits(), 0, 0, 0]),
     )?;
-    passes.push(
+    ctx.recorded.push(
         PassId::ToneMap,
         RenderPass {
             name: PassId::ToneMap.to_string(),

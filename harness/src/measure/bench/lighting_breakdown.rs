@@ -316,7 +316,7 @@ mod tests {
                 name: pass.to_string(),
                 gpu_ns: Some(ms * 1e6),
             }],
-            owners: vec![Some(pass)],
+            owners: vec![pass],
         }
     }
 

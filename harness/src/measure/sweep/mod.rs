@@ -65,7 +65,7 @@ fn pass_ms(frames: &[Frame], of: impl Fn(PassId) -> bool) -> Option<f64> {
                     .passes
                     .iter()
                     .zip(&f.timings.owners)
-                    .filter(|(_, owner)| owner.is_some_and(&of))
+                    .filter(|(_, owner)| of(**owner))
                     .filter_map(|(t, _)| t.gpu_ns)
                     .collect();
                 (!ns.is_empty()).then(|| ns.iter().sum::<f64>() / 1e6)
