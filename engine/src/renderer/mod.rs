@@ -16,7 +16,7 @@ mod passes;
 mod resources;
 pub mod shadows;
 mod uniforms;
-mod validate;
+pub mod variations;
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -26,12 +26,27 @@ use glam::{DMat4, DVec3, Mat3, Mat4};
 use crate::backend::*;
 use crate::ibl::IblMaps;
 use crate::image::Image;
-use crate::plan::{LightingFeature, PassId, RenderPlan, TargetId};
+use crate::plan::{PassId, RenderPlan, TargetId};
 use crate::scene::{Scene, Transform};
 use resources::FrameResources;
 
+pub use crate::scene::InvalidScene;
 pub use uniforms::{ambient_radiance, light_uniforms};
-pub use validate::validate;
+
+/// Checks a scene before anything reaches the GPU ([`Scene::validate`]), as a render error.
+pub fn validate(scene: &Scene) -> Result<(), RenderError> {
+    scene.validate().map_err(RenderError::from)
+}
+
+impl From<InvalidScene> for RenderError {
+    fn from(e: InvalidScene) -> Self {
+        RenderError::InvalidScene {
+            scene: e.scene,
+            problem: e.problem,
+        }
+    }
+}
+pub use variations::Variations;
 
 /// Why a frame could not be rendered.
 #[derive(Debug, thiserror::Error)]
@@ -78,7 +93,7 @@ pub enum RenderError {
 }
 
 impl From<BackendError> for RenderError {
-    /// A backend error inside a render; [`render_with_faults`] fills in the scene's name.
+    /// A backend error inside a render; [`render_prepared`] fills in the scene's name.
     fn from(source: BackendError) -> Self {
         RenderError::Backend {
             scene: String::new(),
@@ -153,24 +168,6 @@ impl PassTimes {
     }
 }
 
-/// Deliberate departures from the scene: faults for the harness's mutation self-test (proof that
-/// the golden tolerances catch a broken pass), and lighting work taken away for the bench's cost
-/// breakdown. All off by default; [`render`] never sets them.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Faults {
-    /// The geometry pass writes albedo with red and blue swapped.
-    pub swap_albedo_red_blue: bool,
-    /// The tone-mapping pass scales the light buffer by this before its curve (a fault in the
-    /// last pass only: the light buffer stays as it was).
-    pub tonemap_input_scale: Option<f32>,
-    /// The lighting passes run without this part of their work (see
-    /// [`RenderPlan::remove_lighting_feature`]).
-    pub remove_lighting: Option<LightingFeature>,
-    /// The light uniforms carry each light's radiance times this: a fault in the uniform
-    /// packing, which only a reference that derives the lights from the scene itself catches.
-    pub light_radiance_scale: Option<f32>,
-}
-
 /// A scene made ready to draw, once: the scene as drawn (with `[quality.ibl] extract_sun`, the
 /// environment's sun added as a directional light), its IBL maps, and the plan of it. The plan
 /// is only ever built here, so whatever names a render's passes and targets (the renderer,
@@ -180,6 +177,7 @@ pub struct PreparedFrame {
     scene: Scene,
     plan: RenderPlan,
     ibl_maps: Option<Arc<IblMaps>>,
+    variations: Variations,
 }
 
 impl PreparedFrame {
@@ -199,7 +197,18 @@ impl PreparedFrame {
             scene,
             plan,
             ibl_maps,
+            variations: Variations::default(),
         })
+    }
+
+    /// This frame with `variations` (test and benchmark hooks; see [`variations`]). Lighting
+    /// work taken away shows in the plan's lighting draws.
+    pub fn with_variations(mut self, variations: Variations) -> Self {
+        if let Some(feature) = variations.remove_lighting {
+            self.plan.remove_lighting_feature(feature, &self.scene);
+        }
+        self.variations = variations;
+        self
     }
 
     /// The scene as drawn: an extracted sun is its last light.
@@ -237,6 +246,7 @@ impl PreparedFrame {
             scene,
             plan,
             ibl_maps: self.ibl_maps.clone(),
+            variations: Variations::default(),
         })
     }
 
@@ -253,37 +263,17 @@ pub fn render(
     scene: &Scene,
     readback: Readback<'_>,
 ) -> Result<Frame, RenderError> {
-    render_prepared(
-        backend,
-        &PreparedFrame::new(scene)?,
-        readback,
-        &Faults::default(),
-    )
+    render_prepared(backend, &PreparedFrame::new(scene)?, readback)
 }
 
-/// [`render`] with deliberate faults injected (see [`Faults`]).
-pub fn render_with_faults(
-    backend: &mut dyn Backend,
-    scene: &Scene,
-    readback: Readback<'_>,
-    faults: &Faults,
-) -> Result<Frame, RenderError> {
-    render_prepared(backend, &PreparedFrame::new(scene)?, readback, faults)
-}
-
-/// Renders a prepared frame (with `faults`; [`Faults::default`] for none) and reads back the
-/// requested outputs. Everything created is destroyed before returning, also on error.
+/// Renders a prepared frame and reads back the requested outputs. Everything created is
+/// destroyed before returning, also on error.
 pub fn render_prepared(
     backend: &mut dyn Backend,
     prepared: &PreparedFrame,
     readback: Readback<'_>,
-    faults: &Faults,
 ) -> Result<Frame, RenderError> {
-    let scene = &prepared.scene;
-    let mut plan = prepared.plan.clone();
-    if let Some(feature) = faults.remove_lighting {
-        plan.remove_lighting_feature(feature, scene);
-    }
+    let (scene, plan) = (&prepared.scene, &prepared.plan);
     let wanted: Vec<TargetId> = match readback {
         Readback::All => plan.target_ids(),
         Readback::Only(ids) | Readback::Needed(ids) => {
@@ -302,15 +292,7 @@ pub fn render_prepared(
         cull: matches!(readback, Readback::Needed(_)),
     };
     let mut scope = ResourceScope::default();
-    let result = record_and_submit(
-        backend,
-        scene,
-        &plan,
-        wanted,
-        faults,
-        prepared.ibl_maps.as_deref(),
-        &mut scope,
-    );
+    let result = record_and_submit(backend, prepared, wanted, &mut scope);
     scope.destroy(backend);
     let (outputs, timings) = result.map_err(|e| match e {
         RenderError::Backend { source, .. } => RenderError::Backend {
@@ -320,7 +302,7 @@ pub fn render_prepared(
         other => other,
     })?;
     Ok(Frame {
-        plan,
+        plan: plan.clone(),
         outputs,
         timings,
     })
@@ -365,16 +347,13 @@ struct Wanted<'a> {
 /// targets.
 fn record_and_submit(
     backend: &mut dyn Backend,
-    scene: &Scene,
-    plan: &RenderPlan,
+    prepared: &PreparedFrame,
     wanted: Wanted<'_>,
-    faults: &Faults,
-    ibl_maps: Option<&crate::ibl::IblMaps>,
     scope: &mut ResourceScope,
 ) -> Result<Outputs, RenderError> {
+    let (scene, plan) = (&prepared.scene, &prepared.plan);
     let frame = FrameResources::create(backend, scope, scene, plan)?;
-    let mut ctx =
-        passes::FrameContext::new(backend, scope, &frame, (scene, plan), faults, ibl_maps);
+    let mut ctx = passes::FrameContext::new(backend, scope, &frame, prepared);
     for spec in &plan.passes {
         passes::record(&mut ctx, spec.id)?;
     }

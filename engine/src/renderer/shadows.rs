@@ -7,58 +7,7 @@
 
 use glam::{DMat4, DVec3};
 
-use crate::scene::{Light, Scene, ShadowFilter, ShadowSettings};
-
-/// What is wrong with a light's shadow settings, if anything: map size 64..8192, biases and
-/// radii finite and non-negative, VSM only on directional lights with its blur radius at most 16
-/// texels and its light-bleeding reduction below 1.
-pub fn settings_problem(light: &Light) -> Option<String> {
-    let (Light::Directional {
-        shadow: Some(s), ..
-    }
-    | Light::Point {
-        shadow: Some(s), ..
-    }) = light
-    else {
-        return None;
-    };
-    let values = [
-        s.bias,
-        s.slope_bias,
-        s.normal_offset,
-        s.soft_radius,
-        s.vsm_min_variance,
-        s.vsm_bleeding_reduction,
-    ];
-    if !(64..=8192).contains(&s.map_size) || !values.iter().all(|b| b.is_finite() && *b >= 0.0) {
-        return Some(
-            "shadow map_size must be 64..8192 and biases, radii and VSM settings finite and \
-             non-negative"
-                .to_owned(),
-        );
-    }
-    if !(1..=4096).contains(&s.soft_samples) {
-        return Some(format!(
-            "soft_samples {} must be in 1..4096",
-            s.soft_samples
-        ));
-    }
-    if s.filter == ShadowFilter::Vsm {
-        if matches!(light, Light::Point { .. }) {
-            return Some(
-                "filter `vsm` is for directional lights; point lights take every other filter"
-                    .to_owned(),
-            );
-        }
-        if s.vsm_blur_radius > 16 || s.vsm_bleeding_reduction >= 1.0 {
-            return Some(format!(
-                "vsm_blur_radius {} must be at most 16 and vsm_bleeding_reduction {} below 1",
-                s.vsm_blur_radius, s.vsm_bleeding_reduction
-            ));
-        }
-    }
-    None
-}
+use crate::scene::{Light, Scene, ShadowSettings};
 
 /// A light's shadow-map views.
 #[derive(Clone, Debug)]
@@ -292,43 +241,5 @@ mod tests {
             assert!(w[..=r].windows(2).all(|p| p[0] > p[1]), "radius {radius}");
             assert!(w[r + 1..].iter().all(|&x| x == 0.0));
         }
-    }
-
-    #[test]
-    fn vsm_is_refused_on_point_lights_and_checked_for_range() {
-        let point = |settings: ShadowSettings| Light::Point {
-            position: DVec3::ZERO,
-            color: [1.0; 3],
-            intensity: 1.0,
-            radius: 1.0,
-            falloff: 1.0,
-            shadow: Some(settings),
-        };
-        let vsm = ShadowSettings {
-            filter: ShadowFilter::Vsm,
-            ..ShadowSettings::default()
-        };
-        assert!(settings_problem(&point(vsm))
-            .unwrap()
-            .contains("directional"));
-        assert!(settings_problem(&point(ShadowSettings::default())).is_none());
-        let directional = |settings: ShadowSettings| Light::Directional {
-            direction: DVec3::Y,
-            color: [1.0; 3],
-            intensity: 1.0,
-            angular_radius: 0.0,
-            shadow: Some(settings),
-        };
-        assert!(settings_problem(&directional(vsm)).is_none());
-        let wide = ShadowSettings {
-            vsm_blur_radius: 17,
-            ..vsm
-        };
-        assert!(settings_problem(&directional(wide)).is_some());
-        let nan = ShadowSettings {
-            vsm_min_variance: f32::NAN,
-            ..vsm
-        };
-        assert!(settings_problem(&directional(nan)).is_some());
     }
 }

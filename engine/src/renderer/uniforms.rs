@@ -4,7 +4,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Mat4};
 
-use super::{object_matrices, CameraMatrices, Faults};
+use super::{object_matrices, CameraMatrices, Variations};
 use crate::plan::{MaskChannel, MAX_LIGHTS_PER_DRAW};
 use crate::scene::{
     GbufferSettings, Light, NormalEncoding, Object, PositionStorage, Scene, Transform,
@@ -80,7 +80,7 @@ pub(super) fn object_uniforms(
     camera_position: DVec3,
     view_projection: Mat4,
     channel: MaskChannel,
-    faults: &Faults,
+    variations: &Variations,
     gbuffer: &GbufferSettings,
 ) -> Vec<f32> {
     let (model, normal) = object_matrices(transform, camera_position);
@@ -99,7 +99,7 @@ pub(super) fn object_uniforms(
         m.anisotropy,
     ]);
     data.extend_from_slice(&[m.roughness, m.metallic, m.specular, m.clearcoat]);
-    let swap = if faults.swap_albedo_red_blue {
+    let swap = if variations.swap_albedo_red_blue {
         1.0
     } else {
         0.0

@@ -14,15 +14,19 @@ use glam::{DMat4, DQuat, DVec3};
 
 use crate::mesh::MeshData;
 
+mod ibl_settings;
 mod light;
 mod material;
 mod quality;
+mod validate;
 
+pub use ibl_settings::{IblSettings, IrradianceMethod};
 pub use light::{Light, ShadowFilter, ShadowSettings};
 pub use material::{LightingModel, Material, TextureIndex};
 pub use quality::{
     GbufferSettings, NormalEncoding, PointShadowPass, PositionStorage, Quality, ToneMap,
 };
+pub use validate::InvalidScene;
 
 /// A decoded RGBA8 texture with its full mip chain (top row first).
 #[derive(Clone, Debug)]

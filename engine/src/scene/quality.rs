@@ -127,7 +127,7 @@ pub struct Quality {
     /// How point-light shadow faces are drawn (default: six passes, the faster on llvmpipe).
     pub point_shadows: PointShadowPass,
     /// Image-based lighting precompute settings (used only with an environment).
-    pub ibl: crate::ibl::IblSettings,
+    pub ibl: super::IblSettings,
     /// G-buffer position storage and normal encoding.
     pub gbuffer: GbufferSettings,
 }
@@ -142,7 +142,7 @@ impl Default for Quality {
             gizmos: false,
             debug_shadow_terms: false,
             point_shadows: PointShadowPass::SixPasses,
-            ibl: crate::ibl::IblSettings::default(),
+            ibl: super::IblSettings::default(),
             gbuffer: GbufferSettings::default(),
         }
     }

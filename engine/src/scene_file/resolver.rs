@@ -191,7 +191,7 @@ impl Resolver {
             textures: self.textures.clone(),
             quality,
         };
-        crate::renderer::validate(&scene).map_err(|e| self.invalid(e.to_string()))?;
+        scene.validate().map_err(|e| self.invalid(e.to_string()))?;
         Ok(LoadedScene {
             scene,
             path: self.path.clone(),
@@ -373,7 +373,7 @@ impl Resolver {
                 shadow: shadow_settings(l.shadow),
             },
         };
-        if let Some(problem) = crate::renderer::shadows::settings_problem(&light) {
+        if let Some(problem) = light.shadow_problem() {
             return Err(self.invalid(format!("light {index}: {problem}")));
         }
         let intensity = match &light {

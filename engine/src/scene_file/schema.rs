@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use serde::Deserialize;
 
-use crate::ibl::IblSettings;
+use crate::scene::IblSettings;
 use crate::scene::{GbufferSettings, LightingModel, PointShadowPass, ShadowFilter, ToneMap};
 
 fn default_up() -> [f64; 3] {

@@ -4,7 +4,7 @@ use std::process::ExitCode;
 
 use engine::backend::BackendKind;
 use engine::plan::TargetId;
-use engine::renderer::{Faults, Readback};
+use engine::renderer::Readback;
 use harness::golden::bless::{bless_pass, BlessOutcome, BlessRequest};
 
 use super::load_cases;
@@ -49,7 +49,6 @@ pub(crate) fn run(
             backend.as_mut(),
             &case.frame,
             Readback::Only(&wanted),
-            &Faults::default(),
         )?;
         let request = BlessRequest {
             named: &named,

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use engine::backend::BackendKind;
 use engine::plan::TargetId;
-use engine::renderer::{Faults, PreparedFrame, Readback};
+use engine::renderer::{PreparedFrame, Readback};
 
 use super::{default_out_dir, print_load_warnings};
 
@@ -40,12 +40,8 @@ pub(crate) fn run(
         scene.name, scene.quality.width, scene.quality.height
     );
     // Only the passes the asked-for outputs depend on run (`harness bench` times whole frames).
-    let frame = engine::renderer::render_prepared(
-        backend.as_mut(),
-        &prepared,
-        Readback::Needed(&targets),
-        &Faults::default(),
-    )?;
+    let frame =
+        engine::renderer::render_prepared(backend.as_mut(), &prepared, Readback::Needed(&targets))?;
     let default_dir = default_out_dir()
         .join("render")
         .join(&scene.name)

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use engine::backend::TextureFormat;
 use engine::backend::{self, BackendKind};
 use engine::plan::{TargetId, TargetSpec};
-use engine::renderer::{self, Faults, Frame, PreparedFrame, Readback, RenderError};
+use engine::renderer::{self, Frame, PreparedFrame, Readback, RenderError};
 use engine::scene_file::LoadedScene;
 use engine::Image;
 
@@ -213,8 +213,7 @@ impl Case {
     /// Renders the golden passes on a given backend.
     pub fn render_on(&self, backend: &mut dyn backend::Backend) -> Result<Frame, String> {
         let readback = Readback::Only(&self.passes);
-        renderer::render_prepared(backend, &self.frame, readback, &Faults::default())
-            .map_err(|e| e.to_string())
+        renderer::render_prepared(backend, &self.frame, readback).map_err(|e| e.to_string())
     }
 }
 

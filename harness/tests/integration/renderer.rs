@@ -63,12 +63,13 @@ fn a_wrong_light_radiance_in_the_uniforms_fails_the_reference() {
         return;
     };
     let mut backend = engine::backend::create(kind).unwrap();
-    let faults = renderer::Faults {
-        light_radiance_scale: Some(1.01),
-        ..Default::default()
-    };
-    let frame =
-        renderer::render_with_faults(backend.as_mut(), &scene, Readback::All, &faults).unwrap();
+    let faulty = PreparedFrame::new(&scene)
+        .unwrap()
+        .with_variations(renderer::Variations {
+            light_radiance_scale: Some(1.01),
+            ..Default::default()
+        });
+    let frame = renderer::render_prepared(backend.as_mut(), &faulty, Readback::All).unwrap();
     let wrong = reference::lighting_error(&scene, &frame).unwrap();
     let frame = render(backend.as_mut(), &scene);
     let right = reference::lighting_error(&scene, &frame).unwrap();

@@ -104,7 +104,7 @@ pub(in crate::renderer) fn record_geometry(ctx: &mut FrameContext<'_>) -> Result
             scene.camera.position,
             frame.view_projection,
             channel,
-            ctx.faults,
+            ctx.variations,
             &scene.quality.gbuffer,
         );
         let uniform = ctx.scope.buffer(

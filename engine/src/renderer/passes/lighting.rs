@@ -12,7 +12,7 @@ use super::super::builders::{
 use super::super::ibl::{self, IblTextures};
 use super::super::resources::FrameResources;
 use super::super::shadows::{self, ShadowView};
-use super::super::{light_uniforms, uniforms, Faults, RenderError};
+use super::super::{light_uniforms, uniforms, RenderError, Variations};
 use super::FrameContext;
 use crate::backend::*;
 use crate::plan::{LightingDraw, LightingPass, LightingVariant, MaskChannel, PassId, TargetId};
@@ -147,14 +147,14 @@ impl<'a> LightingResources<'a> {
         scene: &Scene,
         frame: &'a FrameResources,
         views: &[ShadowView],
-        faults: &Faults,
+        variations: &Variations,
         ibl_maps: Option<&crate::ibl::IblMaps>,
     ) -> Result<Self, RenderError> {
         let lighting_shader = shader(scope, backend, shaders::LIGHTING)?;
         let ibl = ibl::upload(backend, scope, ibl_maps)?;
         let jitter = upload_jitter(backend, scope)?;
         let mut lights = light_uniforms(scene);
-        if let Some(scale) = faults.light_radiance_scale {
+        if let Some(scale) = variations.light_radiance_scale {
             for light in &mut lights {
                 for channel in &mut light.color[..3] {
                     *channel *= scale;
@@ -369,7 +369,7 @@ fn resources<'c, 'a>(
             ctx.scene,
             ctx.frame,
             &ctx.views,
-            ctx.faults,
+            ctx.variations,
             ctx.ibl_maps,
         )?;
         ctx.lighting = Some(made);

@@ -14,7 +14,7 @@ pub(super) mod tonemap;
 
 use super::resources::FrameResources;
 use super::shadows::ShadowView;
-use super::{Faults, RenderError};
+use super::{PreparedFrame, RenderError, Variations};
 use crate::backend::{Backend, Buffer, Handle, RenderPass, ResourceScope};
 use crate::ibl::IblMaps;
 use crate::plan::{PassId, RenderPlan};
@@ -52,8 +52,8 @@ pub(super) struct FrameContext<'a> {
     pub plan: &'a RenderPlan,
     /// The plan's targets, the meshes, material textures and camera.
     pub frame: &'a FrameResources,
-    /// Deliberate departures (all off in a plain render).
-    pub faults: &'a Faults,
+    /// Test and benchmark hooks (none in a plain render).
+    pub variations: &'a Variations,
     /// The environment's IBL maps, prepared with the frame.
     pub ibl_maps: Option<&'a IblMaps>,
     /// Each shadowed light's view(s).
@@ -76,19 +76,17 @@ impl<'a> FrameContext<'a> {
         backend: &'a mut dyn Backend,
         scope: &'a mut ResourceScope,
         frame: &'a FrameResources,
-        (scene, plan): (&'a Scene, &'a RenderPlan),
-        faults: &'a Faults,
-        ibl_maps: Option<&'a IblMaps>,
+        prepared: &'a PreparedFrame,
     ) -> Self {
         Self {
             backend,
             scope,
-            scene,
-            plan,
+            scene: &prepared.scene,
+            plan: &prepared.plan,
             frame,
-            faults,
-            ibl_maps,
-            views: super::shadows::shadow_views(scene),
+            variations: &prepared.variations,
+            ibl_maps: prepared.ibl_maps.as_deref(),
+            views: super::shadows::shadow_views(&prepared.scene),
             recorded: Recorded::default(),
             light_written: false,
             object_uniforms: Vec::new(),

@@ -14,7 +14,7 @@ use crate::shaders;
 
 /// Records the tone-mapping pass: the exposed light buffer into the sRGB final image.
 pub(in crate::renderer) fn record(ctx: &mut FrameContext<'_>) -> Result<(), RenderError> {
-    let (scene, frame, faults) = (ctx.scene, ctx.frame, ctx.faults);
+    let (scene, frame, variations) = (ctx.scene, ctx.frame, ctx.variations);
     let (backend, scope) = (&mut *ctx.backend, &mut *ctx.scope);
     let tonemap_shader = shader(scope, backend, shaders::TONEMAP)?;
     let tonemap_pipeline = scope.pipeline(
@@ -33,7 +33,7 @@ pub(in crate::renderer) fn record(ctx: &mut FrameContext<'_>) -> Result<(), Rend
         ToneMap::Reinhard => 1,
         ToneMap::Clamp => 2,
     };
-    let input_scale = faults.tonemap_input_scale.unwrap_or(1.0);
+    let input_scale = variations.tonemap_input_scale.unwrap_or(1.0);
     let tonemap_uniform = scope.buffer(
         backend,
         "tonemap uniforms",

@@ -14,7 +14,7 @@
 //!   paths, another Mesa, renders from other hosts).
 //!
 //! Faults that no scene parameter can express are injected through
-//! [`engine::renderer::Faults`].
+//! [`engine::renderer::Variations`].
 //!
 //! The parts: `mutations.rs` defines the known changes and applies them to a scene, `run.rs`
 //! renders them and the unchanged scenes, and `tables.rs` prints the findings.

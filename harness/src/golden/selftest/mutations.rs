@@ -2,7 +2,7 @@
 //! it changes a scene (or the renderer, through an injected fault).
 
 use engine::plan::{GBufferTarget, TargetId};
-use engine::renderer::Faults;
+use engine::renderer::Variations;
 use engine::scene::{Light, LightingModel, Material, Scene};
 use glam::DQuat;
 
@@ -119,9 +119,9 @@ impl Mutation {
 
     /// Applies the mutation; `None` when the scene has nothing it could change (no lights, no
     /// environment, no shadow-casting light, no scalar material parameter, ...).
-    pub fn apply(self, scene: &Scene) -> Option<(Scene, Faults)> {
+    pub fn apply(self, scene: &Scene) -> Option<(Scene, Variations)> {
         let mut s = scene.clone();
-        let mut faults = Faults::default();
+        let mut variations = Variations::default();
         match self {
             Mutation::LightIntensity => {
                 if s.lights.is_empty() {
@@ -184,7 +184,7 @@ impl Mutation {
                 let m = scalar_material(&mut s, |m| m.base_color_map.is_none())?;
                 m.base_color = m.base_color.map(|c| c * 0.97);
             }
-            Mutation::GbufferChannelSwap => faults.swap_albedo_red_blue = true,
+            Mutation::GbufferChannelSwap => variations.swap_albedo_red_blue = true,
             Mutation::CameraYaw => {
                 let c = &mut s.camera;
                 let rotation = DQuat::from_axis_angle(c.up.normalize(), 0.25f64.to_radians());
@@ -198,9 +198,9 @@ impl Mutation {
                     LightingModel::Pbr
                 };
             }
-            Mutation::ToneCurve => faults.tonemap_input_scale = Some(1.03),
+            Mutation::ToneCurve => variations.tonemap_input_scale = Some(1.03),
         }
-        Some((s, faults))
+        Some((s, variations))
     }
 }
 

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use engine::backend::{self, BackendKind};
 use engine::plan::TargetId;
-use engine::renderer::{self, Faults, PreparedFrame, Readback};
+use engine::renderer::{self, PreparedFrame, Readback};
 use engine::Image;
 
 use super::{Mutation, MutationChecks, MutationResult, NoiseResult, SelfTest};
@@ -136,11 +136,11 @@ fn run_backend(
             return;
         }
     };
-    let mut render = |frame: &PreparedFrame, faults: &Faults, wanted: &[TargetId]| {
-        renderer::render_prepared(backend.as_mut(), frame, Readback::Needed(wanted), faults)
+    let mut render = |frame: &PreparedFrame, wanted: &[TargetId]| {
+        renderer::render_prepared(backend.as_mut(), frame, Readback::Needed(wanted))
             .map_err(|e| e.to_string())
     };
-    match render(&case.frame, &Faults::default(), wanted) {
+    match render(&case.frame, wanted) {
         Ok(frame) => unchanged_noise(case, kind, reference, goldens, &frame.outputs, result),
         Err(e) => result
             .errors
@@ -160,13 +160,13 @@ fn run_backend(
         let mutated = if mutation.changes_environment() {
             mutation
                 .apply(&case.loaded.scene)
-                .map(|(scene, faults)| (PreparedFrame::new(&scene), faults))
+                .map(|(scene, variations)| (PreparedFrame::new(&scene), variations))
         } else {
             mutation
                 .apply(case.frame.scene())
-                .map(|(scene, faults)| (case.frame.varied(scene), faults))
+                .map(|(scene, variations)| (case.frame.varied(scene), variations))
         };
-        if let Some((mutated, faults)) = mutated {
+        if let Some((mutated, variations)) = mutated {
             entry.applies = true;
             let checked: Vec<TargetId> = match checks {
                 MutationChecks::EveryPass => wanted.to_vec(),
@@ -178,7 +178,7 @@ fn run_backend(
             };
             let rendered = mutated
                 .map_err(|e| e.to_string())
-                .and_then(|frame| render(&frame, &faults, &checked));
+                .and_then(|frame| render(&frame.with_variations(variations), &checked));
             match rendered {
                 Ok(frame) => entry.ratios = ratios(case, goldens, &frame.outputs),
                 Err(e) => {

@@ -10,7 +10,7 @@
 
 use engine::backend::{self, Backend, BackendKind};
 use engine::plan::{LightingFeature, PassId, PassSpec, RenderPlan};
-use engine::renderer::{PassTimes, PreparedFrame};
+use engine::renderer::{PassTimes, PreparedFrame, Variations};
 use engine::scene::Scene;
 
 use super::timing::{percentile_pass_ms, time_frame};
@@ -186,9 +186,15 @@ fn time_variants(
 ) -> Result<Vec<Vec<PassTimes>>, BenchError> {
     // Frames are interleaved (one of each variant in turn, after one warm-up frame of each),
     // so that a drift of the machine's speed during the run falls on every variant alike.
-    let variants: Vec<Option<LightingFeature>> = [None, Some(LightingFeature::KeptInputs)]
+    let variants: Vec<PreparedFrame> = [None, Some(LightingFeature::KeptInputs)]
         .into_iter()
         .chain(removals.iter().map(|(_, feature, _)| Some(*feature)))
+        .map(|without| {
+            prepared.clone().with_variations(Variations {
+                remove_lighting: without,
+                ..Variations::default()
+            })
+        })
         .collect();
     let mut timings: Vec<Vec<PassTimes>> = vec![Vec::new(); variants.len()];
     for round in 0..=frames {
@@ -197,7 +203,7 @@ fn time_variants(
             variants.len()
         ));
         for (variant, timed) in variants.iter().zip(&mut timings) {
-            let (frame, _) = time_frame(backend, prepared, *variant)?;
+            let (frame, _) = time_frame(backend, variant)?;
             if round > 0 {
                 timed.push(frame);
             }

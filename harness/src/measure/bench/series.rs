@@ -117,7 +117,7 @@ pub fn series(
             backend: kind,
             message: e.to_string(),
         })?;
-        let (timings, _) = time_frames(backend.as_mut(), &prepared, frames.max(1), None)?;
+        let (timings, _) = time_frames(backend.as_mut(), &prepared, frames.max(1))?;
         points.push(SeriesPoint {
             series: name.to_owned(),
             value,

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use engine::backend::{self, Backend, BackendKind};
 use engine::plan::{LightingFeature, PassId};
-use engine::renderer::{self, Faults, PassTimes, PreparedFrame, Readback};
+use engine::renderer::{self, PassTimes, PreparedFrame, Readback, Variations};
 use engine::scene::Scene;
 use engine::stats::{median, percentile};
 
@@ -62,25 +62,23 @@ pub fn timed_render(
     pick: impl FnOnce(&PassTimes) -> Option<f64>,
 ) -> std::time::Duration {
     let start = Instant::now();
-    let frame =
-        renderer::render_prepared(backend, prepared, Readback::Only(&[]), &Faults::default())
-            .unwrap_or_else(|e| panic!("{}: {e}", prepared.scene().name));
+    let frame = renderer::render_prepared(backend, prepared, Readback::Only(&[]))
+        .unwrap_or_else(|e| panic!("{}: {e}", prepared.scene().name));
     let wall = start.elapsed();
     pick(&frame.timings).map_or(wall, |ns| std::time::Duration::from_nanos(ns as u64))
 }
 
 /// Renders `prepared` once to warm up, then `frames` times: each frame's pass times and wall
-/// ms. With `without`, the lighting passes run without that part of their work.
+/// ms.
 pub(super) fn time_frames(
     backend: &mut dyn Backend,
     prepared: &PreparedFrame,
     frames: usize,
-    without: Option<LightingFeature>,
 ) -> Result<(Vec<PassTimes>, Vec<f64>), BenchError> {
     let mut timings = Vec::with_capacity(frames);
     let mut wall = Vec::with_capacity(frames);
     for i in 0..=frames {
-        let (frame, ms) = time_frame(backend, prepared, without)?;
+        let (frame, ms) = time_frame(backend, prepared)?;
         if i > 0 {
             wall.push(ms);
             timings.push(frame);
@@ -93,19 +91,15 @@ pub(super) fn time_frames(
 pub(super) fn time_frame(
     backend: &mut dyn Backend,
     prepared: &PreparedFrame,
-    without: Option<LightingFeature>,
 ) -> Result<(PassTimes, f64), BenchError> {
-    let faults = Faults {
-        remove_lighting: without,
-        ..Faults::default()
-    };
     let start = Instant::now();
-    let frame = renderer::render_prepared(backend, prepared, Readback::Only(&[]), &faults)
-        .map_err(|e| BenchError::Render {
+    let frame = renderer::render_prepared(backend, prepared, Readback::Only(&[])).map_err(|e| {
+        BenchError::Render {
             scene: prepared.scene().name.clone(),
             backend: backend.kind(),
             message: e.to_string(),
-        })?;
+        }
+    })?;
     Ok((frame.timings, start.elapsed().as_secs_f64() * 1e3))
 }
 
@@ -155,19 +149,17 @@ pub fn bench_scene(
         message: e.to_string(),
     })?;
     let plan = prepared.plan();
-    let (timings, wall) = time_frames(backend.as_mut(), &prepared, frames, None)?;
+    let (timings, wall) = time_frames(backend.as_mut(), &prepared, frames)?;
     let has_lighting = plan
         .passes
         .iter()
         .any(|p| matches!(p.id, PassId::Lighting(_)));
     let input_floor_timings = if has_lighting {
-        time_frames(
-            backend.as_mut(),
-            &prepared,
-            frames,
-            Some(LightingFeature::Shading),
-        )?
-        .0
+        let input_floor = prepared.clone().with_variations(Variations {
+            remove_lighting: Some(LightingFeature::Shading),
+            ..Variations::default()
+        });
+        time_frames(backend.as_mut(), &input_floor, frames)?.0
     } else {
         Vec::new()
     };

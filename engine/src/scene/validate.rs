@@ -4,11 +4,26 @@
 
 use glam::DVec3;
 
-use super::{shadows, RenderError};
-use crate::scene::{Light, Object, Scene};
+use super::{Light, Object, Scene};
 
-/// Checks what would otherwise turn into NaN pixels or a driver error.
-pub fn validate(scene: &Scene) -> Result<(), RenderError> {
+/// A scene that cannot be drawn as given, and why.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("scene `{scene}`: {problem}")]
+pub struct InvalidScene {
+    /// Scene name.
+    pub scene: String,
+    /// What is wrong (naming the object or light at fault).
+    pub problem: String,
+}
+
+impl Scene {
+    /// Checks what would otherwise turn into NaN pixels, an empty draw or a driver error.
+    pub fn validate(&self) -> Result<(), InvalidScene> {
+        validate(self)
+    }
+}
+
+fn validate(scene: &Scene) -> Result<(), InvalidScene> {
     let checks = || -> Result<(), String> {
         check_output_and_camera(scene)?;
         for object in &scene.objects {
@@ -19,7 +34,7 @@ pub fn validate(scene: &Scene) -> Result<(), RenderError> {
         }
         check_environment(scene)
     };
-    checks().map_err(|problem| RenderError::InvalidScene {
+    checks().map_err(|problem| InvalidScene {
         scene: scene.name.clone(),
         problem,
     })
@@ -173,7 +188,7 @@ fn check_light(i: usize, light: &Light) -> Result<(), String> {
              falloff positive"
         ));
     }
-    if let Some(problem) = shadows::settings_problem(light) {
+    if let Some(problem) = light.shadow_problem() {
         return Err(format!("light {i}: {problem}"));
     }
     Ok(())
