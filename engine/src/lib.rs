@@ -25,6 +25,7 @@ pub mod plan;
 pub mod renderer;
 pub mod scene;
 pub mod scene_file;
+pub mod shader_bindings;
 pub mod shaders;
 pub mod stats;
 

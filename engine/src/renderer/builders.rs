@@ -33,17 +33,6 @@ pub(super) fn filterable_texture_layout(binding: u32) -> BindingLayout {
     }
 }
 
-/// A filterable cube texture at `binding`.
-pub(super) fn cube_layout(binding: u32) -> BindingLayout {
-    BindingLayout {
-        binding,
-        kind: BindingKind::Texture {
-            sample_type: TextureSampleType::Float,
-            view: TextureViewKind::Cube,
-        },
-    }
-}
-
 /// The uniform buffer at binding 0.
 pub(super) fn uniform_layout() -> BindingLayout {
     BindingLayout {

@@ -80,6 +80,10 @@ pub enum RenderError {
         /// What is wrong.
         problem: String,
     },
+    /// A shader's reflection (its bindings) could not be read: a shader that does not parse,
+    /// or a binding looked up under a name the shader does not declare.
+    #[error(transparent)]
+    Shader(#[from] crate::shaders::ShaderError),
     /// A readback asked for a target the plan does not have.
     #[error("scene `{scene}` has no pass output `{name}` (it has: {available})")]
     UnknownOutput {

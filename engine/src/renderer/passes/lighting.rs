@@ -4,11 +4,9 @@
 //! test for equality. Also the debug shadow-term outputs, through the same shader's lookup.
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
-use super::super::builders::{
-    attachment, binding, cube_layout, filterable_texture_layout, fullscreen_draw,
-    fullscreen_pipeline, shader, texture_layout,
-};
+use super::super::builders::{attachment, binding, fullscreen_draw, fullscreen_pipeline, shader};
 use super::super::ibl::{self, IblTextures};
 use super::super::resources::FrameResources;
 use super::super::shadows::{self, ShadowView};
@@ -17,56 +15,8 @@ use super::FrameContext;
 use crate::backend::*;
 use crate::plan::{LightingDraw, LightingPass, LightingVariant, MaskChannel, PassId, TargetId};
 use crate::scene::{LightingModel, Scene};
+use crate::shader_bindings::ModuleBindings;
 use crate::shaders;
-
-/// The layout of `lighting.wgsl`'s bindings 0..17. Parameters are in uniform buffers; nothing
-/// in them steers a branch or loop (see the top of shaders/lighting/inputs.wgsl), so lavapipe
-/// has nothing to specialise per draw.
-fn binding_layouts() -> Vec<BindingLayout> {
-    let mut layouts = vec![BindingLayout {
-        binding: 0,
-        kind: BindingKind::UniformBuffer,
-    }];
-    layouts.extend((1..=6).map(texture_layout));
-    layouts.extend([
-        BindingLayout {
-            binding: 7,
-            kind: BindingKind::Texture {
-                sample_type: TextureSampleType::Depth,
-                view: TextureViewKind::D2,
-            },
-        },
-        BindingLayout {
-            binding: 8,
-            kind: BindingKind::Sampler(SamplerBindingKind::Comparison),
-        },
-        BindingLayout {
-            binding: 9,
-            kind: BindingKind::UniformBuffer,
-        },
-        BindingLayout {
-            binding: 10,
-            kind: BindingKind::Texture {
-                sample_type: TextureSampleType::UnfilterableFloat,
-                view: TextureViewKind::D2Array,
-            },
-        },
-        filterable_texture_layout(11),
-        BindingLayout {
-            binding: 12,
-            kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
-        },
-        cube_layout(13),
-        cube_layout(14),
-        filterable_texture_layout(15),
-        BindingLayout {
-            binding: 16,
-            kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
-        },
-        texture_layout(17),
-    ]);
-    layouts
-}
 
 /// The soft shadow filters' jitter: rotation offsets per pixel of a tile, one layer per pair
 /// of samples.
@@ -125,7 +75,11 @@ struct LightDraw {
 pub(in crate::renderer) struct LightingResources<'a> {
     frame: &'a FrameResources,
     shader: Handle<Shader>,
-    layouts: Vec<BindingLayout>,
+    /// `lighting.wgsl`'s bindings, from naga's reflection of it (the layout of every lighting
+    /// pipeline, and the slots the bind groups fill by name). Parameters are in uniform
+    /// buffers; nothing in them steers a branch or loop (see the top of
+    /// shaders/lighting/inputs.wgsl), so lavapipe has nothing to specialise per draw.
+    bindings: Arc<ModuleBindings>,
     ibl: IblTextures,
     jitter: Handle<Texture>,
     lights: Vec<uniforms::LightData>,
@@ -225,7 +179,7 @@ impl<'a> LightingResources<'a> {
         Ok(Self {
             frame,
             shader: lighting_shader,
-            layouts: binding_layouts(),
+            bindings: ModuleBindings::of(shaders::LIGHTING)?,
             ibl,
             jitter,
             lights,
@@ -254,38 +208,52 @@ impl<'a> LightingResources<'a> {
         }
     }
 
-    /// Bind group of a lighting-shader draw (`lighting.wgsl` bindings 0..17).
+    /// Bind group of a lighting-shader draw: each resource at the slot of the `lighting.wgsl`
+    /// variable named beside it.
     fn bind_group(
         &self,
         uniform: Handle<Buffer>,
         mask: Handle<Texture>,
         draw: &LightDraw,
-    ) -> Vec<Binding> {
-        let mut bindings = vec![binding(0, BindingResource::Buffer(uniform))];
-        bindings.extend(TargetId::GBUFFER.into_iter().enumerate().map(|(i, id)| {
-            binding(
-                i as u32 + 1,
-                BindingResource::Texture(self.frame.target(id)),
-            )
-        }));
-        bindings.extend([
-            binding(6, BindingResource::Texture(mask)),
-            binding(7, BindingResource::Texture(draw.shadow.map)),
-            binding(8, BindingResource::Sampler(draw.shadow.sampler)),
-            binding(9, BindingResource::Buffer(draw.shadow.uniform)),
-            binding(10, BindingResource::Texture(self.jitter)),
-            binding(11, BindingResource::Texture(draw.shadow.moments)),
-            binding(12, BindingResource::Sampler(self.moments_sampler)),
-            binding(13, BindingResource::Texture(self.ibl.irradiance)),
-            binding(14, BindingResource::Texture(self.ibl.specular)),
-            binding(15, BindingResource::Texture(self.ibl.dfg)),
-            binding(16, BindingResource::Sampler(self.ibl.sampler)),
-            binding(
-                17,
-                BindingResource::Texture(self.frame.target(TargetId::Depth)),
+    ) -> Result<Vec<Binding>, RenderError> {
+        let texture = |target| BindingResource::Texture(self.frame.target(target));
+        let [position, normal, tangent, albedo, material] = TargetId::GBUFFER;
+        let resources = [
+            ("u", BindingResource::Buffer(uniform)),
+            ("gbuffer_position", texture(position)),
+            ("gbuffer_normal", texture(normal)),
+            ("gbuffer_tangent", texture(tangent)),
+            ("gbuffer_albedo", texture(albedo)),
+            ("gbuffer_material", texture(material)),
+            ("shader_mask", BindingResource::Texture(mask)),
+            ("shadow_map", BindingResource::Texture(draw.shadow.map)),
+            (
+                "shadow_sampler",
+                BindingResource::Sampler(draw.shadow.sampler),
             ),
-        ]);
-        bindings
+            ("shadow", BindingResource::Buffer(draw.shadow.uniform)),
+            ("shadow_jitter", BindingResource::Texture(self.jitter)),
+            (
+                "shadow_moments",
+                BindingResource::Texture(draw.shadow.moments),
+            ),
+            (
+                "moments_sampler",
+                BindingResource::Sampler(self.moments_sampler),
+            ),
+            (
+                "ibl_irradiance",
+                BindingResource::Texture(self.ibl.irradiance),
+            ),
+            ("ibl_specular", BindingResource::Texture(self.ibl.specular)),
+            ("ibl_dfg", BindingResource::Texture(self.ibl.dfg)),
+            ("ibl_sampler", BindingResource::Sampler(self.ibl.sampler)),
+            ("scene_depth", texture(TargetId::Depth)),
+        ];
+        resources
+            .into_iter()
+            .map(|(name, resource)| Ok(binding(self.bindings.slot(name)?, resource)))
+            .collect()
     }
 
     /// The pipeline of `entry` specialised to `variant`; `routed` ones add into the light
@@ -314,7 +282,7 @@ impl<'a> LightingResources<'a> {
                 &format!("lighting {entry} ({variant})"),
                 self.shader,
                 entry,
-                self.layouts.clone(),
+                self.bindings.layouts(),
                 TextureFormat::Rgba16Float,
                 blend,
             )
@@ -343,13 +311,7 @@ impl<'a> LightingResources<'a> {
                     "lighting route",
                     self.shader,
                     "fs_route",
-                    vec![
-                        BindingLayout {
-                            binding: 0,
-                            kind: BindingKind::UniformBuffer,
-                        },
-                        texture_layout(6),
-                    ],
+                    self.bindings.layouts_of(&["u", "shader_mask"])?,
                     TextureFormat::Rgba16Float,
                     Some(BlendState::ADDITIVE),
                 )
@@ -475,14 +437,20 @@ fn model_draws(
             draws.push(fullscreen_draw(
                 route_pipeline,
                 vec![
-                    binding(0, BindingResource::Buffer(uniform)),
-                    binding(6, BindingResource::Texture(mask)),
+                    binding(
+                        resources.bindings.slot("u")?,
+                        BindingResource::Buffer(uniform),
+                    ),
+                    binding(
+                        resources.bindings.slot("shader_mask")?,
+                        BindingResource::Texture(mask),
+                    ),
                 ],
             ));
         }
         let pipeline =
             resources.pipeline(scope, backend, model.entry_point(), &draw.variant, true)?;
-        let bindings = resources.bind_group(uniform, mask, &light_draw);
+        let bindings = resources.bind_group(uniform, mask, &light_draw)?;
         draws.push(fullscreen_draw(pipeline, bindings));
     }
     Ok(draws)
@@ -563,7 +531,7 @@ pub(in crate::renderer) fn record_shadow_term(
         BufferUsage::Uniform,
         bytemuck::cast_slice(&data),
     )?;
-    let bindings = resources.bind_group(uniform, resources.frame.mask_targets[0], &light_draw);
+    let bindings = resources.bind_group(uniform, resources.frame.mask_targets[0], &light_draw)?;
     recorded.push(
         pass,
         RenderPass {
