@@ -173,7 +173,10 @@ fn source_descriptions(runs: &[(Source, SourceRun)]) -> BTreeMap<String, String>
     runs.iter()
         .map(|(source, run)| {
             let mut text = source.description.clone();
-            for (backend, driver) in &run.drivers {
+            // By name, as the file has always listed them.
+            let mut drivers: Vec<_> = run.drivers.iter().collect();
+            drivers.sort_by_key(|(backend, _)| backend.name());
+            for (backend, driver) in drivers {
                 text.push_str(&format!("; {backend}: {driver}"));
             }
             // Paths inside this checkout (the second Mesa's prefix) are the same on every

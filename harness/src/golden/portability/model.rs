@@ -82,6 +82,19 @@ pub fn build_model(
             m.error.clone(),
         )
     });
+    // A run limited to some scenes keeps the descriptions of the last full run for the sources
+    // it knows: such a run may not reach every backend (a known crash on its scenes), and the
+    // descriptions document the drivers of the whole measurement.
+    let partial = previous
+        .scenes
+        .keys()
+        .any(|scene| !cases.iter().any(|c| c.name() == scene));
+    let mut sources = sources;
+    if partial {
+        for (name, description) in &previous.sources {
+            sources.insert(name.clone(), description.clone());
+        }
+    }
     let mut model = NoiseModel {
         margin,
         regenerate: REGENERATE.to_owned(),
