@@ -6,7 +6,7 @@ struct ToneMapUniforms {
     // x = operator.
     tone_operator: vec4<u32>,
     // x = scale applied to the light buffer before the curve: 1, except when the mutation
-    // self-test injects a tone-mapping fault (engine::renderer::Faults).
+    // self-test injects a tone-mapping fault (engine::renderer::Variations).
     input_scale: vec4<f32>,
 }
 
