@@ -61,6 +61,8 @@ pub const LIGHTING: ShaderSource = ShaderSource {
         include_str!("../shaders/lighting/shade.wgsl"),
     ),
 };
+/// Deferred renderer: screen-space ambient occlusion (the io7m r2 renderer's filter).
+pub const SSAO: ShaderSource = shader!("ssao.wgsl");
 /// Deferred renderer: environment behind the objects.
 pub const SKYBOX: ShaderSource = shader!("skybox.wgsl");
 /// Deferred renderer: HDR light buffer to the sRGB final image.
@@ -84,6 +86,7 @@ pub const ALL: &[ShaderSource] = &[
     DEPTH_COPY,
     GBUFFER,
     LIGHTING,
+    SSAO,
     SKYBOX,
     TONEMAP,
     GIZMO,

@@ -294,3 +294,50 @@ pub fn ibl_furnace(size: u32, material: Material, lighting: LightingModel) -> Sc
     });
     scene
 }
+
+/// Where the wall of [`corner`] stands: the plane x = this, facing +x.
+pub const CORNER_WALL_X: f64 = -1.0;
+
+/// Two planes meeting at a right angle, a floor (y = 0, facing +y) and a wall
+/// (x = [`CORNER_WALL_X`], facing +x), 8 m across, seen from the open side, with a uniform
+/// ambient and screen-space ambient occlusion of `radius`: the occlusion of a floor point has
+/// a closed form in its distance from the wall
+/// ([`engine::renderer::ambient_occlusion::corner_occlusion`]).
+pub fn corner(size: u32, radius: f32, samples: u32) -> Scene {
+    let mut scene = empty_scene(
+        "corner",
+        size,
+        camera(DVec3::new(2.0, 2.2, 3.2), DVec3::new(-0.6, 0.2, 0.0)),
+    );
+    let plane = Arc::new(mesh::plane(8.0, 4.0));
+    let material = Material {
+        base_color: [0.8; 3],
+        roughness: 0.9,
+        specular: 0.0,
+        ..Material::default()
+    };
+    scene.objects.push(Object {
+        name: "floor".to_owned(),
+        mesh: plane.clone(),
+        transform: Transform::default(),
+        material: material.clone(),
+        lighting: LightingModel::Pbr,
+        casts_shadows: false,
+    });
+    scene.objects.push(Object {
+        name: "wall".to_owned(),
+        mesh: plane,
+        transform: Transform {
+            translation: DVec3::new(CORNER_WALL_X, 0.0, 0.0),
+            // The plane's +y normal turned to +x, its extent now along y and z.
+            rotation: DQuat::from_rotation_z(-std::f64::consts::FRAC_PI_2),
+            scale: DVec3::ONE,
+        },
+        material,
+        lighting: LightingModel::Pbr,
+        casts_shadows: false,
+    });
+    scene.ambient = [1.0; 3];
+    scene.quality.ssao = Some(SsaoSettings { radius, samples });
+    scene
+}

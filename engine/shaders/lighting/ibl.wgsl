@@ -80,7 +80,7 @@ fn ibl_specular_sampled(s: Surface, v: vec3<f32>, f0: vec3<f32>) -> vec3<f32> {
 
 // Split-sum IBL of the PBR model (unexposed; the caller scales by u.ibl.x); the specular part by
 // filtered importance sampling instead when IBL_SAMPLES > 0.
-fn pbr_ibl(s: Surface, v: vec3<f32>) -> vec3<f32> {
+fn pbr_ibl(s: Surface, v: vec3<f32>, occlusion: f32) -> vec3<f32> {
     let n = s.normal;
     let n_dot_v = max(dot(n, v), MIN_N_DOT_V);
     let f0 = vec3<f32>(0.16 * s.specular * s.specular * (1.0 - s.metallic)) + s.base_color * s.metallic;
@@ -116,7 +116,10 @@ fn pbr_ibl(s: Surface, v: vec3<f32>) -> vec3<f32> {
     } else {
         specular = ibl_prefiltered(dominant, s.roughness) * e;
     }
-    let diffuse = s.base_color * (1.0 - s.metallic) * (vec3<f32>(1.0) - e) * ibl_irradiance_at(n);
+    var diffuse = s.base_color * (1.0 - s.metallic) * (vec3<f32>(1.0) - e) * ibl_irradiance_at(n);
+    if AMBIENT_OCCLUSION {
+        diffuse *= occlusion;
+    }
     if !CLEARCOAT {
         return diffuse + specular;
     }

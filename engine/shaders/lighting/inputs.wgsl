@@ -60,6 +60,9 @@ override INPUT_FLOOR: bool = false;
 // pass does), adding them times a uniform zero, so that taking a light away does not also take
 // away the reads of the G-buffer targets only it needed, which the input floor already counts.
 override KEEP_INPUTS: bool = false;
+// The scene's screen-space ambient occlusion scales this draw's ambient and IBL diffuse light
+// (first draws of a lit model, in scenes with [quality.ssao]).
+override AMBIENT_OCCLUSION: bool = false;
 
 const PI: f32 = 3.14159265358979;
 const MAX_LIGHTS: u32 = 16u;
@@ -150,4 +153,8 @@ struct ShadowUniforms {
 // The depth buffer (D32F, read as an unfilterable float texture: naga's GLSL output cannot
 // textureLoad a texture_depth_2d), for positions reconstructed from depth.
 @group(0) @binding(17) var scene_depth: texture_2d<f32>;
+
+// Screen-space ambient occlusion (shaders/ssao.wgsl; r = 1 unoccluded .. 0), read where
+// AMBIENT_OCCLUSION is set.
+@group(0) @binding(18) var ambient_occlusion: texture_2d<f32>;
 

@@ -21,26 +21,41 @@ fn input_floor(model: u32, pixel: vec2<i32>) -> vec4<f32> {
     if ANISOTROPY {
         sum += textureLoad(gbuffer_tangent, pixel, 0);
     }
+    if AMBIENT_OCCLUSION {
+        sum += textureLoad(ambient_occlusion, pixel, 0);
+    }
     return finish(sum.rgb * 1e-3 + vec3<f32>(sum.a * 1e-3));
 }
 
 // Exposed radiance of a masked pixel under the draw's ambient and lights. Ambient is diffuse:
-// PBR scales it by (1 - metallic), the other models by the base color alone.
+// PBR scales it by (1 - metallic), the other models by the base color alone. With
+// AMBIENT_OCCLUSION, the ambient and the IBL diffuse light are scaled by the occlusion.
 fn shade(model: u32, pixel: vec2<i32>) -> vec4<f32> {
     if INPUT_FLOOR {
         return input_floor(model, pixel);
     }
     let s = load_surface(pixel);
     let v = safe_normalize(-s.position, s.normal);
+    var occlusion = 1.0;
+    if AMBIENT_OCCLUSION {
+        occlusion = textureLoad(ambient_occlusion, pixel, 0).r;
+    }
     var radiance = s.base_color * u.ambient.rgb;
     if model == MODEL_PBR {
         radiance *= 1.0 - s.metallic;
     }
+    if AMBIENT_OCCLUSION {
+        radiance *= occlusion;
+    }
     if IBL {
         if model == MODEL_PBR {
-            radiance += pbr_ibl(s, v) * u.ibl.x;
+            radiance += pbr_ibl(s, v, occlusion) * u.ibl.x;
         } else {
-            radiance += s.base_color * ibl_irradiance_at(s.normal) * u.ibl.x;
+            var diffuse = s.base_color * ibl_irradiance_at(s.normal);
+            if AMBIENT_OCCLUSION {
+                diffuse *= occlusion;
+            }
+            radiance += diffuse * u.ibl.x;
         }
     }
     for (var i = 0u; i < min(LIGHT_COUNT, MAX_LIGHTS); i++) {

@@ -3,10 +3,12 @@
 //! shadow-term debug outputs, then tone mapping and gizmos.
 
 use crate::backend::TextureFormat;
-use crate::scene::{Light, LightingModel, Scene, ShadowFilter, ShadowSettings};
+use crate::scene::{Light, LightingModel, Scene, ShadowFilter, ShadowSettings, SsaoSettings};
 
 use super::lighting::{lighting_passes, LightingPass};
-use super::{BlurAxis, MaskChannel, PassId, PassSpec, RenderPlan, TargetId, TargetSpec};
+use super::{
+    BlurAxis, GBufferTarget, MaskChannel, PassId, PassSpec, RenderPlan, TargetId, TargetSpec,
+};
 
 impl RenderPlan {
     /// Builds the plan for a scene as drawn. Only [`crate::renderer::PreparedFrame`] calls
@@ -30,6 +32,12 @@ impl RenderPlan {
         let mut passes = shadow_passes;
         passes.push(geometry_pass(scene, &gbuffer));
         passes.push(mask_pass(&models, &masks));
+        let occlusion = scene.quality.ssao.filter(|_| !models.is_empty());
+        if let Some(settings) = occlusion {
+            let (target, pass) = ambient_occlusion(scene, settings);
+            targets.push(target);
+            passes.push(pass);
+        }
         passes.extend(environment_passes(scene, &masks));
         let lighting = lighting_passes(scene, &models, casters > 0);
         passes.extend(lighting_pass_specs(
@@ -279,6 +287,28 @@ impl ShadowStage {
     }
 }
 
+/// The screen-space ambient occlusion's target and pass: from the camera's depth and the
+/// G-buffer's normals, before any lighting.
+fn ambient_occlusion(scene: &Scene, settings: SsaoSettings) -> (TargetSpec, PassSpec) {
+    let target = TargetSpec {
+        id: TargetId::AmbientOcclusion,
+        format: TextureFormat::Rgba16Float,
+        width: scene.quality.width,
+        height: scene.quality.height,
+        contents: "rgb ambient occlusion, 1 unoccluded .. 0 occluded".to_owned(),
+    };
+    let pass = PassSpec {
+        id: PassId::AmbientOcclusion,
+        reads: vec![TargetId::Depth, TargetId::GBuffer(GBufferTarget::Normal)],
+        writes: vec![TargetId::AmbientOcclusion],
+        detail: format!(
+            "{} kernel points in a {} m hemisphere, halo removal at the radius",
+            settings.samples, settings.radius
+        ),
+    };
+    (target, pass)
+}
+
 /// Every object into the G-buffer and depth.
 fn geometry_pass(scene: &Scene, gbuffer: &[TargetId]) -> PassSpec {
     let objects = scene.objects.len();
@@ -353,6 +383,9 @@ fn lighting_pass_specs(
             reads.push(TargetId::Mask(channel.target));
             if channel.model != LightingModel::Unlit {
                 reads.extend(shadow_maps.iter().copied());
+                if scene.quality.ssao.is_some() {
+                    reads.push(TargetId::AmbientOcclusion);
+                }
             }
             PassSpec {
                 id: PassId::Lighting(channel.model),

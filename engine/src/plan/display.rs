@@ -101,6 +101,7 @@ impl fmt::Display for LightingVariant {
             (self.ibl && self.ibl_samples == 0, "ibl"),
             (self.clearcoat, "clearcoat"),
             (self.anisotropy, "anisotropy"),
+            (self.ambient_occlusion, "ambient occlusion"),
             (self.input_floor, "input floor"),
             (self.keep_inputs, "keep inputs"),
         ] {

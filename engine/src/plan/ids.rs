@@ -95,6 +95,8 @@ pub enum TargetId {
         /// Index into the scene's lights.
         light: usize,
     },
+    /// Screen-space ambient occlusion: 1 unoccluded .. 0 occluded, in rgb.
+    AmbientOcclusion,
 }
 
 /// What a target holds, which decides whether it gets a golden and how it is compared and
@@ -133,7 +135,7 @@ impl TargetId {
             TargetId::GBuffer(_) => TargetContent::SurfaceAttributes,
             TargetId::Depth | TargetId::Shadow { .. } => TargetContent::Depth,
             TargetId::Mask(_) => TargetContent::Mask,
-            TargetId::ShadowTerm { .. } => TargetContent::Visibility,
+            TargetId::ShadowTerm { .. } | TargetId::AmbientOcclusion => TargetContent::Visibility,
             TargetId::Light => TargetContent::Radiance,
             TargetId::Final => TargetContent::Display,
             TargetId::Route | TargetId::ShadowMoments { .. } | TargetId::ShadowBlur { .. } => {
@@ -169,6 +171,7 @@ impl TargetId {
             TargetId::ShadowMoments { light } => format!("shadow_{light}_moments"),
             TargetId::ShadowBlur { light } => format!("shadow_{light}_blur"),
             TargetId::ShadowTerm { light } => format!("shadow_term_{light}"),
+            TargetId::AmbientOcclusion => "ambient_occlusion".to_owned(),
         }
     }
 }
@@ -210,6 +213,7 @@ impl FromStr for TargetId {
             "route" => Some(TargetId::Route),
             "light" => Some(TargetId::Light),
             "final" => Some(TargetId::Final),
+            "ambient_occlusion" => Some(TargetId::AmbientOcclusion),
             _ => None,
         };
         let gbuffer = || {
@@ -281,6 +285,9 @@ pub enum PassId {
     Geometry,
     /// Draws every object's one-hot lighting-model channel into the mask targets.
     ShaderMask,
+    /// Screen-space ambient occlusion from the depth and normals (the io7m r2 renderer's
+    /// filter).
+    AmbientOcclusion,
     /// On the CPU, before any GPU pass: the environment's IBL maps (prefiltered specular,
     /// irradiance, DFG), read by the lighting passes; cached in memory and on disk.
     IblPrecompute,
@@ -316,6 +323,7 @@ impl PassId {
             }
             PassId::Geometry => "geometry".to_owned(),
             PassId::ShaderMask => "mask".to_owned(),
+            PassId::AmbientOcclusion => "ambient_occlusion".to_owned(),
             PassId::IblPrecompute => "ibl_precompute".to_owned(),
             PassId::Skybox => "skybox".to_owned(),
             PassId::Lighting(model) => format!("lighting_{}", model.name().replace('-', "_")),
@@ -341,6 +349,7 @@ impl FromStr for PassId {
         let fixed = match name {
             "geometry" => Some(PassId::Geometry),
             "mask" => Some(PassId::ShaderMask),
+            "ambient_occlusion" => Some(PassId::AmbientOcclusion),
             "ibl_precompute" => Some(PassId::IblPrecompute),
             "skybox" => Some(PassId::Skybox),
             "clear_light" => Some(PassId::ClearLight),
@@ -420,6 +429,7 @@ mod tests {
             TargetId::Route,
             TargetId::Light,
             TargetId::Final,
+            TargetId::AmbientOcclusion,
         ]);
         for i in [0, 1, 7, 12] {
             all.extend([
@@ -437,6 +447,7 @@ mod tests {
         let mut all = vec![
             PassId::Geometry,
             PassId::ShaderMask,
+            PassId::AmbientOcclusion,
             PassId::IblPrecompute,
             PassId::Skybox,
             PassId::ClearLight,

@@ -51,6 +51,9 @@ pub struct LightingVariant {
     pub anisotropy: bool,
     /// G-buffer position storage and normal encoding (`POSITION_MODE`, `NORMAL_MODE`).
     pub gbuffer: GbufferSettings,
+    /// The ambient and IBL diffuse light of this draw are scaled by the screen-space ambient
+    /// occlusion (`AMBIENT_OCCLUSION`; first draws of a lit model in a scene with SSAO).
+    pub ambient_occlusion: bool,
     /// Draws of the model's pass (`DRAWS`). They add into the same pixels, so each clamps its
     /// output to the fp16-safe maximum divided by this, and their sum stays finite.
     pub draws: u32,
@@ -101,6 +104,7 @@ impl LightingVariant {
             ("DRAWS", f64::from(self.draws)),
             ("INPUT_FLOOR", flag(self.input_floor)),
             ("KEEP_INPUTS", flag(self.keep_inputs)),
+            ("AMBIENT_OCCLUSION", flag(self.ambient_occlusion)),
         ]
         .into_iter()
         .map(|(name, value)| (name.to_owned(), value))
@@ -288,6 +292,7 @@ pub(super) fn lighting_passes(
                     && materials().any(|m| m.clearcoat != 0.0 || m.clearcoat_map.is_some()),
                 anisotropy: pbr && materials().any(|m| m.anisotropy != 0.0),
                 gbuffer: scene.quality.gbuffer,
+                ambient_occlusion: false,
                 draws: if model == LightingModel::Unlit {
                     1
                 } else {
@@ -314,6 +319,7 @@ pub(super) fn lighting_passes(
                             first: index == 0,
                             variant: LightingVariant {
                                 ibl: ibl && index == 0,
+                                ambient_occlusion: scene.quality.ssao.is_some() && index == 0,
                                 ibl_samples: if ibl && index == 0 && pbr {
                                     scene.quality.ibl.runtime_samples
                                 } else {

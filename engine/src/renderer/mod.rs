@@ -9,6 +9,7 @@
 //! camera positions are subtracted in f64 ([`Transform::relative_to`]); the G-buffer stores
 //! camera-relative positions, so a scene 10 km from the origin renders like one at the origin.
 
+pub mod ambient_occlusion;
 mod builders;
 mod cull;
 mod ibl;

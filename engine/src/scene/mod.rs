@@ -24,7 +24,8 @@ pub use ibl_settings::{IblSettings, IrradianceMethod};
 pub use light::{Light, ShadowFilter, ShadowSettings};
 pub use material::{LightingModel, Material, TextureIndex};
 pub use quality::{
-    GbufferSettings, NormalEncoding, PointShadowPass, PositionStorage, Quality, ToneMap,
+    GbufferSettings, NormalEncoding, PointShadowPass, PositionStorage, Quality, SsaoSettings,
+    ToneMap,
 };
 pub use validate::InvalidScene;
 

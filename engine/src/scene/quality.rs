@@ -108,6 +108,50 @@ impl GbufferSettings {
     }
 }
 
+/// Screen-space ambient occlusion (`[quality.ssao]`; the io7m r2 renderer's filter): a
+/// hemisphere of `samples` kernel points of radius `radius` around each pixel's surface, each
+/// tested against the depth buffer. Its occlusion scales the ambient and IBL diffuse light.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SsaoSettings {
+    /// Hemisphere radius in meters (world units).
+    pub radius: f32,
+    /// Kernel points, 1..=64.
+    pub samples: u32,
+}
+
+impl Default for SsaoSettings {
+    fn default() -> Self {
+        Self {
+            radius: 0.5,
+            samples: 32,
+        }
+    }
+}
+
+impl SsaoSettings {
+    /// Most kernel points a scene may ask for (the kernel is a uniform array of this size).
+    pub const MAX_SAMPLES: u32 = 64;
+
+    /// Why these settings cannot be used, if they cannot.
+    pub fn problem(&self) -> Option<String> {
+        if !(self.radius.is_finite() && self.radius > 0.0) {
+            return Some(format!(
+                "ssao radius {} must be finite and positive",
+                self.radius
+            ));
+        }
+        if !(1..=Self::MAX_SAMPLES).contains(&self.samples) {
+            return Some(format!(
+                "ssao samples {} must be in 1..={}",
+                self.samples,
+                Self::MAX_SAMPLES
+            ));
+        }
+        None
+    }
+}
+
 /// Output size and the knobs that trade time for error.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Quality {
@@ -130,6 +174,8 @@ pub struct Quality {
     pub ibl: super::IblSettings,
     /// G-buffer position storage and normal encoding.
     pub gbuffer: GbufferSettings,
+    /// Screen-space ambient occlusion; none (the default) plans no occlusion pass.
+    pub ssao: Option<SsaoSettings>,
 }
 
 impl Default for Quality {
@@ -144,6 +190,7 @@ impl Default for Quality {
             point_shadows: PointShadowPass::SixPasses,
             ibl: super::IblSettings::default(),
             gbuffer: GbufferSettings::default(),
+            ssao: None,
         }
     }
 }

@@ -59,6 +59,9 @@ fn check_output_and_camera(scene: &Scene) -> Result<(), String> {
             q.exposure
         ));
     }
+    if let Some(problem) = scene.quality.ssao.as_ref().and_then(|s| s.problem()) {
+        return Err(problem);
+    }
     let c = &scene.camera;
     if !finite3(c.position) || !finite3(c.target) || !finite3(c.up) {
         return Err("camera position, target and up must be finite".into());

@@ -403,6 +403,7 @@ fn quality(q: &QualitySpec) -> Quality {
         point_shadows: q.point_shadows.unwrap_or(defaults.point_shadows),
         ibl: q.ibl.clone().unwrap_or(defaults.ibl),
         gbuffer: q.gbuffer.unwrap_or(defaults.gbuffer),
+        ssao: q.ssao.or(defaults.ssao),
     }
 }
 

@@ -7,7 +7,9 @@ use std::path::PathBuf;
 use serde::Deserialize;
 
 use crate::scene::IblSettings;
-use crate::scene::{GbufferSettings, LightingModel, PointShadowPass, ShadowFilter, ToneMap};
+use crate::scene::{
+    GbufferSettings, LightingModel, PointShadowPass, ShadowFilter, SsaoSettings, ToneMap,
+};
 
 fn default_up() -> [f64; 3] {
     [0.0, 1.0, 0.0]
@@ -73,6 +75,9 @@ pub struct QualitySpec {
     /// `[quality.gbuffer]`: position storage and normal encoding (defaults: camera-relative,
     /// fp16).
     pub gbuffer: Option<GbufferSettings>,
+    /// `[quality.ssao]`: screen-space ambient occlusion, `radius` (m, default 0.5) and
+    /// `samples` (1..=64, default 32); none without the table.
+    pub ssao: Option<SsaoSettings>,
 }
 
 /// `[environment]`.
@@ -262,6 +267,7 @@ impl QualitySpec {
             point_shadows: None,
             ibl: None,
             gbuffer: None,
+            ssao: None,
         }
     }
 }

@@ -237,20 +237,22 @@ fn canonical_names_resolve_and_unknown_names_list_the_scenes() {
         .err()
         .unwrap()
         .to_string();
-    assert!(e.contains("arrow, chess, ibl"), "{e}");
+    assert!(e.contains("arrow, chess, corner, ibl"), "{e}");
 }
 
-/// Every canonical scene loads, renders at 512x512 by default, and every vertex of every mesh
+/// Every canonical scene loads, renders at 512x512 (corner, the ambient occlusion's scene, at
+/// 256x256), and every vertex of every mesh
 /// it uses has a finite unit normal and a unit tangent orthogonal to it with w = +1 or -1.
 #[test]
 fn canonical_scenes_load_with_valid_tangent_frames() {
     let names = scene_file::canonical_scenes(&scenes_dir());
-    assert_eq!(names, ["arrow", "chess", "ibl"]);
+    assert_eq!(names, ["arrow", "chess", "corner", "ibl"]);
     for name in names {
         let loaded = scene_file::load(&scenes_dir().join(format!("{name}.toml")))
             .unwrap_or_else(|e| panic!("{e}"));
         let scene = &loaded.scene;
-        assert_eq!((scene.quality.width, scene.quality.height), (512, 512));
+        let size = if name == "corner" { 256 } else { 512 };
+        assert_eq!((scene.quality.width, scene.quality.height), (size, size));
         assert!(!scene.objects.is_empty());
         for object in &scene.objects {
             for (i, v) in object.mesh.vertices.iter().enumerate() {

@@ -11,6 +11,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod ambient_occlusion;
 mod backends;
 mod cli_bless;
 mod cli_check;

@@ -18,7 +18,7 @@ fn plan_of(scene: &Scene) -> RenderPlan {
 
 #[test]
 fn canonical_scene_plans() {
-    for name in ["chess", "arrow", "ibl"] {
+    for name in ["chess", "arrow", "ibl", "corner"] {
         let loaded = harness::load_scene(name).unwrap_or_else(|e| panic!("{e}"));
         insta::assert_snapshot!(format!("plan_{name}"), plan_of(&loaded.scene).to_string());
     }

@@ -249,6 +249,15 @@ impl<'a> LightingResources<'a> {
             ("ibl_dfg", BindingResource::Texture(self.ibl.dfg)),
             ("ibl_sampler", BindingResource::Sampler(self.ibl.sampler)),
             ("scene_depth", texture(TargetId::Depth)),
+            // Read only by draws with AMBIENT_OCCLUSION, in scenes that have the target.
+            (
+                "ambient_occlusion",
+                BindingResource::Texture(
+                    self.frame
+                        .optional_target(TargetId::AmbientOcclusion)
+                        .unwrap_or(self.frame.white),
+                ),
+            ),
         ];
         resources
             .into_iter()

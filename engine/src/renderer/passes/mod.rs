@@ -5,6 +5,7 @@
 //! Adding a pass: a [`PassId`] variant and its place in the plan's builder, a file here with
 //! its `record`, and an arm below. The harness takes what it needs from the plan's types.
 
+pub(super) mod ambient_occlusion;
 pub(super) mod geometry;
 pub(super) mod gizmos;
 pub(super) mod lighting;
@@ -27,6 +28,7 @@ pub(super) fn record(ctx: &mut FrameContext<'_>, pass: PassId) -> Result<(), Ren
         PassId::ShadowBlur { light, axis } => shadow::record_blur(ctx, light, axis),
         PassId::Geometry => geometry::record_geometry(ctx),
         PassId::ShaderMask => geometry::record_mask(ctx),
+        PassId::AmbientOcclusion => ambient_occlusion::record(ctx),
         // On the CPU, when the frame was prepared (`PreparedFrame::new`): nothing to record.
         PassId::IblPrecompute => Ok(()),
         PassId::Skybox => skybox::record(ctx),

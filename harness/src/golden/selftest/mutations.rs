@@ -41,11 +41,13 @@ pub enum Mutation {
     /// The tone-mapping pass scales its input by 1.03 (an injected fault: the light buffer is
     /// untouched).
     ToneCurve,
+    /// The screen-space ambient occlusion's radius x1.1.
+    OcclusionRadius,
 }
 
 impl Mutation {
     /// Every mutation.
-    pub const ALL: [Mutation; 15] = [
+    pub const ALL: [Mutation; 16] = [
         Mutation::LightIntensity,
         Mutation::Exposure,
         Mutation::PointLightMoved,
@@ -61,6 +63,7 @@ impl Mutation {
         Mutation::CameraYaw,
         Mutation::LightingModel,
         Mutation::ToneCurve,
+        Mutation::OcclusionRadius,
     ];
 
     /// Short description.
@@ -81,6 +84,7 @@ impl Mutation {
             Mutation::CameraYaw => "camera yaw 0.25 deg",
             Mutation::LightingModel => "one object's lighting model",
             Mutation::ToneCurve => "tone-map input x1.03",
+            Mutation::OcclusionRadius => "ssao radius x1.1",
         }
     }
 
@@ -104,6 +108,7 @@ impl Mutation {
             Mutation::CameraYaw => TargetId::Depth,
             Mutation::LightingModel => TargetId::Mask(0),
             Mutation::ToneCurve => TargetId::Final,
+            Mutation::OcclusionRadius => TargetId::AmbientOcclusion,
         }
     }
 
@@ -199,6 +204,7 @@ impl Mutation {
                 };
             }
             Mutation::ToneCurve => variations.tonemap_input_scale = Some(1.03),
+            Mutation::OcclusionRadius => s.quality.ssao.as_mut()?.radius *= 1.1,
         }
         Some((s, variations))
     }
