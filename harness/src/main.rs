@@ -144,8 +144,8 @@ enum Command {
         #[arg(long, default_value = "chess")]
         scene: String,
         /// The knob: shadow, ibl or gbuffer.
-        #[arg(long, default_value = "shadow")]
-        knob: String,
+        #[arg(long, value_enum, default_value = "shadow")]
+        knob: harness::measure::sweep::Knob,
         /// Backend.
         #[arg(long, default_value = "gl")]
         backend: BackendKind,
@@ -180,8 +180,8 @@ enum Command {
         frames: Option<usize>,
         /// Instead of the scenes, a scaling series: resolution, lights, triangles, shadow-map,
         /// or all (repeatable).
-        #[arg(long = "series")]
-        series: Vec<String>,
+        #[arg(long = "series", value_enum)]
+        series: Vec<cli::bench::SeriesArg>,
         /// Instead of the pass table, where each lighting pass's time goes: its input floor
         /// (reading the G-buffer, no shading), its per-pixel setup, then the time it loses
         /// without IBL, without each light, and (parts of those) without shadow lookups and
@@ -274,7 +274,7 @@ fn main() -> ExitCode {
             json,
         } => cli::sweep::run(
             &scene,
-            &knob,
+            knob,
             backend,
             repeats,
             environment.as_deref(),

@@ -38,7 +38,7 @@ impl Suite {
             .entry((case, kind))
             .or_default()
             .clone();
-        cell.get_or_init(|| self.cases[case].render(kind));
+        cell.get_or_init(|| self.cases[case].render(kind).map_err(|e| e.to_string()));
         cell
     }
 

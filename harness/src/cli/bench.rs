@@ -1,6 +1,7 @@
 //! `harness bench`: GPU timings of every pass against its floor, scaling series, and the
 //! breakdown of the lighting passes, kept for the check report.
 
+use harness::measure::bench::Series;
 use std::path::Path;
 use std::process::ExitCode;
 
@@ -77,30 +78,58 @@ pub(crate) fn pass_table(
 
 /// `harness bench --series`: the scaling series named (`all` for every one) on each backend
 /// asked for (gl by default), kept as bench_series.json in `out`.
+/// `--series`: a scaling series, or all of them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum SeriesArg {
+    /// Chess at 256..2048 pixels a side.
+    Resolution,
+    /// 1..256 point lights.
+    Lights,
+    /// Chess's meshes subdivided 1x..64x.
+    Triangles,
+    /// Chess's sun with 512..4096 shadow maps.
+    ShadowMap,
+    /// Every series.
+    All,
+}
+
+impl SeriesArg {
+    /// The series chosen (none for `all`).
+    fn series(self) -> Option<Series> {
+        match self {
+            SeriesArg::Resolution => Some(Series::Resolution),
+            SeriesArg::Lights => Some(Series::Lights),
+            SeriesArg::Triangles => Some(Series::Triangles),
+            SeriesArg::ShadowMap => Some(Series::ShadowMap),
+            SeriesArg::All => None,
+        }
+    }
+}
+
 pub(crate) fn series(
-    names: &[String],
+    chosen: &[SeriesArg],
     backends: &[BackendKind],
     frames: usize,
     out: &Path,
     json: bool,
 ) -> anyhow::Result<ExitCode> {
-    let names: Vec<String> = if names.iter().any(|n| n == "all") {
-        harness::measure::bench::SERIES
-            .iter()
-            .map(|s| (*s).to_owned())
-            .collect()
+    let names: Vec<Series> = if chosen.contains(&SeriesArg::All) {
+        Series::ALL.to_vec()
     } else {
-        names.to_vec()
+        chosen.iter().filter_map(|s| s.series()).collect()
     };
     let kinds = backends_or_gl(backends);
     let mut all = Vec::new();
     for kind in kinds {
         for name in &names {
-            let points = harness::measure::bench::series(name, kind, frames, |what| {
+            let points = harness::measure::bench::series(*name, kind, frames, |what| {
                 eprintln!("  {kind}: {what} ...");
             })?;
             if !json {
-                println!("{name} series on {kind} (median of {frames} frames, GPU ms)");
+                println!(
+                    "{} series on {kind} (median of {frames} frames, GPU ms)",
+                    name.name()
+                );
                 println!("{}", harness::measure::bench::series_table(&points));
             }
             all.push(serde_json::json!({ "backend": kind.name(), "points": points }));

@@ -99,9 +99,8 @@ fn print_table(run: &CheckRun, report: &Path, failures: &Path) {
         "scene", "pass", "backend", "result"
     );
     for r in &run.results {
-        let (label, worst) = match &r.outcome {
-            harness::golden::Outcome::Passed(v) | harness::golden::Outcome::Failed(v) => (
-                if r.outcome.passed() { "ok" } else { "FAILED" },
+        let worst = match &r.outcome {
+            harness::golden::Outcome::Passed(v) | harness::golden::Outcome::Failed(v) => {
                 // The check closest to (or furthest past) its limit, and for a failure
                 // where the largest difference is.
                 v.checks
@@ -111,17 +110,19 @@ fn print_table(run: &CheckRun, report: &Path, failures: &Path) {
                     .unwrap_or_default()
                     + &v.largest_difference
                         .map(|l| format!("; {l}"))
-                        .unwrap_or_default(),
-            ),
-            harness::golden::Outcome::MissingGolden => (
-                "MISSING",
-                format!("no golden at {}", r.golden_path.display()),
-            ),
-            harness::golden::Outcome::Incomparable(why) => ("FAILED", why.clone()),
+                        .unwrap_or_default()
+            }
+            harness::golden::Outcome::MissingGolden => {
+                format!("no golden at {}", r.golden_path.display())
+            }
+            harness::golden::Outcome::Incomparable(why) => why.clone(),
         };
         println!(
             "{:<8} {:<17} {:<12} {:<8} {worst}",
-            r.scene, r.pass, r.backend, label
+            r.scene,
+            r.pass,
+            r.backend,
+            r.outcome.label()
         );
     }
     for (scene, backend, error) in &run.render_errors {

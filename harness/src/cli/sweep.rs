@@ -5,12 +5,13 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use engine::backend::BackendKind;
+use harness::measure::sweep::Knob;
 
 /// Sweeps `knob` over its settings on `scene` (lit by `environment` when one is given) and
-/// prints the table (or JSON); an unknown knob is an error.
+/// prints the table (or JSON).
 pub(crate) fn run(
     scene: &str,
-    knob: &str,
+    knob: Knob,
     kind: BackendKind,
     repeats: usize,
     environment: Option<&Path>,
@@ -21,12 +22,12 @@ pub(crate) fn run(
     if let Some(path) = environment {
         replace_environment(&mut loaded.scene, path)?;
     }
-    if knob == "ibl" {
+    if knob == Knob::Ibl {
         let rows = harness::measure::sweep::ibl_sweep(&loaded.scene, kind, repeats, |what| {
             eprintln!("  {what} ...");
         })?;
         let text = serde_json::to_string_pretty(&rows)?;
-        save_sweep(out, &loaded.scene.name, "ibl", &text);
+        save_sweep(out, &loaded.scene.name, knob, &text);
         if json {
             println!("{text}");
         } else {
@@ -40,12 +41,12 @@ pub(crate) fn run(
         }
         return Ok(ExitCode::SUCCESS);
     }
-    if knob == "gbuffer" {
+    if knob == Knob::Gbuffer {
         let rows = harness::measure::sweep::gbuffer_sweep(&loaded.scene, kind, repeats, |what| {
             eprintln!("  {what} ...");
         })?;
         let text = serde_json::to_string_pretty(&rows)?;
-        save_sweep(out, &loaded.scene.name, "gbuffer", &text);
+        save_sweep(out, &loaded.scene.name, knob, &text);
         if json {
             println!("{text}");
         } else {
@@ -57,14 +58,11 @@ pub(crate) fn run(
         }
         return Ok(ExitCode::SUCCESS);
     }
-    if knob != "shadow" {
-        return Err(harness::measure::sweep::SweepError::UnknownKnob(knob.to_owned()).into());
-    }
     let rows = harness::measure::sweep::shadow_sweep(&loaded.scene, kind, repeats, |what| {
         eprintln!("  {what} ...");
     })?;
     let text = serde_json::to_string_pretty(&rows)?;
-    save_sweep(out, &loaded.scene.name, "shadow", &text);
+    save_sweep(out, &loaded.scene.name, knob, &text);
     if json {
         println!("{text}");
     } else {
@@ -106,8 +104,8 @@ fn replace_environment(scene: &mut engine::scene::Scene, path: &Path) -> anyhow:
 
 /// Keeps a sweep's results (`out`/sweep_<scene>_<knob>.json, target/harness by default) for the
 /// check report; a failure to write them is a warning.
-fn save_sweep(out: &Path, scene: &str, knob: &str, json: &str) {
-    let path = out.join(harness::measure::sweep::result_file(scene, knob));
+fn save_sweep(out: &Path, scene: &str, knob: Knob, json: &str) {
+    let path = out.join(harness::measure::sweep::result_file(scene, knob.name()));
     let written = std::fs::create_dir_all(out)
         .map_err(|e| e.to_string())
         .and_then(|_| {

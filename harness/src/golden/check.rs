@@ -265,7 +265,9 @@ pub fn run_with(
             progress(done, total, &format!("{} on {kind}", case.name()));
             let rendered = create(kind)
                 .map_err(|e| e.to_string())
-                .and_then(|mut backend| case.render_on(backend.as_mut()));
+                .and_then(|mut backend| {
+                    case.render_on(backend.as_mut()).map_err(|e| e.to_string())
+                });
             match rendered {
                 Ok(frame) => {
                     for pass in frame.plan.passes.iter().map(|p| p.id) {

@@ -228,6 +228,17 @@ impl Outcome {
     pub fn passed(&self) -> bool {
         matches!(self, Outcome::Passed(_))
     }
+
+    /// The outcome as one word, the same in the check table, the test output and the review
+    /// page: `ok`, `FAILED`, `MISSING` (no golden) or `INCOMPARABLE` (size or format changed).
+    pub fn label(&self) -> &'static str {
+        match self {
+            Outcome::Passed(_) => "ok",
+            Outcome::Failed(_) => "FAILED",
+            Outcome::MissingGolden => "MISSING",
+            Outcome::Incomparable(_) => "INCOMPARABLE",
+        }
+    }
 }
 
 /// Checks an output against its golden with a rule.

@@ -205,15 +205,15 @@ impl Case {
     }
 
     /// Renders the golden passes on a new backend of this kind.
-    pub fn render(&self, kind: BackendKind) -> Result<Frame, String> {
-        let mut backend = backend::create(kind).map_err(|e| e.to_string())?;
+    pub fn render(&self, kind: BackendKind) -> Result<Frame, RenderError> {
+        let mut backend = backend::create(kind)?;
         self.render_on(backend.as_mut())
     }
 
     /// Renders the golden passes on a given backend.
-    pub fn render_on(&self, backend: &mut dyn backend::Backend) -> Result<Frame, String> {
+    pub fn render_on(&self, backend: &mut dyn backend::Backend) -> Result<Frame, RenderError> {
         let readback = Readback::Only(&self.passes);
-        renderer::render_prepared(backend, &self.frame, readback).map_err(|e| e.to_string())
+        renderer::render_prepared(backend, &self.frame, readback)
     }
 }
 
@@ -327,7 +327,13 @@ impl PassCheck {
     /// A multi-line explanation for test output.
     pub fn message(&self) -> String {
         let golden = &self.golden_path;
-        let mut lines = vec![format!("{}::{}::{}", self.scene, self.pass, self.backend)];
+        let mut lines = vec![format!(
+            "{}::{}::{} {}",
+            self.scene,
+            self.pass,
+            self.backend,
+            self.outcome.label()
+        )];
         match &self.outcome {
             Outcome::Passed(v) | Outcome::Failed(v) => {
                 if v.non_finite > 0 {

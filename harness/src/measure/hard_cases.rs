@@ -60,16 +60,44 @@ pub struct HardCaseRow {
     pub passed: bool,
 }
 
-/// Loads `scenes/hard/<name>.toml`.
-pub fn scene(name: &str) -> Result<Scene, String> {
-    let path = crate::workspace_root().join(format!("scenes/hard/{name}.toml"));
-    engine::scene_file::load(&path)
-        .map(|l| l.scene)
-        .map_err(|e| e.to_string())
+/// Why a hard case could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum HardCaseError {
+    /// Its scene file did not load.
+    #[error(transparent)]
+    Scene(#[from] engine::scene_file::SceneFileError),
+    /// The backend is missing or failed.
+    #[error(transparent)]
+    Backend(#[from] backend::BackendError),
+    /// The render failed.
+    #[error(transparent)]
+    Render(#[from] engine::renderer::RenderError),
+    /// The comparison with its reference could not run.
+    #[error(transparent)]
+    Reference(#[from] reference::ReferenceError),
+    /// Two renders could not be compared.
+    #[error(transparent)]
+    Compare(#[from] crate::golden::metrics::compare::CompareError),
 }
 
-fn render(backend: &mut dyn backend::Backend, scene: &Scene) -> Result<Frame, String> {
-    renderer::render(backend, scene, Readback::All).map_err(|e| e.to_string())
+/// Loads `scenes/hard/<name>.toml`.
+pub fn scene(name: &str) -> Result<Scene, HardCaseError> {
+    let path = crate::workspace_root().join(format!("scenes/hard/{name}.toml"));
+    Ok(engine::scene_file::load(&path)?.scene)
+}
+
+fn render(backend: &mut dyn backend::Backend, scene: &Scene) -> Result<Frame, HardCaseError> {
+    Ok(renderer::render(backend, scene, Readback::All)?)
+}
+
+/// A frame's final image.
+fn final_image(frame: &Frame) -> Result<&engine::Image, reference::ReferenceError> {
+    frame
+        .output(engine::plan::TargetId::Final)
+        .ok_or(reference::ReferenceError::MissingOutput {
+            target: engine::plan::TargetId::Final,
+            storage: "8-bit",
+        })
 }
 
 /// Non-finite values in every float output, and the light buffer's range.
@@ -199,15 +227,18 @@ fn row(
 }
 
 /// Runs every hard case on one backend.
-pub fn run(kind: BackendKind, mut progress: impl FnMut(&str)) -> Result<Vec<HardCaseRow>, String> {
-    let mut backend = backend::create(kind).map_err(|e| e.to_string())?;
+pub fn run(
+    kind: BackendKind,
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<HardCaseRow>, HardCaseError> {
+    let mut backend = backend::create(kind)?;
     let mut rows = Vec::new();
     for case in SCENE_CASES {
         progress(case);
         let scene = scene(case)?;
         let frame = render(backend.as_mut(), &scene)?;
         let row = if REFERENCE_CASES.contains(&case) {
-            let error = reference::lighting_error(&scene, &frame).map_err(|e| e.to_string())?;
+            let error = reference::lighting_error(&scene, &frame)?;
             let value = if error.pixels > 1000 && error.non_finite == 0 {
                 error.p999_relative
             } else {
@@ -262,7 +293,7 @@ pub fn run(kind: BackendKind, mut progress: impl FnMut(&str)) -> Result<Vec<Hard
         rows.push(row);
     }
     progress("chess moved and scaled");
-    let chess = crate::load_scene("chess").map_err(|e| e.to_string())?.scene;
+    let chess = crate::load_scene("chess")?.scene;
     let reference = render(backend.as_mut(), &chess)?;
     for (what, moved) in [
         (
@@ -278,15 +309,10 @@ pub fn run(kind: BackendKind, mut progress: impl FnMut(&str)) -> Result<Vec<Hard
     ] {
         let frame = render(backend.as_mut(), &moved)?;
         let diff = crate::golden::metrics::compare::u8_difference(
-            reference
-                .output(engine::plan::TargetId::Final)
-                .ok_or("no final image")?,
-            frame
-                .output(engine::plan::TargetId::Final)
-                .ok_or("no final image")?,
+            final_image(&reference)?,
+            final_image(&frame)?,
             1,
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         rows.push(row(
             what,
             kind,

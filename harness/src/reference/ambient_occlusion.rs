@@ -14,6 +14,8 @@ use engine::renderer::Frame;
 use engine::scene::Scene;
 use glam::DVec3;
 
+use super::ReferenceError;
+
 /// How far a frame's occlusion is from the references, over the floor pixels.
 #[derive(Clone, Debug, PartialEq)]
 pub struct OcclusionError {
@@ -34,17 +36,24 @@ pub struct OcclusionError {
 
 /// Compares `frame`'s occlusion of `scene` (a [`crate::test_scenes::corner`]) with the
 /// references, over the floor pixels at least one kernel radius inside the image's edges.
-pub fn corner_error(scene: &Scene, frame: &Frame, wall_x: f64) -> Result<OcclusionError, String> {
+pub fn corner_error(
+    scene: &Scene,
+    frame: &Frame,
+    wall_x: f64,
+) -> Result<OcclusionError, ReferenceError> {
     let settings = scene
         .quality
         .ssao
-        .ok_or("the scene has no [quality.ssao]")?;
+        .ok_or_else(|| ReferenceError::SceneLacks {
+            scene: scene.name.clone(),
+            what: "[quality.ssao]".to_owned(),
+        })?;
     let radius = f64::from(settings.radius);
     let read = |target: TargetId| {
         frame
             .output(target)
             .and_then(|image| image.as_f32())
-            .ok_or_else(|| format!("frame has no float output `{target}`"))
+            .ok_or(ReferenceError::no_float(target))
     };
     let occlusion = read(TargetId::AmbientOcclusion)?;
     let position = read(TargetId::GBuffer(GBufferTarget::Position))?;
@@ -97,7 +106,7 @@ pub fn corner_error(scene: &Scene, frame: &Frame, wall_x: f64) -> Result<Occlusi
         }
     }
     if error.pixels == 0 {
-        return Err("no floor pixel in the frame".to_owned());
+        return Err(ReferenceError::NoPixels("floor pixels"));
     }
     error.mean_vs_kernel /= error.pixels as f64;
     error.p99_vs_kernel = engine::stats::percentile(differences, 0.99).unwrap_or(0.0);

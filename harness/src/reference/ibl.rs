@@ -13,6 +13,7 @@
 //! deterministic and the standard error returned with each estimate is measured from the
 //! replicas' spread.
 
+use super::ReferenceError;
 use std::f64::consts::PI;
 
 use engine::plan;
@@ -314,29 +315,34 @@ pub fn reference_pixels(
     frame: &Frame,
     pixels: usize,
     samples_per_strategy: usize,
-) -> Result<Vec<PixelReference>, String> {
+) -> Result<Vec<PixelReference>, ReferenceError> {
     let environment = scene
         .environment
         .as_ref()
-        .ok_or_else(|| format!("scene `{}` has no environment", scene.name))?;
-    let gbuffer = crate::reference::lighting::gbuffer_images(frame).map_err(|e| e.to_string())?;
+        .ok_or_else(|| ReferenceError::SceneLacks {
+            scene: scene.name.clone(),
+            what: "environment".to_owned(),
+        })?;
+    let gbuffer = crate::reference::lighting::gbuffer_images(frame)?;
     let mask = frame
         .output(plan::TargetId::Mask(0))
-        .ok_or("frame has no `mask` output")?
-        .as_u8()
-        .ok_or("mask is not 8-bit")?;
+        .and_then(|m| m.as_u8())
+        .ok_or(ReferenceError::MissingOutput {
+            target: plan::TargetId::Mask(0),
+            storage: "8-bit",
+        })?;
     let channel = frame
         .plan
         .mask_channels
         .iter()
         .find(|c| c.model == LightingModel::Pbr && c.target == 0)
-        .ok_or("no PBR pixels")?
+        .ok_or(ReferenceError::NoPixels("PBR pixels"))?
         .channel;
     let covered: Vec<usize> = (0..mask.len() / 4)
         .filter(|i| mask[i * 4 + channel] > 127)
         .collect();
     if covered.is_empty() {
-        return Err("no PBR pixels".into());
+        return Err(ReferenceError::NoPixels("PBR pixels"));
     }
     let sampler = EnvironmentSampler::new(
         &environment.image,

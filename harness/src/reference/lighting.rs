@@ -11,6 +11,8 @@
 use std::f64::consts::PI;
 
 use engine::plan::TargetId;
+
+pub use super::ReferenceError;
 use engine::renderer::Frame;
 use engine::scene::{Light, LightingModel, Scene};
 use engine::Image;
@@ -263,15 +265,8 @@ pub struct LightingError {
     pub worst_pixel: (u32, u32),
 }
 
-/// Why the comparison could not run.
-#[derive(Debug, thiserror::Error)]
-#[error("reference comparison: {0}")]
-pub struct ReferenceError(String);
-
 fn f32_image(frame: &Frame, target: TargetId) -> Result<&Image, ReferenceError> {
-    frame
-        .output(target)
-        .ok_or_else(|| ReferenceError(format!("frame has no `{target}` output")))
+    frame.output(target).ok_or(ReferenceError::no_float(target))
 }
 
 fn sample(image: &Image, index: usize) -> [f64; 4] {
@@ -333,7 +328,10 @@ pub fn reference_light_buffer(
         .filter_map(|mask| frame.output(mask))
         .collect();
     if masks.is_empty() {
-        return Err(ReferenceError("frame has no mask output".into()));
+        return Err(ReferenceError::MissingOutput {
+            target: TargetId::Mask(0),
+            storage: "8-bit",
+        });
     }
     let lights = reference_lights(scene);
     let ambient = reference_ambient(scene);

@@ -9,6 +9,7 @@ use engine::scene::{Light, Scene};
 use engine::Image;
 use glam::DVec3;
 
+use super::ReferenceError;
 use crate::golden::metrics::bitwise_equal;
 
 /// A triangle in camera-relative world space.
@@ -253,7 +254,7 @@ pub fn visibility_error(
     frame: &Frame,
     light: usize,
     epsilon: f64,
-) -> Result<VisibilityError, String> {
+) -> Result<VisibilityError, ReferenceError> {
     RayCastVisibility::cast(scene, frame, light, epsilon)?.error(frame)
 }
 
@@ -266,21 +267,23 @@ struct GbufferInputs<'a> {
 }
 
 impl<'a> GbufferInputs<'a> {
-    fn of(frame: &'a Frame) -> Result<Self, String> {
+    fn of(frame: &'a Frame) -> Result<Self, ReferenceError> {
         let float = |target: TargetId| {
             frame
                 .output(target)
                 .and_then(|i| i.as_f32())
-                .ok_or_else(|| format!("frame has no float output `{target}`"))
+                .ok_or(ReferenceError::no_float(target))
         };
         let [position, normal, mask, mask_1] = CAST_INPUTS;
         Ok(Self {
             position: float(position)?,
             normal: float(normal)?,
-            mask: frame
-                .output(mask)
-                .and_then(|i| i.as_u8())
-                .ok_or("frame has no mask output")?,
+            mask: frame.output(mask).and_then(|i| i.as_u8()).ok_or(
+                ReferenceError::MissingOutput {
+                    target: mask,
+                    storage: "8-bit",
+                },
+            )?,
             mask_1: frame.output(mask_1).and_then(|i| i.as_u8()),
         })
     }
@@ -301,11 +304,22 @@ pub struct RayCastVisibility {
 impl RayCastVisibility {
     /// Casts a ray to `light` from each covered pixel of `frame`'s G-buffer that faces it,
     /// `epsilon` (meters) off its surface along the normal.
-    pub fn cast(scene: &Scene, frame: &Frame, light: usize, epsilon: f64) -> Result<Self, String> {
+    pub fn cast(
+        scene: &Scene,
+        frame: &Frame,
+        light: usize,
+        epsilon: f64,
+    ) -> Result<Self, ReferenceError> {
         let inputs = GbufferInputs::of(frame)?;
         let occluders = Occluders::new(scene);
         let camera = scene.camera.position;
-        let light_data = scene.lights.get(light).ok_or("no such light")?;
+        let light_data = scene
+            .lights
+            .get(light)
+            .ok_or_else(|| ReferenceError::SceneLacks {
+                scene: scene.name.clone(),
+                what: format!("light {light}"),
+            })?;
         let (position, normal, mask) = (inputs.position, inputs.normal, inputs.mask);
         let visible = (0..position.len() / 4)
             .map(|i| {
@@ -360,18 +374,18 @@ impl RayCastVisibility {
 
     /// `frame`'s shadow term of this light against the cast (the frame must have the same
     /// G-buffer: see [`RayCastVisibility::holds_for`]).
-    pub fn error(&self, frame: &Frame) -> Result<VisibilityError, String> {
+    pub fn error(&self, frame: &Frame) -> Result<VisibilityError, ReferenceError> {
         let name = TargetId::ShadowTerm { light: self.light };
         let term = frame
             .output(name)
             .and_then(|i| i.as_f32())
-            .ok_or_else(|| format!("frame has no float output `{name}`"))?;
+            .ok_or(ReferenceError::no_float(name))?;
         if term.len() != self.visible.len() * 4 {
-            return Err(format!(
-                "`{name}` has {} pixels, the ray cast {}",
-                term.len() / 4,
-                self.visible.len()
-            ));
+            return Err(ReferenceError::SizeMismatch {
+                target: name,
+                output: term.len() / 4,
+                reference: self.visible.len(),
+            });
         }
         let (mut lit_surface, mut wrong, mut shadowed, mut false_lit) = (0, 0, 0, 0);
         for (i, visible) in self.visible.iter().enumerate() {

@@ -73,19 +73,14 @@ fn metrics_text(outcome: &Outcome) -> String {
             }
             lines.join("\n")
         }
-        Outcome::MissingGolden => "no golden".to_owned(),
+        Outcome::MissingGolden => "no golden yet".to_owned(),
         Outcome::Incomparable(why) => why.clone(),
     }
 }
 
-/// The result of a check as a word (`ok`, `FAILED`, ...).
+/// The result of a check as a word ([`Outcome::label`]).
 fn result_label(outcome: &Outcome) -> &'static str {
-    match outcome {
-        Outcome::Passed(_) => "ok",
-        Outcome::Failed(_) => "FAILED",
-        Outcome::MissingGolden => "no golden",
-        Outcome::Incomparable(_) => "incomparable",
-    }
+    outcome.label()
 }
 
 /// A command as code, with a button that copies it.

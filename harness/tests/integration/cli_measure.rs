@@ -216,3 +216,21 @@ fn noise_measures_sources_and_fails_when_a_golden_moved() {
         "{stdout}"
     );
 }
+
+/// Closed sets of values are typed on the command line: an unknown knob or series is refused
+/// before anything runs, with the values that exist.
+#[test]
+fn unknown_knobs_and_series_are_refused_with_the_known_ones() {
+    let (code, _, stderr) = harness(&["sweep", "--knob", "shadows"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("shadow") && stderr.contains("ibl") && stderr.contains("gbuffer"),
+        "{stderr}"
+    );
+    let (code, _, stderr) = harness(&["bench", "--series", "pixels"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("resolution") && stderr.contains("shadow-map") && stderr.contains("all"),
+        "{stderr}"
+    );
+}

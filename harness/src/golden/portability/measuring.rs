@@ -305,7 +305,7 @@ pub fn measure(
                             source: source.name.clone(),
                             backend: reference,
                             scene: case.name().to_owned(),
-                            error,
+                            error: error.to_string(),
                             known: false,
                         }),
                     }

@@ -32,7 +32,7 @@ pub use floors::Floors;
 pub use lighting_breakdown::{breakdown, BreakdownRow, PassBreakdown, BREAKDOWN_FRAMES};
 pub use precompute::{precompute, Precompute};
 pub use report::{report_sections, series_svg, BENCH_JSON, SERIES_JSON};
-pub use series::{series, SeriesPoint, SERIES};
+pub use series::{series, Series, SeriesPoint};
 pub use tables::{breakdown_table, series_table, table};
 pub use timing::{bench_scene, timed_render, PassBench, SceneBench};
 
@@ -70,7 +70,7 @@ mod tests {
         let points: Vec<SeriesPoint> = [(1u64, 1.0), (8, 3.0), (64, 20.0)]
             .into_iter()
             .map(|(value, ms)| SeriesPoint {
-                series: "lights".to_owned(),
+                series: Series::Lights,
                 value,
                 pass: engine::plan::PassId::Lighting(engine::scene::LightingModel::Pbr),
                 pass_ms: Some(ms),

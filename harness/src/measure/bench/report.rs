@@ -23,7 +23,7 @@ pub fn series_svg(points: &[SeriesPoint]) -> String {
          style=\"background:#fff;border:1px solid #ccc\">\
          <text x=\"{left}\" y=\"14\" font-size=\"12\">{} ms against {}</text>",
         crate::html::escape(&first.pass.to_string()),
-        crate::html::escape(&first.series)
+        crate::html::escape(first.series.name())
     );
     if data.is_empty() {
         svg.push_str("<text x=\"60\" y=\"100\" font-size=\"12\">no timestamps</text></svg>");

@@ -12,14 +12,47 @@ use super::BenchError;
 /// The PBR lighting pass, which the resolution and light series time.
 const PBR: PassId = PassId::Lighting(LightingModel::Pbr);
 
-/// The scaling series `harness bench --series` knows.
-pub const SERIES: [&str; 4] = ["resolution", "lights", "triangles", "shadow-map"];
+/// A scaling series of `harness bench --series`.
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum Series {
+    /// Chess at 256..2048 pixels a side (the PBR lighting pass).
+    Resolution,
+    /// 1..256 point lights on a floor (the PBR lighting pass).
+    Lights,
+    /// Chess's meshes subdivided 1x..64x (the geometry pass).
+    Triangles,
+    /// Chess's sun with 512..4096 shadow maps (its shadow pass).
+    ShadowMap,
+}
+
+impl Series {
+    /// Every series.
+    pub const ALL: [Series; 4] = [
+        Series::Resolution,
+        Series::Lights,
+        Series::Triangles,
+        Series::ShadowMap,
+    ];
+
+    /// Its name on the command line and in the JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Series::Resolution => "resolution",
+            Series::Lights => "lights",
+            Series::Triangles => "triangles",
+            Series::ShadowMap => "shadow-map",
+        }
+    }
+}
 
 /// One point of a scaling series.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct SeriesPoint {
-    /// Series name (see [`SERIES`]).
-    pub series: String,
+    /// The series.
+    pub series: Series,
     /// The value varied: pixels per side, point lights, triangles, or shadow-map texels per side.
     pub value: u64,
     /// The pass the series is about.
@@ -34,7 +67,7 @@ pub struct SeriesPoint {
 /// a floor (lighting), chess's meshes subdivided 1x..64x (geometry), chess's sun with 512..4096
 /// shadow maps (shadow pass).
 pub fn series(
-    name: &str,
+    name: Series,
     kind: BackendKind,
     frames: usize,
     mut progress: impl FnMut(&str),
@@ -49,7 +82,7 @@ pub fn series(
             })
     };
     let settings: Vec<(u64, Scene, PassId)> = match name {
-        "resolution" => [256u32, 512, 1024, 2048]
+        Series::Resolution => [256u32, 512, 1024, 2048]
             .into_iter()
             .map(|size| {
                 let mut scene = chess()?;
@@ -58,11 +91,11 @@ pub fn series(
                 Ok((u64::from(size), scene, PBR))
             })
             .collect::<Result<_, BenchError>>()?,
-        "lights" => [1usize, 8, 64, 256]
+        Series::Lights => [1usize, 8, 64, 256]
             .into_iter()
             .map(|n| (n as u64, crate::test_scenes::many_point_lights(512, n), PBR))
             .collect(),
-        "triangles" => {
+        Series::Triangles => {
             let mut scene = chess()?;
             let mut points = Vec::new();
             for level in 0..4 {
@@ -82,7 +115,7 @@ pub fn series(
             }
             points
         }
-        "shadow-map" => [512u32, 1024, 2048, 4096]
+        Series::ShadowMap => [512u32, 1024, 2048, 4096]
             .into_iter()
             .map(|size| {
                 let mut scene = chess()?;
@@ -97,13 +130,6 @@ pub fn series(
                 Ok((u64::from(size), scene, PassId::Shadow { light: 0 }))
             })
             .collect::<Result<_, BenchError>>()?,
-        other => {
-            return Err(BenchError::Render {
-                scene: "-".to_owned(),
-                backend: kind,
-                message: format!("unknown series `{other}` (known: {})", SERIES.join(", ")),
-            })
-        }
     };
     let mut backend = backend::create(kind).map_err(|e| BenchError::Backend {
         backend: kind,
@@ -111,7 +137,7 @@ pub fn series(
     })?;
     let mut points = Vec::new();
     for (value, scene, pass) in settings {
-        progress(&format!("{name} {value}"));
+        progress(&format!("{} {value}", name.name()));
         let prepared = PreparedFrame::new(&scene).map_err(|e| BenchError::Render {
             scene: scene.name.clone(),
             backend: kind,
@@ -119,7 +145,7 @@ pub fn series(
         })?;
         let (timings, _) = time_frames(backend.as_mut(), &prepared, frames.max(1))?;
         points.push(SeriesPoint {
-            series: name.to_owned(),
+            series: name,
             value,
             pass,
             pass_ms: median_pass_ms(&timings, pass),

@@ -109,7 +109,7 @@ pub fn series_table(points: &[SeriesPoint]) -> String {
         };
         out.push_str(&format!(
             "{:<12} {:>10} {:>14} {:>10} {:>10} {:>12}\n",
-            p.series,
+            p.series.name(),
             p.value,
             ms(p.pass_ms),
             value_growth,

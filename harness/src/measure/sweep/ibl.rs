@@ -196,15 +196,12 @@ pub fn ibl_sweep_with(
         }
         if references.is_none() {
             progress("Monte Carlo reference");
-            references = Some(
-                crate::reference::ibl::reference_pixels(
-                    scene,
-                    &frames[0],
-                    IBL_REFERENCE_PIXELS,
-                    IBL_REFERENCE_SAMPLES,
-                )
-                .map_err(SweepError::Render)?,
-            );
+            references = Some(crate::reference::ibl::reference_pixels(
+                scene,
+                &frames[0],
+                IBL_REFERENCE_PIXELS,
+                IBL_REFERENCE_SAMPLES,
+            )?);
         }
         let references = references.as_deref().unwrap_or_default();
         let by_roughness = crate::reference::ibl::error_by_roughness(&frames[0], references);

@@ -40,9 +40,6 @@ use engine::stats::median;
 /// Why a sweep failed.
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
-    /// The knob is not one the sweep knows.
-    #[error("unknown knob `{0}` (known: shadow, ibl, gbuffer)")]
-    UnknownKnob(String),
     /// The scene has no environment (for the `ibl` knob).
     #[error("scene `{0}` has no environment")]
     NoEnvironment(String),
@@ -52,6 +49,9 @@ pub enum SweepError {
     /// Rendering failed.
     #[error("{0}")]
     Render(String),
+    /// The comparison with the reference could not run.
+    #[error(transparent)]
+    Reference(#[from] crate::reference::ReferenceError),
 }
 
 /// Median over frames of the GPU ms of every pass `of` selects (summed in each frame).
@@ -82,6 +82,28 @@ fn shadow_map(pass: PassId) -> bool {
 /// The lighting passes, which the sweeps time.
 fn lighting(pass: PassId) -> bool {
     matches!(pass, PassId::Lighting(_))
+}
+
+/// A quality knob `harness sweep` times against error.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Knob {
+    /// Shadow filter x map size, against ray-cast visibility.
+    Shadow,
+    /// IBL settings, against a Monte Carlo reference.
+    Ibl,
+    /// G-buffer position storage x normal encoding, at 0, 1 km and 10 km from the origin.
+    Gbuffer,
+}
+
+impl Knob {
+    /// Its name on the command line and in file names.
+    pub fn name(self) -> &'static str {
+        match self {
+            Knob::Shadow => "shadow",
+            Knob::Ibl => "ibl",
+            Knob::Gbuffer => "gbuffer",
+        }
+    }
 }
 
 /// Mean, 99th percentile and maximum of some errors (zeros when there are none).

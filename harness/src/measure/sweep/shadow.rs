@@ -172,10 +172,9 @@ pub fn shadow_sweep_with(
             // G-buffer is the same (checked, bit for bit).
             let cast = match ray_cast.take() {
                 Some(cast) if cast.holds_for(frame) => cast,
-                _ => shadows::RayCastVisibility::cast(&mutated, frame, light, 1e-4)
-                    .map_err(SweepError::Render)?,
+                _ => shadows::RayCastVisibility::cast(&mutated, frame, light, 1e-4)?,
             };
-            let visibility = cast.error(frame).map_err(SweepError::Render)?;
+            let visibility = cast.error(frame)?;
             ray_cast = Some(cast);
             let soft = matches!(
                 filter,
