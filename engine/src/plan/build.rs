@@ -378,14 +378,20 @@ fn lighting_pass_specs(
     mask_channels
         .iter()
         .zip(lighting)
-        .map(|(channel, pass)| {
+        .enumerate()
+        .map(|(index, (channel, pass))| {
             let mut reads = gbuffer.to_vec();
-            reads.push(TargetId::Mask(channel.target));
+            // The camera's depth is bound for positions reconstructed from it.
+            reads.extend([TargetId::Depth, TargetId::Mask(channel.target)]);
             if channel.model != LightingModel::Unlit {
                 reads.extend(shadow_maps.iter().copied());
                 if scene.quality.ssao.is_some() {
                     reads.push(TargetId::AmbientOcclusion);
                 }
+            }
+            // Each adds into the light buffer the skybox or the pass before cleared.
+            if index > 0 || scene.environment.is_some() {
+                reads.push(TargetId::Light);
             }
             PassSpec {
                 id: PassId::Lighting(channel.model),
@@ -420,11 +426,20 @@ fn shadow_term_output(
         height: scene.quality.height,
         contents: format!("debug: light {light}'s shadow term (1 = lit)"),
     };
+    // The lighting shader's bind group: the G-buffer, depth and first mask target, the light's
+    // maps, the occlusion where there is one.
     let mut reads = gbuffer.to_vec();
-    reads.push(TargetId::Shadow { light });
+    reads.extend([
+        TargetId::Depth,
+        TargetId::Mask(0),
+        TargetId::Shadow { light },
+    ]);
     let moments = TargetId::ShadowMoments { light };
     if shadow_maps.contains(&moments) {
         reads.push(moments);
+    }
+    if scene.quality.ssao.is_some() {
+        reads.push(TargetId::AmbientOcclusion);
     }
     let pass = PassSpec {
         id: PassId::ShadowTerm { light },
@@ -446,7 +461,8 @@ fn output_passes(scene: &Scene) -> Vec<PassSpec> {
     if scene.quality.gizmos {
         passes.push(PassSpec {
             id: PassId::Gizmos,
-            reads: vec![],
+            // Drawn over the tone-mapped image.
+            reads: vec![TargetId::Final],
             writes: vec![TargetId::Final],
             detail: "axes, light directions, point-light markers; no depth test".to_owned(),
         });

@@ -123,6 +123,28 @@ impl RenderPlan {
             })
     }
 
+    /// Which of the plan's passes (in order) the `wanted` targets depend on, from the passes'
+    /// declared reads and writes: walking back from the wanted targets, a pass is needed when it
+    /// writes a target still needed, and then what it reads is needed too. Every earlier writer
+    /// of a needed target is kept (also where a later one clears it), so the kept passes leave
+    /// the wanted targets exactly as the whole frame would.
+    pub fn passes_needed_for(&self, wanted: &[TargetId]) -> Vec<bool> {
+        let mut needed: Vec<TargetId> = wanted.to_vec();
+        let mut keep = vec![false; self.passes.len()];
+        for (index, pass) in self.passes.iter().enumerate().rev() {
+            if !pass.writes.iter().any(|t| needed.contains(t)) {
+                continue;
+            }
+            keep[index] = true;
+            for target in &pass.reads {
+                if !needed.contains(target) {
+                    needed.push(*target);
+                }
+            }
+        }
+        keep
+    }
+
     /// The targets' names, comma-separated, for messages.
     pub fn target_list(&self) -> String {
         let names: Vec<String> = self.targets.iter().map(|t| t.id.to_string()).collect();

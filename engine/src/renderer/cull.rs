@@ -1,12 +1,14 @@
-//! Pass culling for [`Readback::Needed`](super::Readback::Needed): of the recorded passes, only
-//! those the wanted targets depend on are submitted.
+//! The check of pass culling for [`Readback::Needed`](super::Readback::Needed): the renderer
+//! culls by the plan's declared reads and writes
+//! ([`RenderPlan::passes_needed_for`](crate::plan::RenderPlan::passes_needed_for)), and, where
+//! debug assertions are on, checks that it keeps no pass the recorded passes themselves do not
+//! need (an upper bound: a loaded depth attachment counts as written here).
 //!
-//! The dependencies come from the recorded passes themselves, not from the plan's declared
-//! reads: a pass writes its attachments, and reads every texture its draws bind and every
-//! attachment it loads rather than clears (the shader mask tests against the geometry pass's
-//! depth, the lighting passes add into the light buffer). Walking back
-//! from the wanted targets, a pass is kept when it writes a target still needed, and then what
-//! it reads is needed too. Every earlier writer of a needed target is kept (also where a later
+//! Here the dependencies come from the recorded passes: a pass writes its attachments, and
+//! reads every texture its draws bind and every attachment it loads rather than clears (the
+//! shader mask tests against the geometry pass's depth, the lighting passes add into the light
+//! buffer). Walking back from the wanted targets, a pass is kept when it writes a target still
+//! needed, and then what it reads is needed too. Every earlier writer of a needed target is kept (also where a later
 //! one clears it), so the kept passes leave the wanted targets exactly as the whole frame would.
 
 use crate::backend::{BindingResource, Handle, LoadOp, RenderPass, Texture};

@@ -368,9 +368,37 @@ fn record_and_submit(
     } = std::mem::take(&mut ctx.recorded);
     drop(ctx);
     if wanted.cull {
-        let targets: Vec<Handle<Texture>> =
-            wanted.targets.iter().map(|id| frame.target(*id)).collect();
-        let keep = cull::needed(&passes, &targets);
+        // The plan says which passes the wanted targets need. The recorded passes' attachments
+        // and bindings give an upper bound (they count a loaded depth attachment as written, as
+        // the mask pass's is not): wherever debug assertions are on, so in every test render
+        // that culls, the plan must keep no pass outside it. That the plan keeps enough is the
+        // test that renders every target of every canonical scene culled and compares it with
+        // the whole frame's, bit for bit (harness/tests/integration/renderer.rs).
+        let needed = plan.passes_needed_for(wanted.targets);
+        let keep: Vec<bool> = owners
+            .iter()
+            .map(|owner| {
+                let index = plan.passes.iter().position(|p| p.id == *owner);
+                index.is_some_and(|i| needed[i])
+            })
+            .collect();
+        if cfg!(debug_assertions) {
+            let targets: Vec<Handle<Texture>> =
+                wanted.targets.iter().map(|id| frame.target(*id)).collect();
+            let recorded = cull::needed(&passes, &targets);
+            let extra: Vec<PassId> = owners
+                .iter()
+                .zip(keep.iter().zip(&recorded))
+                .filter_map(|(owner, (&plan, &recorded))| (plan && !recorded).then_some(*owner))
+                .collect();
+            debug_assert!(
+                extra.is_empty(),
+                "scene `{}`: for {:?}, the plan keeps {extra:?}, which the recorded passes do \
+                 not need",
+                scene.name,
+                wanted.targets
+            );
+        }
         let mut kept = keep.iter().copied();
         passes.retain(|_| kept.next().unwrap_or(false));
         let mut kept = keep.iter().copied();
