@@ -109,7 +109,8 @@ pub(super) fn parse_mtl_file(
 pub(super) fn parse_mtl_bytes(path: &Path, bytes: &[u8]) -> Result<ParsedMtl, AssetError> {
     let dir = path.parent().unwrap_or(Path::new(""));
     let mut materials = Vec::new();
-    let mut warnings = Vec::new();
+    let (bytes, encoding) = super::text::utf8_bytes(path, bytes);
+    let mut warnings: Vec<String> = encoding.into_iter().collect();
     let mut current: Option<ParsedMaterial> = None;
     let mut text = LossyLines::default();
     // Logged at debug level only: callers report the returned list (see `obj::warn`).
@@ -132,15 +133,18 @@ pub(super) fn parse_mtl_bytes(path: &Path, bytes: &[u8]) -> Result<ParsedMtl, As
         };
         let lkey = key.to_ascii_lowercase();
         if lkey == "newmtl" {
-            if rest.is_empty() {
-                return Err(AssetError::parse(
-                    path,
-                    lineno,
-                    "newmtl without a material name",
-                ));
-            }
             if let Some(done) = current.take() {
                 materials.push(done);
+            }
+            if rest.is_empty() {
+                // No `usemtl` can name it: its block is read and dropped (as a nameless
+                // `usemtl`, whose faces get the default material, only warns).
+                warn(format!(
+                    "{}:{lineno}: `newmtl` without a name; its block is ignored",
+                    path.display()
+                ));
+                current = Some(ParsedMaterial::default());
+                continue;
             }
             current = Some(ParsedMaterial {
                 name: rest.to_string(),
@@ -231,6 +235,8 @@ pub(super) fn parse_mtl_bytes(path: &Path, bytes: &[u8]) -> Result<ParsedMtl, As
     if let Some(done) = current.take() {
         materials.push(done);
     }
+    // Nameless blocks were read for their syntax only.
+    materials.retain(|m| !m.name.is_empty());
     if let Some(warning) = text.warning(path) {
         warn(warning);
     }

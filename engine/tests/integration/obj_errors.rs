@@ -298,3 +298,56 @@ fn random_garbage_never_panics() {
         let _ = engine::assets::load_obj(&path, &mut engine::assets::TextureCache::new());
     }
 }
+
+/// A `newmtl` without a name (assimp's `empty_mat.obj` has one) warns, naming the file and line,
+/// and its block is dropped unread (its missing texture is never loaded); the named material
+/// after it loads, and faces without a material take the default.
+#[test]
+fn a_nameless_newmtl_warns_and_its_block_is_ignored() {
+    let model = load("empty_mat.obj").unwrap();
+    assert!(
+        model
+            .warnings
+            .iter()
+            .any(|w| w.contains("empty_mat.mtl:2: `newmtl` without a name; its block is ignored")),
+        "{:?}",
+        model.warnings
+    );
+    assert_eq!(model.materials.len(), 1, "{:?}", model.materials);
+    assert_eq!(model.materials[0].name, "red");
+    assert_eq!(model.materials[0].diffuse, Some([0.8, 0.1, 0.1]));
+    let materials: Vec<Option<usize>> = model.meshes.iter().map(|m| m.material).collect();
+    assert!(
+        materials.contains(&Some(0)) && materials.contains(&None),
+        "{materials:?}"
+    );
+}
+
+/// OBJ files in UTF-16 with a byte-order mark (assimp's `box_UTF16BE.obj` is one) are decoded,
+/// with a warning naming the file and the encoding, and load like their UTF-8 original.
+#[test]
+fn utf16_obj_files_with_a_byte_order_mark_are_decoded() {
+    let original = load("cube.obj").unwrap();
+    for (name, encoding) in [
+        ("box_utf16be.obj", "UTF-16 BE"),
+        ("box_utf16le.obj", "UTF-16 LE"),
+    ] {
+        let model = load(name).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(
+            model
+                .warnings
+                .iter()
+                .any(|w| w.contains(&format!("{name}: {encoding} text")) && w.contains("decoded")),
+            "{name}: {:?}",
+            model.warnings
+        );
+        let triangles = |m: &engine::assets::Model| -> usize {
+            m.meshes.iter().map(|mesh| mesh.indices.len() / 3).sum()
+        };
+        assert_eq!(triangles(&model), triangles(&original), "{name}");
+        assert_eq!(
+            model.meshes[0].vertices, original.meshes[0].vertices,
+            "{name}: the decoded cube differs from the UTF-8 one"
+        );
+    }
+}

@@ -104,6 +104,7 @@ impl MaterialMaps {
 /// and builds render-ready meshes with normals and MikkTSpace tangents.
 pub fn load_obj(path: &Path, textures: &mut TextureCache) -> Result<Model, AssetError> {
     let bytes = std::fs::read(path).map_err(|e| AssetError::io(path, e))?;
+    let (bytes, encoding) = super::text::utf8_bytes(path, &bytes);
     let scan = prescan(path, &bytes)?;
     // Limits from the pre-scan's counts, before tobj parses anything: positions, and the
     // vertices (48 bytes) and indices one triangle per face would take after single-indexing.
@@ -112,7 +113,8 @@ pub fn load_obj(path: &Path, textures: &mut TextureCache) -> Result<Model, Asset
     textures
         .budget()
         .reserve(path, (scan.faces as u64).saturating_mul(3 * vertex_bytes))?;
-    let mut warnings = scan.warnings.clone();
+    let mut warnings: Vec<String> = encoding.into_iter().collect();
+    warnings.extend(scan.warnings.iter().cloned());
     if scan.faces == 0 {
         return Err(AssetError::NoGeometry {
             path: path.to_path_buf(),
