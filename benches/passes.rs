@@ -20,14 +20,14 @@ use engine::renderer::PreparedFrame;
 use engine::scene::Scene;
 use harness::measure::bench::Floors;
 
-/// GPU time of plan pass `pass` (every pass when `None`) in one render of `scene` (wall time
+/// GPU time of plan pass `pass` (every pass when `None`) in one render of `frame` (wall time
 /// of the render when the backend has no timestamps).
 fn timed_render(
     backend: &mut dyn Backend,
-    scene: &PreparedFrame,
+    frame: &PreparedFrame,
     pass: Option<PassId>,
 ) -> Duration {
-    harness::measure::bench::timed_render(backend, scene, |timings| match pass {
+    harness::measure::bench::timed_render(backend, frame, |timings| match pass {
         Some(pass) => timings.pass_time(pass),
         None => timings.total(),
     })

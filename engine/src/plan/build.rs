@@ -1,6 +1,8 @@
 //! [`RenderPlan::new`], stage by stage: the screen-sized targets, each shadowed light's maps and
-//! passes, geometry and shader mask, the environment's passes, one lighting pass per model, the
-//! shadow-term debug outputs, then tone mapping and gizmos.
+//! passes, geometry and shader mask, the ambient occlusion (with `[quality.ssao]`), the
+//! environment's passes, one lighting pass per model (or the light buffer's clear when there is
+//! neither a model nor an environment), the shadow-term debug outputs, then tone mapping and
+//! gizmos.
 
 use crate::backend::TextureFormat;
 use crate::scene::{Light, LightingModel, Scene, ShadowFilter, ShadowSettings, SsaoSettings};
@@ -32,7 +34,9 @@ impl RenderPlan {
         let mut passes = shadow_passes;
         passes.push(geometry_pass(scene, &gbuffer));
         passes.push(mask_pass(&models, &masks));
-        let occlusion = scene.quality.ssao.filter(|_| !models.is_empty());
+        // Only a lit model's pass reads the occlusion.
+        let lit = models.iter().any(|&m| m != LightingModel::Unlit);
+        let occlusion = scene.quality.ssao.filter(|_| lit);
         if let Some(settings) = occlusion {
             let (target, pass) = ambient_occlusion(scene, settings);
             targets.push(target);

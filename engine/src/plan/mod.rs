@@ -4,7 +4,8 @@
 //!
 //! What is left out, and when: no shader-mask channel for a lighting model no object uses (and a
 //! second mask target only past four models), no lighting pass for an unused model, no skybox
-//! or IBL precompute without an environment, no gizmos unless the quality settings ask for them.
+//! or IBL precompute without an environment, no ambient occlusion without `[quality.ssao]` (or
+//! without a lit model to read it), no gizmos unless the quality settings ask for them.
 //!
 //! Built stage by stage in `build`; the lighting draws and their shader variants are in
 //! `lighting`, the typed identities of targets and passes (and their names) in `ids`, the plan's

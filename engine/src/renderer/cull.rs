@@ -8,8 +8,9 @@
 //! reads every texture its draws bind and every attachment it loads rather than clears (the
 //! shader mask tests against the geometry pass's depth, the lighting passes add into the light
 //! buffer). Walking back from the wanted targets, a pass is kept when it writes a target still
-//! needed, and then what it reads is needed too. Every earlier writer of a needed target is kept (also where a later
-//! one clears it), so the kept passes leave the wanted targets exactly as the whole frame would.
+//! needed, and then what it reads is needed too. Every earlier writer of a needed target is
+//! kept (also where a later one clears it), so the kept passes leave the wanted targets exactly
+//! as the whole frame would.
 
 use crate::backend::{BindingResource, Handle, LoadOp, RenderPass, Texture};
 

@@ -1,8 +1,9 @@
-//! The deferred renderer: executes a [`RenderPlan`] for a [`Scene`] on any [`Backend`] and reads
-//! back the pass outputs by name.
+//! The deferred renderer: executes the [`RenderPlan`] of a [`PreparedFrame`] on any [`Backend`]
+//! and reads back the pass outputs by [`TargetId`].
 //!
-//! One call to [`render`] uploads the scene, records every pass of the plan, submits them at
-//! once, reads back what was asked for and destroys everything it created. There is no state
+//! One call to [`render_prepared`] (or [`render`], which prepares the frame first) uploads the
+//! scene, records the plan's passes in order, submits them at once, reads back what was asked
+//! for and destroys everything it created. There is no state
 //! between calls: the same scene on the same driver gives the same images, bit for bit.
 //!
 //! Precision: positions never reach the GPU in absolute world coordinates. Object, light and
@@ -83,10 +84,16 @@ pub enum RenderError {
     },
     /// A shader's reflection (its bindings) could not be read: a shader that does not parse,
     /// or a binding looked up under a name the shader does not declare.
-    #[error(transparent)]
-    Shader(#[from] crate::shaders::ShaderError),
+    #[error("scene `{scene}`: {source}")]
+    Shader {
+        /// Scene name.
+        scene: String,
+        /// What naga said.
+        #[source]
+        source: crate::shaders::ShaderError,
+    },
     /// A readback asked for a target the plan does not have.
-    #[error("scene `{scene}` has no pass output `{name}` (it has: {available})")]
+    #[error("scene `{scene}` has no pass output `{name}` (its outputs: {available})")]
     UnknownOutput {
         /// Scene name.
         scene: String,
@@ -95,6 +102,17 @@ pub enum RenderError {
         /// Names that exist.
         available: String,
     },
+}
+
+impl From<crate::shaders::ShaderError> for RenderError {
+    /// A shader's reflection failed inside a render; [`render_prepared`] fills in the scene's
+    /// name.
+    fn from(source: crate::shaders::ShaderError) -> Self {
+        RenderError::Shader {
+            scene: String::new(),
+            source,
+        }
+    }
 }
 
 impl From<BackendError> for RenderError {
@@ -221,7 +239,8 @@ impl PreparedFrame {
         &self.scene
     }
 
-    /// This frame with `scene`, a variation of its scene as drawn (a light, a material, the
+    /// This frame with `scene`, a variation of its scene as drawn, and no variations of its own
+    /// (set them again with [`PreparedFrame::with_variations`]) (a light, a material, the
     /// camera, a shadow setting changed: what the mutation self-test and the benches vary),
     /// validated and planned again. The IBL maps are kept, so the variation must keep the
     /// environment and the IBL settings as they are (an extracted sun's light follows both);
@@ -301,6 +320,10 @@ pub fn render_prepared(
     scope.destroy(backend);
     let (outputs, timings) = result.map_err(|e| match e {
         RenderError::Backend { source, .. } => RenderError::Backend {
+            scene: scene.name.clone(),
+            source,
+        },
+        RenderError::Shader { source, .. } => RenderError::Shader {
             scene: scene.name.clone(),
             source,
         },

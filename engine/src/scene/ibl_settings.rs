@@ -33,7 +33,7 @@ pub struct IblSettings {
     /// `source_size`); levels go down to 4 x 4.
     pub specular_size: u32,
     /// GGX samples per texel of level 1; each level after it takes four times more (see
-    /// [`specular::samples_at`]).
+    /// [`samples_at`](crate::ibl::specular::samples_at)).
     pub specular_samples: u32,
     /// Face size of the irradiance cube.
     pub irradiance_size: u32,
@@ -51,7 +51,7 @@ pub struct IblSettings {
     /// changes no precomputed map.
     pub runtime_samples: u32,
     /// Cut the environment's sun out of the maps and light it as a directional light instead
-    /// ([`sun`]).
+    /// ([`crate::ibl::sun`]).
     pub extract_sun: bool,
     /// Whether the extracted sun casts a shadow (with the default [`ShadowSettings`]). It
     /// changes no precomputed map.

@@ -1,11 +1,11 @@
 //! `harness bench`: GPU timings of every pass against its floor, scaling series, and the
 //! breakdown of the lighting passes, kept for the check report.
 
-use harness::measure::bench::Series;
 use std::path::Path;
 use std::process::ExitCode;
 
 use engine::backend::BackendKind;
+use harness::measure::bench::Series;
 
 use super::scenes_or_canonical;
 
@@ -76,8 +76,6 @@ pub(crate) fn pass_table(
     })
 }
 
-/// `harness bench --series`: the scaling series named (`all` for every one) on each backend
-/// asked for (gl by default), kept as bench_series.json in `out`.
 /// `--series`: a scaling series, or all of them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum SeriesArg {
@@ -106,6 +104,8 @@ impl SeriesArg {
     }
 }
 
+/// `harness bench --series`: the scaling series named (`all` for every one) on each backend
+/// asked for (gl by default), kept as bench_series.json in `out`.
 pub(crate) fn series(
     chosen: &[SeriesArg],
     backends: &[BackendKind],

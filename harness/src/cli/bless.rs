@@ -27,11 +27,11 @@ pub(crate) fn run(
     let mut backend = engine::backend::create(kind)?;
     let driver = harness::golden::fingerprint(backend.info());
     for case in &cases {
-        // Names given on the command line, as the case's golden passes.
+        // Names given on the command line (an edge), as the case's golden passes.
         let mut named: Vec<TargetId> = Vec::new();
         for name in passes {
-            match case.passes.iter().find(|p| p.to_string() == *name) {
-                Some(&pass) => named.push(pass),
+            match name.parse().ok().filter(|p| case.passes.contains(p)) {
+                Some(pass) => named.push(pass),
                 None => anyhow::bail!(
                     "scene {} has no golden pass `{name}` (it has: {})",
                     case.name(),
@@ -39,11 +39,13 @@ pub(crate) fn run(
                 ),
             }
         }
-        let wanted: Vec<TargetId> = if named.is_empty() {
-            case.passes.clone()
-        } else {
-            named.clone()
-        };
+        // In the case's order, each once.
+        let wanted: Vec<TargetId> = case
+            .passes
+            .iter()
+            .copied()
+            .filter(|p| named.is_empty() || named.contains(p))
+            .collect();
         eprintln!("rendering {} on {kind} ...", case.name());
         let frame = engine::renderer::render_prepared(
             backend.as_mut(),

@@ -95,7 +95,7 @@ fn note_borrowed_limits(cases: &[Case]) {
 /// images are and the bless commands.
 fn print_table(run: &CheckRun, report: &Path, failures: &Path) {
     println!(
-        "{:<8} {:<17} {:<12} {:<8} worst metric",
+        "{:<8} {:<17} {:<12} {:<12} worst metric",
         "scene", "pass", "backend", "result"
     );
     for r in &run.results {
@@ -118,7 +118,7 @@ fn print_table(run: &CheckRun, report: &Path, failures: &Path) {
             harness::golden::Outcome::Incomparable(why) => why.clone(),
         };
         println!(
-            "{:<8} {:<17} {:<12} {:<8} {worst}",
+            "{:<8} {:<17} {:<12} {:<12} {worst}",
             r.scene,
             r.pass,
             r.backend,
@@ -127,13 +127,13 @@ fn print_table(run: &CheckRun, report: &Path, failures: &Path) {
     }
     for (scene, backend, error) in &run.render_errors {
         println!(
-            "{scene:<8} {:<17} {backend:<12} FAILED   render: {error}",
+            "{scene:<8} {:<17} {backend:<12} FAILED       render: {error}",
             "-"
         );
     }
     for b in &run.load_errors {
         println!(
-            "{:<8} {:<17} {:<12} FAILED   load: {}",
+            "{:<8} {:<17} {:<12} FAILED       load: {}",
             b.scene, "-", "-", b.error
         );
     }

@@ -32,7 +32,14 @@ pub(crate) fn run(
             .iter()
             .map(|name| plan.target_named(name))
             .collect::<Result<_, _>>()
-            .map_err(|e| anyhow::anyhow!("{e}, or `all`"))?
+            .map_err(|e| {
+                anyhow::anyhow!(
+                    "scene `{}` has no pass output `{}` (its outputs: {}, or `all`)",
+                    e.scene,
+                    e.name,
+                    e.available
+                )
+            })?
     };
     let mut backend = engine::backend::create(kind)?;
     eprintln!(

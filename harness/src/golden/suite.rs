@@ -122,7 +122,7 @@ impl Case {
         let mut rules = BTreeMap::new();
         let mut limit_sources = BTreeMap::new();
         for (name, value) in &loaded.tolerances {
-            let Some(pass) = passes.iter().copied().find(|p| p.to_string() == *name) else {
+            let Some(pass) = name.parse().ok().filter(|p| passes.contains(p)) else {
                 return Err(SuiteError::UnknownPass {
                     path: loaded.path.clone(),
                     pass: name.clone(),
@@ -206,7 +206,10 @@ impl Case {
 
     /// Renders the golden passes on a new backend of this kind.
     pub fn render(&self, kind: BackendKind) -> Result<Frame, RenderError> {
-        let mut backend = backend::create(kind)?;
+        let mut backend = backend::create(kind).map_err(|source| RenderError::Backend {
+            scene: self.name().to_owned(),
+            source,
+        })?;
         self.render_on(backend.as_mut())
     }
 

@@ -35,7 +35,9 @@ pub struct OcclusionError {
 }
 
 /// Compares `frame`'s occlusion of `scene` (a [`crate::test_scenes::corner`]) with the
-/// references, over the floor pixels at least one kernel radius inside the image's edges.
+/// references, over the floor pixels more than an eighth of the image from its edges (kernel
+/// points that project off screen count as unoccluded on the GPU and are counted here: the
+/// margin keeps most of them out).
 pub fn corner_error(
     scene: &Scene,
     frame: &Frame,

@@ -32,7 +32,7 @@ fn a_broken_scene_is_one_failed_case_and_the_others_are_checked() {
     assert_eq!(output.status.code(), Some(1), "{stdout}\n{stderr}");
     let load_lines: Vec<&str> = stdout
         .lines()
-        .filter(|l| l.contains("FAILED   load:"))
+        .filter(|l| l.contains("FAILED") && l.contains(" load: "))
         .collect();
     assert_eq!(load_lines.len(), 1, "{stdout}");
     assert!(

@@ -90,7 +90,8 @@ impl Mutation {
 
     /// The golden pass where the change first shows, and so must be caught: lighting changes in
     /// the light buffer, material changes in the G-buffer target that holds them, geometry in
-    /// depth, the lighting model in the mask, tone mapping in the final image.
+    /// depth, the lighting model in the mask, tone mapping in the final image, the occlusion's
+    /// radius in the occlusion.
     pub fn origin(self) -> TargetId {
         match self {
             Mutation::LightIntensity

@@ -238,7 +238,11 @@ fn recorded_noise(case: &Case, model: &NoiseModel, noise: &mut Vec<NoiseResult>)
     };
     for (name, checks) in passes {
         // The file's keys are names; one the case has no golden pass for is not its noise.
-        let Some((&pass, rule)) = case.rules.iter().find(|(p, _)| p.to_string() == *name) else {
+        let Some((pass, rule)) = name
+            .parse::<TargetId>()
+            .ok()
+            .and_then(|pass| Some((pass, case.rules.get(&pass)?)))
+        else {
             continue;
         };
         for (metric, limit) in rule.checks() {
