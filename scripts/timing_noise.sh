@@ -4,21 +4,23 @@
 # a table per scene, backend and pass (docs/2026-11-25-timing-noise.md was made with N = 8).
 # Nothing else should run meanwhile. Needs python3.
 #
-#   scripts/timing_noise.sh [N]     (default 8; about 4 minutes at 8 on a 2-core machine)
+#   scripts/timing_noise.sh [N] [FRAMES]   (default 8 runs of 5 frames; about 4 minutes at 8 on
+#                                           a 2-core machine, 4 times that at 21 frames)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 n=${1:-8}
+frames=${2:-5}
 dir=$(mktemp -d)
 cargo build -q -p harness --bin harness
 bin=target/debug/harness
-for i in $(seq "$n"); do "$bin" bench --json --out "$dir/out" > "$dir/quiet_$i.json" 2>/dev/null; done
+for i in $(seq "$n"); do "$bin" bench --frames "$frames" --json --out "$dir/out" > "$dir/quiet_$i.json" 2>/dev/null; done
 for i in $(seq "$n"); do
   yes > /dev/null & busy=$!
-  "$bin" bench --json --out "$dir/out" > "$dir/busy_$i.json" 2>/dev/null
+  "$bin" bench --frames "$frames" --json --out "$dir/out" > "$dir/busy_$i.json" 2>/dev/null
   kill "$busy"
 done
 for i in $(seq $(( (n + 1) / 2 ))); do
-  LP_NUM_THREADS=1 "$bin" bench --json --out "$dir/out" > "$dir/threads1_$i.json" 2>/dev/null
+  LP_NUM_THREADS=1 "$bin" bench --frames "$frames" --json --out "$dir/out" > "$dir/threads1_$i.json" 2>/dev/null
 done
 python3 - "$dir" <<'PY'
 import glob, json, statistics, sys

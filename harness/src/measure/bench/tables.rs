@@ -39,7 +39,7 @@ pub fn table(bench: &SceneBench) -> String {
     let ms = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.2}"));
     let ratio = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.1}x"));
     let mut out = format!(
-        "{} on {} ({}x{}, median of {} frames, GPU ms)\n{:<22} {:>9} {:>9} {:>8} {:>12} {:>8}\n",
+        "{} on {} ({}x{}, {} frames: median GPU ms; ratio: lower quartile of per-frame pass / floor)\n{:<22} {:>9} {:>9} {:>8} {:>12} {:>8}\n",
         bench.scene,
         bench.backend,
         bench.width,

@@ -20,8 +20,11 @@ pub struct PassBench {
     pub median_ms: Option<f64>,
     /// Median GPU time of its floor, ms.
     pub floor_ms: Option<f64>,
-    /// `median_ms / floor_ms`.
+    /// The pass's time over its floor's, per frame (the floor submitted right after that
+    /// frame), at the lower quartile over frames.
     pub ratio: Option<f64>,
+    /// Those per-frame ratios, in frame order.
+    pub frame_ratios: Vec<f64>,
     /// Lighting passes: median GPU time of the pass reading its inputs and shading nothing, ms.
     pub input_floor_ms: Option<f64>,
     /// `median_ms / input_floor_ms`.
@@ -131,7 +134,72 @@ pub(super) fn median_frame_ms(timings: &[PassTimes]) -> Option<f64> {
     )
 }
 
-/// Times `scene` on `kind`: one warm-up frame, then `frames` frames, each pass and its floor.
+/// The quantile of a pass's per-frame ratios [`PassBench::ratio`] reports: the lower quartile,
+/// as the breakdown's parts (llvmpipe's frame times of a short pass fall in a fast and a slow
+/// cluster; a low quantile measures the work, a median jumps between the clusters).
+const RATIO_PERCENTILE: f64 = 0.25;
+
+/// Frames timed with each pass's floor right after the frame (see [`time_interleaved`]).
+struct Interleaved {
+    /// Each frame's pass times.
+    timings: Vec<PassTimes>,
+    /// Each frame's wall ms.
+    wall: Vec<f64>,
+    /// Each pass's floor ms, a value per frame.
+    floors: std::collections::BTreeMap<PassId, Vec<f64>>,
+    /// Each pass's time over its floor's, a value per frame.
+    ratios: std::collections::BTreeMap<PassId, Vec<f64>>,
+}
+
+/// Renders `prepared` once to warm up (and submits every floor once), then `frames` times,
+/// each frame followed by one submit of every pass's floor: each frame's ratios are of times
+/// taken moments apart, so a change of the machine's speed between frames (a busy neighbour, a
+/// frequency step) falls on the pass and its floor alike.
+fn time_interleaved(
+    backend: &mut dyn Backend,
+    prepared: &PreparedFrame,
+    floors: &Floors,
+    frames: usize,
+) -> Result<Interleaved, BenchError> {
+    let kind = backend.kind();
+    let floor_error = |e: backend::BackendError| BenchError::Backend {
+        backend: kind,
+        message: e.to_string(),
+    };
+    let mut out = Interleaved {
+        timings: Vec::with_capacity(frames),
+        wall: Vec::with_capacity(frames),
+        floors: Default::default(),
+        ratios: Default::default(),
+    };
+    for round in 0..=frames {
+        let (times, ms) = time_frame(backend, prepared)?;
+        for spec in &prepared.plan().passes {
+            let floor = floors.time(backend, spec.id).map_err(floor_error)?;
+            if round == 0 {
+                continue;
+            }
+            let Some(floor_ns) = floor else {
+                continue;
+            };
+            out.floors.entry(spec.id).or_default().push(floor_ns / 1e6);
+            if let Some(pass_ns) = times.pass_time(spec.id) {
+                out.ratios
+                    .entry(spec.id)
+                    .or_default()
+                    .push(pass_ns / floor_ns);
+            }
+        }
+        if round > 0 {
+            out.wall.push(ms);
+            out.timings.push(times);
+        }
+    }
+    Ok(out)
+}
+
+/// Times `scene` on `kind`: one warm-up frame, then `frames` frames, each followed by every
+/// pass's floor.
 pub fn bench_scene(
     scene: &Scene,
     kind: BackendKind,
@@ -149,7 +217,15 @@ pub fn bench_scene(
         message: e.to_string(),
     })?;
     let plan = prepared.plan();
-    let (timings, wall) = time_frames(backend.as_mut(), &prepared, frames)?;
+    let floors = Floors::new(backend.as_mut(), plan).map_err(backend_error)?;
+    let interleaved = time_interleaved(backend.as_mut(), &prepared, &floors, frames);
+    floors.destroy(backend.as_mut());
+    let Interleaved {
+        timings,
+        wall,
+        floors: floor_times,
+        ratios,
+    } = interleaved?;
     let has_lighting = plan
         .passes
         .iter()
@@ -163,38 +239,25 @@ pub fn bench_scene(
     } else {
         Vec::new()
     };
-    let floors = Floors::new(backend.as_mut(), plan).map_err(backend_error)?;
     let mut passes = Vec::with_capacity(plan.passes.len());
-    let mut floor_result = Ok(());
     for spec in &plan.passes {
         let median_ms = median_pass_ms(&timings, spec.id);
-        let mut floor_times = Vec::with_capacity(frames);
-        for _ in 0..=frames {
-            match floors.time(backend.as_mut(), spec.id) {
-                Ok(Some(ns)) => floor_times.push(ns / 1e6),
-                Ok(None) => {}
-                Err(e) => floor_result = Err(e),
-            }
-        }
-        // The first floor submit is the warm-up.
-        if !floor_times.is_empty() {
-            floor_times.remove(0);
-        }
-        let floor_ms = median(floor_times);
+        let floor_ms = floor_times.get(&spec.id).and_then(|t| median(t.clone()));
         let input_floor_ms = matches!(spec.id, PassId::Lighting(_))
             .then(|| median_pass_ms(&input_floor_timings, spec.id))
             .flatten();
+        let frame_ratios = ratios.get(&spec.id).cloned().unwrap_or_default();
+        let ratio = percentile(frame_ratios.clone(), RATIO_PERCENTILE);
         passes.push(PassBench {
             pass: spec.id,
             median_ms,
             floor_ms,
-            ratio: median_ms.zip(floor_ms).map(|(p, f)| p / f),
+            ratio,
+            frame_ratios,
             input_floor_ms,
             input_ratio: median_ms.zip(input_floor_ms).map(|(p, f)| p / f),
         });
     }
-    floors.destroy(backend.as_mut());
-    floor_result.map_err(backend_error)?;
     let frame_ms = median_frame_ms(&timings);
     let gbuffer_floor_ms = passes
         .iter()
