@@ -178,6 +178,13 @@ enum Command {
         /// variant with --breakdown].
         #[arg(long)]
         frames: Option<usize>,
+        /// Submit this pass's render passes --repeat-times times in every frame timed: how a
+        /// pass that many times slower shows in the ratios (its pixels are not the point).
+        #[arg(long, conflicts_with_all = ["series", "breakdown"])]
+        repeat_pass: Option<String>,
+        /// How many times --repeat-pass submits its pass.
+        #[arg(long, default_value_t = 2, requires = "repeat_pass")]
+        repeat_times: u32,
         /// Instead of the scenes, a scaling series: resolution, lights, triangles, shadow-map,
         /// or all (repeatable).
         #[arg(long = "series", value_enum)]
@@ -285,6 +292,8 @@ fn main() -> ExitCode {
             scenes,
             backends,
             frames,
+            repeat_pass,
+            repeat_times,
             series,
             breakdown,
             out,
@@ -295,7 +304,17 @@ fn main() -> ExitCode {
                 cli::bench::breakdown(&scenes, &backends, frames, json)
             } else if series.is_empty() {
                 let frames = frames.unwrap_or(harness::measure::bench::BENCH_FRAMES);
-                cli::bench::pass_table(&scenes, &backends, frames, &out, json)
+                let repeat = match repeat_pass {
+                    Some(name) => match name.parse::<engine::plan::PassId>() {
+                        Ok(pass) => Some((pass, repeat_times)),
+                        Err(e) => {
+                            eprintln!("error: --repeat-pass: {e}");
+                            return ExitCode::from(2);
+                        }
+                    },
+                    None => None,
+                };
+                cli::bench::pass_table(&scenes, &backends, frames, repeat, &out, json)
             } else {
                 let frames = frames.unwrap_or(harness::measure::bench::BENCH_FRAMES);
                 cli::bench::series(&series, &backends, frames, &out, json)

@@ -427,6 +427,18 @@ fn record_and_submit(
         let mut kept = keep.iter().copied();
         owners.retain(|_| kept.next().unwrap_or(false));
     }
+    if let Some((repeated, times)) = prepared.variations.repeat_pass {
+        let mut slowed = Vec::with_capacity(passes.len());
+        let mut slowed_owners = Vec::with_capacity(owners.len());
+        for (pass, owner) in passes.into_iter().zip(owners) {
+            let copies = if owner == repeated { times.max(1) } else { 1 };
+            for _ in 0..copies {
+                slowed.push(pass.clone());
+                slowed_owners.push(owner);
+            }
+        }
+        (passes, owners) = (slowed, slowed_owners);
+    }
     let timings = backend.submit(&passes)?;
     let mut outputs = BTreeMap::new();
     for &id in wanted.targets {

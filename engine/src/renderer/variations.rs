@@ -5,7 +5,7 @@
 //! [`PreparedFrame::with_variations`](super::PreparedFrame::with_variations), never through the
 //! renderer's main signatures.
 
-use crate::plan::LightingFeature;
+use crate::plan::{LightingFeature, PassId};
 
 /// What a frame does differently from its scene. All off by default.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -21,4 +21,9 @@ pub struct Variations {
     /// Fault: the light uniforms carry each light's radiance times this, a fault in the uniform
     /// packing that only a reference deriving the lights from the scene itself catches.
     pub light_radiance_scale: Option<f32>,
+    /// Speed: the render passes of this plan pass are submitted this many times in a row
+    /// (`harness bench --repeat-pass`): a slowdown of about that factor in that pass alone, to
+    /// see how a slower pass shows. A pass that adds into its target adds more than once: its
+    /// pixels are not the point.
+    pub repeat_pass: Option<(PassId, u32)>,
 }

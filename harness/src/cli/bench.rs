@@ -16,9 +16,14 @@ pub(crate) fn pass_table(
     scenes: &[String],
     backends: &[BackendKind],
     frames: usize,
+    repeat: Option<(engine::plan::PassId, u32)>,
     out: &Path,
     json: bool,
 ) -> anyhow::Result<ExitCode> {
+    let variations = engine::renderer::Variations {
+        repeat_pass: repeat,
+        ..Default::default()
+    };
     let names = scenes_or_canonical(scenes);
     let loaded = names
         .iter()
@@ -41,7 +46,7 @@ pub(crate) fn pass_table(
         }
         for scene in &loaded {
             eprintln!("timing {} on {kind} ({frames} frames) ...", scene.name);
-            match harness::measure::bench::bench_scene(scene, kind, frames) {
+            match harness::measure::bench::bench_scene_with(scene, kind, frames, variations) {
                 Ok(result) => {
                     if !json {
                         println!("{}", harness::measure::bench::table(&result));

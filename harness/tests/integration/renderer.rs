@@ -520,3 +520,37 @@ fn culled_renders_give_the_whole_frame_s_targets() {
         }
     }
 }
+
+/// The speed hook `Variations::repeat_pass` submits one plan pass's render passes that many
+/// times in a row (what `harness bench --repeat-pass` times), and no other pass more than once.
+#[test]
+fn a_repeated_pass_is_submitted_that_many_times_and_no_other() {
+    let scene = test_scenes::five_models(64);
+    let Some(&kind) = common::available_backends().first() else {
+        return;
+    };
+    let mut backend = engine::backend::create(kind).unwrap();
+    let plain = PreparedFrame::new(&scene).unwrap();
+    let repeated = plain.clone().with_variations(renderer::Variations {
+        repeat_pass: Some((PassId::ToneMap, 3)),
+        ..Default::default()
+    });
+    let count =
+        |frame: &Frame, pass: PassId| frame.timings.owners.iter().filter(|o| **o == pass).count();
+    let a = renderer::render_prepared(backend.as_mut(), &plain, Readback::All).unwrap();
+    let b = renderer::render_prepared(backend.as_mut(), &repeated, Readback::All).unwrap();
+    assert_eq!(
+        (count(&a, PassId::ToneMap), count(&b, PassId::ToneMap)),
+        (1, 3)
+    );
+    for spec in &a.plan.passes {
+        if spec.id != PassId::ToneMap {
+            assert_eq!(count(&a, spec.id), count(&b, spec.id), "{}", spec.id);
+        }
+    }
+    // Tone mapping clears and redraws its target: repeating it leaves the image as it was.
+    assert!(bitwise_equal(
+        &a.outputs[&TargetId::Final],
+        &b.outputs[&TargetId::Final]
+    ));
+}

@@ -34,7 +34,7 @@ pub use precompute::{precompute, Precompute};
 pub use report::{report_sections, series_svg, BENCH_JSON, SERIES_JSON};
 pub use series::{series, Series, SeriesPoint};
 pub use tables::{breakdown_table, series_table, table};
-pub use timing::{bench_scene, timed_render, PassBench, SceneBench};
+pub use timing::{bench_scene, bench_scene_with, timed_render, PassBench, SceneBench};
 
 /// Frames timed per scene and backend by `harness bench` and its series unless told otherwise.
 pub const BENCH_FRAMES: usize = 5;

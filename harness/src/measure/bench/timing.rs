@@ -205,6 +205,17 @@ pub fn bench_scene(
     kind: BackendKind,
     frames: usize,
 ) -> Result<SceneBench, BenchError> {
+    bench_scene_with(scene, kind, frames, Variations::default())
+}
+
+/// [`bench_scene`] with `variations` applied to the frames timed (not to the input floor's):
+/// `repeat_pass` shows how a slower pass shows in the ratios.
+pub fn bench_scene_with(
+    scene: &Scene,
+    kind: BackendKind,
+    frames: usize,
+    variations: Variations,
+) -> Result<SceneBench, BenchError> {
     let backend_error = |e: backend::BackendError| BenchError::Backend {
         backend: kind,
         message: e.to_string(),
@@ -218,7 +229,8 @@ pub fn bench_scene(
     })?;
     let plan = prepared.plan();
     let floors = Floors::new(backend.as_mut(), plan).map_err(backend_error)?;
-    let interleaved = time_interleaved(backend.as_mut(), &prepared, &floors, frames);
+    let varied = prepared.clone().with_variations(variations);
+    let interleaved = time_interleaved(backend.as_mut(), &varied, &floors, frames);
     floors.destroy(backend.as_mut());
     let Interleaved {
         timings,
