@@ -1,6 +1,7 @@
 //! The layout rules a newcomer relies on: no source file over 600 lines (shaders, scripts and
 //! the review page's JS and CSS included), so each concern stays in a file that can be read in
-//! one sitting. Function length is clippy's `too_many_lines` (see clippy.toml).
+//! one sitting, and no relative link in the Markdown (README.md, docs/, ...) leads nowhere.
+//! Function length is clippy's `too_many_lines` (see clippy.toml).
 
 use std::path::{Path, PathBuf};
 
@@ -47,4 +48,53 @@ fn no_source_file_is_over_600_lines() {
         })
         .collect();
     assert!(long.is_empty(), "over {MAX_LINES} lines: {long:?}");
+}
+
+/// Every relative link in the project's Markdown (README.md, docs/, golden/, scenes/, ...)
+/// points at a file or folder that exists: a moved doc must not leave a dead link behind.
+#[test]
+fn every_relative_markdown_link_points_at_a_file() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut docs = Vec::new();
+    markdown_files(&root, &mut docs);
+    assert!(docs.iter().any(|d| d.ends_with("README.md")), "{docs:?}");
+    let mut dead = Vec::new();
+    for doc in &docs {
+        let text = std::fs::read_to_string(doc).unwrap();
+        for target in relative_links(&text) {
+            let path = target.split('#').next().unwrap_or_default();
+            if !path.is_empty() && !doc.parent().unwrap().join(path).exists() {
+                dead.push(format!("{}: {target}", doc.display()));
+            }
+        }
+    }
+    assert!(dead.is_empty(), "dead links: {dead:#?}");
+}
+
+/// The Markdown files under `dir`, build outputs and version control left out.
+fn markdown_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let entry = entry.unwrap();
+        let path = entry.path();
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if entry.file_type().unwrap().is_dir() {
+            if !SKIPPED.contains(&name.as_str()) {
+                markdown_files(&path, out);
+            }
+        } else if path.extension().is_some_and(|e| e == "md") {
+            out.push(path);
+        }
+    }
+}
+
+/// The targets of `[text](target)` links that are neither absolute URLs nor anchors.
+fn relative_links(text: &str) -> Vec<&str> {
+    text.match_indices("](")
+        .filter_map(|(at, _)| {
+            let rest = &text[at + 2..];
+            let target = &rest[..rest.find(')')?];
+            let external = target.contains("://") || target.starts_with("mailto:");
+            (!external && !target.starts_with('#') && !target.is_empty()).then_some(target)
+        })
+        .collect()
 }
