@@ -203,6 +203,13 @@ fn index(digits: &str) -> Option<usize> {
     (value.to_string() == digits).then_some(value)
 }
 
+/// The light index and the rest of a `shadow_<light>[_<tail>]` name (`tail` empty when absent).
+fn shadow_light_and_tail(name: &str) -> Option<(usize, &str)> {
+    let rest = name.strip_prefix("shadow_")?;
+    let (digits, tail) = rest.split_once('_').unwrap_or((rest, ""));
+    Some((index(digits)?, tail))
+}
+
 impl FromStr for TargetId {
     type Err = UnknownName;
 
@@ -234,9 +241,7 @@ impl FromStr for TargetId {
             })
         };
         let shadow = || {
-            let rest = name.strip_prefix("shadow_")?;
-            let (digits, tail) = rest.split_once('_').unwrap_or((rest, ""));
-            let light = index(digits)?;
+            let (light, tail) = shadow_light_and_tail(name)?;
             match tail {
                 "" => Some(TargetId::Shadow { light }),
                 "moments" => Some(TargetId::ShadowMoments { light }),
@@ -370,9 +375,7 @@ impl FromStr for PassId {
             })
         };
         let shadow = || {
-            let rest = name.strip_prefix("shadow_")?;
-            let (digits, tail) = rest.split_once('_').unwrap_or((rest, ""));
-            let light = index(digits)?;
+            let (light, tail) = shadow_light_and_tail(name)?;
             match tail {
                 "" => Some(PassId::Shadow { light }),
                 "blur_x" => Some(PassId::ShadowBlur {
