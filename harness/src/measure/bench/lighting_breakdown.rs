@@ -13,7 +13,7 @@ use engine::plan::{LightingFeature, PassId, PassSpec, RenderPlan};
 use engine::renderer::{PassTimes, PreparedFrame, Variations};
 use engine::scene::Scene;
 
-use super::timing::{percentile_pass_ms, time_frame};
+use super::timing::{percentile_pass_ms, prepare, time_frame};
 use super::BenchError;
 
 /// The percentile of each variant's frames that stands for its time: the lower quartile (see
@@ -77,11 +77,7 @@ pub fn breakdown(
         message: e.to_string(),
     })?;
     let frames = frames.max(1);
-    let prepared = PreparedFrame::new(scene).map_err(|e| BenchError::Render {
-        scene: scene.name.clone(),
-        backend: kind,
-        message: e.to_string(),
-    })?;
+    let prepared = prepare(scene, kind)?;
     let plan = prepared.plan();
     let removals = removals(prepared.scene(), plan);
     let mut timings = time_variants(backend.as_mut(), &prepared, frames, &removals, progress)?;

@@ -3,10 +3,9 @@
 
 use engine::backend::{self, BackendKind};
 use engine::plan::PassId;
-use engine::renderer::PreparedFrame;
 use engine::scene::{LightingModel, Scene};
 
-use super::timing::{median_frame_ms, median_pass_ms, time_frames};
+use super::timing::{median_frame_ms, median_pass_ms, prepare, time_frames};
 use super::BenchError;
 
 /// The PBR lighting pass, which the resolution and light series time.
@@ -138,11 +137,7 @@ pub fn series(
     let mut points = Vec::new();
     for (value, scene, pass) in settings {
         progress(&format!("{} {value}", name.name()));
-        let prepared = PreparedFrame::new(&scene).map_err(|e| BenchError::Render {
-            scene: scene.name.clone(),
-            backend: kind,
-            message: e.to_string(),
-        })?;
+        let prepared = prepare(&scene, kind)?;
         let (timings, _) = time_frames(backend.as_mut(), &prepared, frames.max(1))?;
         points.push(SeriesPoint {
             series: name,

@@ -71,6 +71,15 @@ pub fn timed_render(
     pick(&frame.timings).map_or(wall, |ns| std::time::Duration::from_nanos(ns as u64))
 }
 
+/// The scene's frame prepared for timing on `kind`, its plan error named as a render error.
+pub(super) fn prepare(scene: &Scene, kind: BackendKind) -> Result<PreparedFrame, BenchError> {
+    PreparedFrame::new(scene).map_err(|e| BenchError::Render {
+        scene: scene.name.clone(),
+        backend: kind,
+        message: e.to_string(),
+    })
+}
+
 /// Renders `prepared` once to warm up, then `frames` times: each frame's pass times and wall
 /// ms.
 pub(super) fn time_frames(
@@ -222,11 +231,7 @@ pub fn bench_scene_with(
     };
     let mut backend = backend::create(kind).map_err(backend_error)?;
     let frames = frames.max(1);
-    let prepared = PreparedFrame::new(scene).map_err(|e| BenchError::Render {
-        scene: scene.name.clone(),
-        backend: kind,
-        message: e.to_string(),
-    })?;
+    let prepared = prepare(scene, kind)?;
     let plan = prepared.plan();
     let floors = Floors::new(backend.as_mut(), plan).map_err(backend_error)?;
     let varied = prepared.clone().with_variations(variations);
