@@ -14,18 +14,20 @@ const SOURCE_EXTENSIONS: &[&str] = &["rs", "wgsl", "geom", "js", "css", "py", "s
 /// Folders the rule does not walk: build outputs and version control.
 const SKIPPED: &[&str] = &["target", ".git"];
 
-fn source_files(dir: &Path, out: &mut Vec<PathBuf>) {
+/// The files under `dir` whose extension is one of `extensions`, build outputs and version
+/// control left out.
+fn files_with_extensions(dir: &Path, extensions: &[&str], out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap() {
         let entry = entry.unwrap();
         let path = entry.path();
         let name = entry.file_name().to_string_lossy().into_owned();
         if entry.file_type().unwrap().is_dir() {
             if !SKIPPED.contains(&name.as_str()) {
-                source_files(&path, out);
+                files_with_extensions(&path, extensions, out);
             }
         } else if path
             .extension()
-            .is_some_and(|e| SOURCE_EXTENSIONS.contains(&e.to_string_lossy().as_ref()))
+            .is_some_and(|e| extensions.contains(&e.to_string_lossy().as_ref()))
         {
             out.push(path);
         }
@@ -37,7 +39,7 @@ fn no_source_file_is_over_600_lines() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut files = Vec::new();
     for dir in ["engine", "harness", "benches", "scripts", "fuzz", ".ci"] {
-        source_files(&root.join(dir), &mut files);
+        files_with_extensions(&root.join(dir), SOURCE_EXTENSIONS, &mut files);
     }
     assert!(files.len() > 100, "found only {} source files", files.len());
     let long: Vec<String> = files
@@ -56,7 +58,7 @@ fn no_source_file_is_over_600_lines() {
 fn every_relative_markdown_link_points_at_a_file() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut docs = Vec::new();
-    markdown_files(&root, &mut docs);
+    files_with_extensions(&root, &["md"], &mut docs);
     assert!(docs.iter().any(|d| d.ends_with("README.md")), "{docs:?}");
     let mut dead = Vec::new();
     for doc in &docs {
@@ -69,22 +71,6 @@ fn every_relative_markdown_link_points_at_a_file() {
         }
     }
     assert!(dead.is_empty(), "dead links: {dead:#?}");
-}
-
-/// The Markdown files under `dir`, build outputs and version control left out.
-fn markdown_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let entry = entry.unwrap();
-        let path = entry.path();
-        let name = entry.file_name().to_string_lossy().into_owned();
-        if entry.file_type().unwrap().is_dir() {
-            if !SKIPPED.contains(&name.as_str()) {
-                markdown_files(&path, out);
-            }
-        } else if path.extension().is_some_and(|e| e == "md") {
-            out.push(path);
-        }
-    }
 }
 
 /// The targets of `[text](target)` links that are neither absolute URLs nor anchors.
