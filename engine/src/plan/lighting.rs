@@ -382,6 +382,26 @@ impl RenderPlan {
             .map_or(&[], |p| &p.draws[..])
     }
 
+    /// Gives every lighting draw the generic variant (for `harness check
+    /// --debug-unspecialised-lighting`, a slowdown the speed checks must catch): both light
+    /// types picked per light, and for PBR the sun disc, clearcoat and anisotropy branched on
+    /// per pixel. The shader gives the same picture; it only does more work for it.
+    pub fn unspecialise_lighting(&mut self) {
+        for pass in &mut self.lighting {
+            if pass.model == LightingModel::Unlit {
+                continue;
+            }
+            let pbr = pass.model == LightingModel::Pbr;
+            for draw in &mut pass.draws {
+                draw.variant.directional = true;
+                draw.variant.point = true;
+                draw.variant.sun_disc = pbr;
+                draw.variant.clearcoat = pbr;
+                draw.variant.anisotropy = pbr;
+            }
+        }
+    }
+
     /// Takes `feature` out of every lighting pass (for the bench's cost breakdown): the frame
     /// then times the passes without it. A light taken out leaves its draw, with no light.
     pub fn remove_lighting_feature(&mut self, feature: LightingFeature, scene: &Scene) {

@@ -15,6 +15,7 @@ mod builders;
 mod cull;
 mod ibl;
 mod passes;
+mod recorded;
 mod resources;
 pub mod shadows;
 mod uniforms;
@@ -48,7 +49,8 @@ impl From<InvalidScene> for RenderError {
         }
     }
 }
-pub use variations::Variations;
+pub use recorded::RecordedFrame;
+pub use variations::{SlowPass, Variations};
 
 /// Why a frame could not be rendered.
 #[derive(Debug, thiserror::Error)]
@@ -230,6 +232,9 @@ impl PreparedFrame {
         if let Some(feature) = variations.remove_lighting {
             self.plan.remove_lighting_feature(feature, &self.scene);
         }
+        if variations.unspecialised_lighting {
+            self.plan.unspecialise_lighting();
+        }
         self.variations = variations;
         self
     }
@@ -318,17 +323,7 @@ pub fn render_prepared(
     let mut scope = ResourceScope::default();
     let result = record_and_submit(backend, prepared, wanted, &mut scope);
     scope.destroy(backend);
-    let (outputs, timings) = result.map_err(|e| match e {
-        RenderError::Backend { source, .. } => RenderError::Backend {
-            scene: scene.name.clone(),
-            source,
-        },
-        RenderError::Shader { source, .. } => RenderError::Shader {
-            scene: scene.name.clone(),
-            source,
-        },
-        other => other,
-    })?;
+    let (outputs, timings) = result.map_err(|e| recorded::named(&scene.name, e))?;
     Ok(Frame {
         plan: plan.clone(),
         outputs,
@@ -369,10 +364,43 @@ struct Wanted<'a> {
     cull: bool,
 }
 
-/// Records the passes of `plan` in its order (each dispatched by its [`PassId`] in
-/// [`passes::record`], one file each, over one shared [`passes::FrameContext`]), submits them at
-/// once (when `wanted` culls, only those its targets depend on) and reads back the `wanted`
-/// targets.
+/// The render passes of a frame as recorded, each with the plan pass it belongs to, and the
+/// frame's targets.
+pub(crate) struct Recorded {
+    frame: FrameResources,
+    passes: Vec<RenderPass>,
+    owners: Vec<PassId>,
+}
+
+/// Creates the frame's resources in `scope` and records the passes of its plan in its order
+/// (each dispatched by its [`PassId`] in [`passes::record`], one file each, over one shared
+/// [`passes::FrameContext`]), then applies a [`SlowPass`] variation.
+fn record(
+    backend: &mut dyn Backend,
+    prepared: &PreparedFrame,
+    scope: &mut ResourceScope,
+) -> Result<Recorded, RenderError> {
+    let (scene, plan) = (&prepared.scene, &prepared.plan);
+    let frame = FrameResources::create(backend, scope, scene, plan)?;
+    let mut ctx = passes::FrameContext::new(backend, scope, &frame, prepared);
+    for spec in &plan.passes {
+        passes::record(&mut ctx, spec.id)?;
+    }
+    let passes::Recorded { passes, owners } = std::mem::take(&mut ctx.recorded);
+    drop(ctx);
+    let (passes, owners) = match prepared.variations.slow_pass {
+        Some(slow) => recorded::slowed(plan, passes, owners, slow),
+        None => (passes, owners),
+    };
+    Ok(Recorded {
+        frame,
+        passes,
+        owners,
+    })
+}
+
+/// Records the frame ([`record`]), submits its passes at once (when `wanted` culls, only those
+/// its targets depend on) and reads back the `wanted` targets.
 fn record_and_submit(
     backend: &mut dyn Backend,
     prepared: &PreparedFrame,
@@ -380,16 +408,11 @@ fn record_and_submit(
     scope: &mut ResourceScope,
 ) -> Result<Outputs, RenderError> {
     let (scene, plan) = (&prepared.scene, &prepared.plan);
-    let frame = FrameResources::create(backend, scope, scene, plan)?;
-    let mut ctx = passes::FrameContext::new(backend, scope, &frame, prepared);
-    for spec in &plan.passes {
-        passes::record(&mut ctx, spec.id)?;
-    }
-    let passes::Recorded {
+    let Recorded {
+        frame,
         mut passes,
         mut owners,
-    } = std::mem::take(&mut ctx.recorded);
-    drop(ctx);
+    } = record(backend, prepared, scope)?;
     if wanted.cull {
         // The plan says which passes the wanted targets need. The recorded passes' attachments
         // and bindings give an upper bound (they count a loaded depth attachment as written, as
@@ -426,18 +449,6 @@ fn record_and_submit(
         passes.retain(|_| kept.next().unwrap_or(false));
         let mut kept = keep.iter().copied();
         owners.retain(|_| kept.next().unwrap_or(false));
-    }
-    if let Some((repeated, times)) = prepared.variations.repeat_pass {
-        let mut slowed = Vec::with_capacity(passes.len());
-        let mut slowed_owners = Vec::with_capacity(owners.len());
-        for (pass, owner) in passes.into_iter().zip(owners) {
-            let copies = if owner == repeated { times.max(1) } else { 1 };
-            for _ in 0..copies {
-                slowed.push(pass.clone());
-                slowed_owners.push(owner);
-            }
-        }
-        (passes, owners) = (slowed, slowed_owners);
     }
     let timings = backend.submit(&passes)?;
     let mut outputs = BTreeMap::new();

@@ -521,10 +521,10 @@ fn culled_renders_give_the_whole_frame_s_targets() {
     }
 }
 
-/// The speed hook `Variations::repeat_pass` submits one plan pass's render passes that many
-/// times in a row (what `harness bench --repeat-pass` times), and no other pass more than once.
+/// The speed hook `Variations::slow_pass` submits one plan pass's render passes that many
+/// times over (what `harness bench --slow-pass` times), and no other pass more than once.
 #[test]
-fn a_repeated_pass_is_submitted_that_many_times_and_no_other() {
+fn a_slowed_pass_is_submitted_that_many_times_and_no_other() {
     let scene = test_scenes::five_models(64);
     let Some(&kind) = common::available_backends().first() else {
         return;
@@ -532,7 +532,10 @@ fn a_repeated_pass_is_submitted_that_many_times_and_no_other() {
     let mut backend = engine::backend::create(kind).unwrap();
     let plain = PreparedFrame::new(&scene).unwrap();
     let repeated = plain.clone().with_variations(renderer::Variations {
-        repeat_pass: Some((PassId::ToneMap, 3)),
+        slow_pass: Some(renderer::SlowPass {
+            pass: PassId::ToneMap,
+            factor: 3.0,
+        }),
         ..Default::default()
     });
     let count =

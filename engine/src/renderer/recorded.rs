@@ -1,0 +1,201 @@
+//! A frame recorded once and submitted many times, whole or one plan pass at a time: what the
+//! harness's speed checks time. A pass submitted alone, right before its floor, sees the same
+//! machine state as the floor, and each sample costs that pass only, not a frame's setup and
+//! uploads.
+
+use crate::backend::*;
+use crate::plan::{PassId, RenderPlan};
+
+use super::{record, PassTimes, PreparedFrame, Recorded, RenderError, SlowPass};
+
+/// A frame's resources and render passes, kept alive between submissions. Destroy it with
+/// [`RecordedFrame::destroy`]; its resources are the backend's until then.
+pub struct RecordedFrame {
+    scene: String,
+    scope: ResourceScope,
+    passes: Vec<RenderPass>,
+    owners: Vec<PassId>,
+}
+
+impl RecordedFrame {
+    /// Uploads the frame's resources and records its passes (with its variations: a
+    /// [`SlowPass`] is in the passes recorded). Nothing is submitted yet.
+    pub fn record(
+        backend: &mut dyn Backend,
+        prepared: &PreparedFrame,
+    ) -> Result<Self, RenderError> {
+        let scene = prepared.scene().name.clone();
+        let mut scope = ResourceScope::default();
+        match record(backend, prepared, &mut scope) {
+            Ok(Recorded { passes, owners, .. }) => Ok(Self {
+                scene,
+                scope,
+                passes,
+                owners,
+            }),
+            Err(e) => {
+                scope.destroy(backend);
+                Err(named(&scene, e))
+            }
+        }
+    }
+
+    /// Submits every pass in plan order, as a render does: their times.
+    pub fn submit(&self, backend: &mut dyn Backend) -> Result<PassTimes, RenderError> {
+        let timings = backend
+            .submit(&self.passes)
+            .map_err(|e| named(&self.scene, e.into()))?;
+        Ok(PassTimes {
+            passes: timings,
+            owners: self.owners.clone(),
+        })
+    }
+
+    /// Submits plan pass `pass`'s render passes alone: its GPU ns (their sum; None when the
+    /// frame has no such pass or the backend no timestamps). Its inputs hold what the last
+    /// whole submission left in them; submit the frame once first.
+    pub fn submit_pass(
+        &self,
+        backend: &mut dyn Backend,
+        pass: PassId,
+    ) -> Result<Option<f64>, RenderError> {
+        let passes: Vec<RenderPass> = self
+            .passes
+            .iter()
+            .zip(&self.owners)
+            .filter(|(_, owner)| **owner == pass)
+            .map(|(p, _)| p.clone())
+            .collect();
+        if passes.is_empty() {
+            return Ok(None);
+        }
+        let timings = backend
+            .submit(&passes)
+            .map_err(|e| named(&self.scene, e.into()))?;
+        Ok(timings.iter().map(|t| t.gpu_ns).sum())
+    }
+
+    /// Destroys the frame's resources.
+    pub fn destroy(self, backend: &mut dyn Backend) {
+        self.scope.destroy(backend);
+    }
+}
+
+/// `e` with the scene's name filled in.
+pub(super) fn named(scene: &str, e: RenderError) -> RenderError {
+    match e {
+        RenderError::Backend { source, .. } => RenderError::Backend {
+            scene: scene.to_owned(),
+            source,
+        },
+        RenderError::Shader { source, .. } => RenderError::Shader {
+            scene: scene.to_owned(),
+            source,
+        },
+        other => other,
+    }
+}
+
+/// `passes` with `slow`'s extra copies of its pass's render passes right after each of them
+/// (see [`SlowPass`]): a fractional copy's viewports keep their top, at that fraction of their
+/// height (a pass with none gets one over that fraction of the target it writes first).
+pub(super) fn slowed(
+    plan: &RenderPlan,
+    passes: Vec<RenderPass>,
+    owners: Vec<PassId>,
+    slow: SlowPass,
+) -> (Vec<RenderPass>, Vec<PassId>) {
+    let copies = slow.extra_copies();
+    let target_size = plan
+        .passes
+        .iter()
+        .find(|p| p.id == slow.pass)
+        .and_then(|p| p.writes.iter().find_map(|w| plan.target(*w)))
+        .map(|t| (t.width as f32, t.height as f32));
+    let mut out = Vec::with_capacity(passes.len() + copies.len());
+    let mut out_owners = Vec::with_capacity(out.capacity());
+    for (pass, owner) in passes.into_iter().zip(owners) {
+        let extra: Vec<RenderPass> = if owner == slow.pass {
+            copies
+                .iter()
+                .map(|&fraction| partial_copy(&pass, fraction, target_size))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        out.push(pass);
+        out_owners.push(owner);
+        for copy in extra {
+            out.push(copy);
+            out_owners.push(owner);
+        }
+    }
+    (out, out_owners)
+}
+
+/// `pass` again, its viewports cut to `fraction` of their height (the whole pass at 1).
+fn partial_copy(pass: &RenderPass, fraction: f32, target_size: Option<(f32, f32)>) -> RenderPass {
+    let mut copy = pass.clone();
+    if fraction >= 1.0 {
+        return copy;
+    }
+    if copy.viewports.is_empty() {
+        if let Some((width, height)) = target_size {
+            copy.viewports.push(Viewport {
+                x: 0.0,
+                y: 0.0,
+                width,
+                height,
+                min_depth: 0.0,
+                max_depth: 1.0,
+            });
+        }
+    }
+    for viewport in &mut copy.viewports {
+        viewport.height = (viewport.height * fraction).max(1.0);
+    }
+    copy
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pass(name: &str, viewports: Vec<Viewport>) -> RenderPass {
+        RenderPass {
+            name: name.to_owned(),
+            color_attachments: vec![],
+            depth_attachment: None,
+            viewports,
+            draws: vec![],
+        }
+    }
+
+    #[test]
+    fn a_fractional_copy_cuts_each_viewport_to_the_fraction_of_its_height() {
+        let viewport = Viewport {
+            x: 8.0,
+            y: 16.0,
+            width: 64.0,
+            height: 32.0,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        let half = partial_copy(&pass("face", vec![viewport; 2]), 0.5, None);
+        assert!(half
+            .viewports
+            .iter()
+            .all(|v| v.height == 16.0 && v.y == 16.0 && v.width == 64.0));
+        let whole = partial_copy(&pass("face", vec![viewport]), 1.0, None);
+        assert_eq!(whole.viewports, vec![viewport]);
+        let full_target = partial_copy(&pass("tonemap", vec![]), 0.25, Some((100.0, 40.0)));
+        assert_eq!(full_target.viewports.len(), 1);
+        assert_eq!(
+            (
+                full_target.viewports[0].width,
+                full_target.viewports[0].height
+            ),
+            (100.0, 10.0)
+        );
+    }
+}
