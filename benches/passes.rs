@@ -8,8 +8,9 @@
 //! - `frame`: every pass of the frame together.
 //!
 //! Backends without timestamps are timed by wall clock around the whole render or submit, and
-//! say so. Flat sampling with ten samples keeps the whole run to a few minutes here; `harness
-//! bench` prints the same figures as a table with ratios, quicker.
+//! say so. Flat sampling with ten samples of two iterations each (sized from one timed
+//! iteration, so criterion does not warn that it cannot complete them) keeps the whole run to a
+//! few minutes here; `harness bench` prints the same figures as a table with ratios, quicker.
 
 use std::time::{Duration, Instant};
 
@@ -32,6 +33,19 @@ fn timed_render(
         None => timings.total(),
     })
 }
+
+/// Sets the group's warm-up and measurement time for a benchmark whose iteration takes `one`.
+fn budget(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    one: Duration,
+) {
+    let (warm_up, measurement) = harness::measure::bench::criterion_budget(one, SAMPLES);
+    group.warm_up_time(warm_up);
+    group.measurement_time(measurement);
+}
+
+/// Samples per benchmark (criterion's least).
+const SAMPLES: usize = 10;
 
 fn passes(c: &mut Criterion) {
     let names = engine::scene_file::canonical_scenes(&harness::scenes_dir());
@@ -56,9 +70,8 @@ fn passes(c: &mut Criterion) {
             let floors = Floors::new(backend.as_mut(), plan).expect("floor passes");
             let mut group = c.benchmark_group(format!("{}/{kind}", scene.name));
             group.sampling_mode(SamplingMode::Flat);
-            group.sample_size(10);
-            group.warm_up_time(Duration::from_millis(1));
-            group.measurement_time(Duration::from_millis(1));
+            group.sample_size(SAMPLES);
+            budget(&mut group, timed_render(backend.as_mut(), &prepared, None));
             group.bench_function("frame", |b| {
                 b.iter_custom(|iters| {
                     (0..iters)
@@ -68,6 +81,10 @@ fn passes(c: &mut Criterion) {
             });
             for spec in &plan.passes {
                 let name = spec.id.to_string();
+                budget(
+                    &mut group,
+                    timed_render(backend.as_mut(), &prepared, Some(spec.id)),
+                );
                 group.bench_function(BenchmarkId::new(&name, "pass"), |b| {
                     b.iter_custom(|iters| {
                         (0..iters)
@@ -75,6 +92,11 @@ fn passes(c: &mut Criterion) {
                             .sum()
                     })
                 });
+                let floor_ns = floors.time(backend.as_mut(), spec.id).expect("floor pass");
+                budget(
+                    &mut group,
+                    Duration::from_nanos(floor_ns.unwrap_or(1e6) as u64),
+                );
                 group.bench_function(BenchmarkId::new(&name, "floor"), |b| {
                     b.iter_custom(|iters| {
                         (0..iters)

@@ -67,6 +67,19 @@ fn with_filter(scene: &Scene, filter: ShadowFilter) -> Scene {
     scene
 }
 
+/// Sets the group's warm-up and measurement time for a benchmark whose iteration takes `one`.
+fn budget(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    one: Duration,
+) {
+    let (warm_up, measurement) = harness::measure::bench::criterion_budget(one, SAMPLES);
+    group.warm_up_time(warm_up);
+    group.measurement_time(measurement);
+}
+
+/// Samples per benchmark (criterion's least).
+const SAMPLES: usize = 10;
+
 fn shadows(c: &mut Criterion) {
     let arrow = harness::load_scene("arrow").expect("arrow").scene;
     let chess = harness::load_scene("chess").expect("chess").scene;
@@ -84,9 +97,7 @@ fn shadows(c: &mut Criterion) {
 
         let mut group = c.benchmark_group(format!("arrow/{kind}"));
         group.sampling_mode(SamplingMode::Flat);
-        group.sample_size(10);
-        group.warm_up_time(Duration::from_millis(1));
-        group.measurement_time(Duration::from_millis(1));
+        group.sample_size(SAMPLES);
         let mut paths = vec![PointShadowPass::SixPasses];
         if backend.features().geometry_shaders {
             paths.push(PointShadowPass::GeometryShader);
@@ -95,6 +106,10 @@ fn shadows(c: &mut Criterion) {
             let mut scene = arrow.clone();
             scene.quality.point_shadows = path;
             let scene = prepared(&scene);
+            budget(
+                &mut group,
+                timed_render(backend.as_mut(), &scene, shadow_0_map),
+            );
             group.bench_function(BenchmarkId::new("shadow_0", path.name()), |b| {
                 b.iter_custom(|iters| {
                     (0..iters)
@@ -107,9 +122,7 @@ fn shadows(c: &mut Criterion) {
 
         let mut group = c.benchmark_group(format!("chess/{kind}"));
         group.sampling_mode(SamplingMode::Flat);
-        group.sample_size(10);
-        group.warm_up_time(Duration::from_millis(1));
-        group.measurement_time(Duration::from_millis(1));
+        group.sample_size(SAMPLES);
         for filter in [
             ShadowFilter::Hard,
             ShadowFilter::Pcf3,
@@ -123,6 +136,7 @@ fn shadows(c: &mut Criterion) {
             let selections: [(&str, &dyn Fn(PassId) -> bool); 2] =
                 [("shadow_0_map", &shadow_0_map), ("shadow_term_0", &term)];
             for (label, of) in selections {
+                budget(&mut group, timed_render(backend.as_mut(), &scene, of));
                 group.bench_function(BenchmarkId::new(label, filter.name()), |b| {
                     b.iter_custom(|iters| {
                         (0..iters)

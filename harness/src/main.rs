@@ -45,6 +45,14 @@ enum Command {
         /// Print the results as JSON on stdout.
         #[arg(long)]
         json: bool,
+        /// Skip the speed checks (each pass's speed ratio against its timing golden).
+        #[arg(long)]
+        no_speed: bool,
+        /// Debug: give the lighting passes the generic, unspecialised shader variant, in the
+        /// renders and the speed probes (a real slowdown, reproduced: the lighting passes'
+        /// speed checks fail and nothing else does).
+        #[arg(long)]
+        debug_unspecialised_lighting: bool,
     },
     /// Measure the noise model behind the golden tolerances: how far unchanged renders move
     /// from the goldens under every source of variation (the backends, llvmpipe's CPU code
@@ -63,12 +71,18 @@ enum Command {
         /// Write golden/noise.toml from this run (needs every source).
         #[arg(long)]
         write: bool,
-        /// With --write: limit = margin x max(noise, resolution).
-        #[arg(long, default_value_t = harness::golden::noise::DEFAULT_MARGIN)]
-        margin: f64,
+        /// With --write: limit = margin x max(noise, resolution) [default: 3]; with --timing,
+        /// ln limit = margin x ln noise [default: 2].
+        #[arg(long)]
+        margin: Option<f64>,
         /// Print JSON.
         #[arg(long)]
         json: bool,
+        /// Measure the timing-noise model instead (golden/timing-noise.toml): each pass's
+        /// speed ratio against its timing golden over repeated probes, beside a busy
+        /// neighbour, under the CPU code paths and the second Mesa.
+        #[arg(long)]
+        timing: bool,
     },
     /// Write new goldens after an intended change: renders the scene, compares each pass with
     /// its golden, and rewrites only the passes that changed (outside tolerance) or have no
@@ -93,6 +107,12 @@ enum Command {
         /// Show what would change without writing anything.
         #[arg(long)]
         dry_run: bool,
+        /// Bless the timing goldens only (a deliberate slowdown or speed-up), not the images.
+        #[arg(long, conflicts_with = "no_speed")]
+        speed_only: bool,
+        /// Bless the images only, not the timing goldens.
+        #[arg(long)]
+        no_speed: bool,
     },
     /// Render a scene on one backend and write pass outputs (`.png`, or `.exr` for float passes).
     Render {
@@ -134,6 +154,17 @@ enum Command {
         /// Print JSON.
         #[arg(long)]
         json: bool,
+        /// The speed self-test instead: each pass slowed down x1.5 and x2 in turn must fail
+        /// its own speed check and no other (run it on the host that blessed the timing
+        /// goldens).
+        #[arg(long)]
+        speed: bool,
+        /// With --speed: only these scenes (repeatable).
+        #[arg(long = "scene", requires = "speed")]
+        scenes: Vec<String>,
+        /// With --speed: only this backend (repeatable).
+        #[arg(long = "backend", requires = "speed")]
+        backends: Vec<BackendKind>,
     },
     /// Speed against error for a quality knob, timed with GPU timestamps: `shadow` (filter x map
     /// size, against ray casting and the converged soft filter) or `ibl` (samples, specular size,
@@ -178,13 +209,14 @@ enum Command {
         /// variant with --breakdown].
         #[arg(long)]
         frames: Option<usize>,
-        /// Submit this pass's render passes --repeat-times times in every frame timed: how a
-        /// pass that many times slower shows in the ratios (its pixels are not the point).
+        /// Slow this pass down by --slowdown in every frame timed (its render passes submitted
+        /// that many times over): how a slower pass shows in the ratios (its pixels are not
+        /// the point).
         #[arg(long, conflicts_with_all = ["series", "breakdown"])]
-        repeat_pass: Option<String>,
-        /// How many times --repeat-pass submits its pass.
-        #[arg(long, default_value_t = 2, requires = "repeat_pass")]
-        repeat_times: u32,
+        slow_pass: Option<String>,
+        /// How many times over --slow-pass submits its pass's work (1.5: half of it again).
+        #[arg(long, default_value_t = 2.0, requires = "slow_pass")]
+        slowdown: f32,
         /// Instead of the scenes, a scaling series: resolution, lights, triangles, shadow-map,
         /// or all (repeatable).
         #[arg(long = "series", value_enum)]
@@ -204,6 +236,10 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Probe each pass's speed ratio, what the timing goldens record: per scene and backend,
+    /// every pass submitted alone and its floor right after it, round after round; the ratio is
+    /// the pass's fastest time over its floor's. Prints a table (or JSON with every sample).
+    Speed(cli::bench::SpeedArgs),
     /// Run the numerical hard cases (scenes/hard/ and chess moved 1e4/1e5 and scaled
     /// 0.001/1000) on every available backend: no NaN/Inf, the light buffer in range, and each
     /// case's own check. Prints the table, keeps it for the check report, exits 1 on a failure.
@@ -236,6 +272,8 @@ fn main() -> ExitCode {
         scenes: vec![],
         backends: vec![],
         json: false,
+        no_speed: false,
+        debug_unspecialised_lighting: false,
     });
     let result = match command {
         Command::Backends { json } => cli::info::backends(json),
@@ -244,14 +282,27 @@ fn main() -> ExitCode {
             scenes,
             backends,
             json,
-        } => cli::check::run(&out, &scenes, &backends, json),
+            no_speed,
+            debug_unspecialised_lighting,
+        } => cli::check::run(
+            &out,
+            &scenes,
+            &backends,
+            cli::check::Options {
+                json,
+                speed: !no_speed,
+                unspecialised_lighting: debug_unspecialised_lighting,
+            },
+        ),
+        Command::Speed(args) => cli::bench::speed_command(args),
         Command::Noise {
             sources,
             scenes,
             write,
             margin,
             json,
-        } => cli::noise::run(&sources, &scenes, write, margin, json),
+            timing,
+        } => cli::noise::command(&sources, &scenes, write, margin, json, timing),
         Command::Bless {
             scenes,
             passes,
@@ -259,7 +310,20 @@ fn main() -> ExitCode {
             all,
             every_pass,
             dry_run,
-        } => cli::bless::run(&scenes, &passes, backend, all, every_pass, dry_run),
+            speed_only,
+            no_speed,
+        } => cli::bless::run(
+            &scenes,
+            &passes,
+            backend,
+            all,
+            cli::bless::Options {
+                every_pass,
+                dry_run,
+                images: !speed_only,
+                speed: !no_speed,
+            },
+        ),
         Command::Render {
             scene,
             backend,
@@ -270,7 +334,12 @@ fn main() -> ExitCode {
         Command::Inspect { path, json } => cli::info::inspect(&path, json),
         Command::Scenes => cli::info::scenes(),
         Command::Hard { backends, json } => cli::hard::run(&backends, json),
-        Command::Selftest { json } => cli::selftest::run(json),
+        Command::Selftest {
+            json,
+            speed,
+            scenes,
+            backends,
+        } => cli::selftest::command(json, speed, &scenes, &backends),
         Command::Sweep {
             scene,
             knob,
@@ -292,8 +361,8 @@ fn main() -> ExitCode {
             scenes,
             backends,
             frames,
-            repeat_pass,
-            repeat_times,
+            slow_pass,
+            slowdown,
             series,
             breakdown,
             out,
@@ -304,17 +373,20 @@ fn main() -> ExitCode {
                 cli::bench::breakdown(&scenes, &backends, frames, json)
             } else if series.is_empty() {
                 let frames = frames.unwrap_or(harness::measure::bench::BENCH_FRAMES);
-                let repeat = match repeat_pass {
+                let slow = match slow_pass {
                     Some(name) => match name.parse::<engine::plan::PassId>() {
-                        Ok(pass) => Some((pass, repeat_times)),
+                        Ok(pass) => Some(engine::renderer::SlowPass {
+                            pass,
+                            factor: slowdown,
+                        }),
                         Err(e) => {
-                            eprintln!("error: --repeat-pass: {e}");
+                            eprintln!("error: --slow-pass: {e}");
                             return ExitCode::from(2);
                         }
                     },
                     None => None,
                 };
-                cli::bench::pass_table(&scenes, &backends, frames, repeat, &out, json)
+                cli::bench::pass_table(&scenes, &backends, frames, slow, &out, json)
             } else {
                 let frames = frames.unwrap_or(harness::measure::bench::BENCH_FRAMES);
                 cli::bench::series(&series, &backends, frames, &out, json)

@@ -6,12 +6,17 @@
 //! not available here is reported as ignored, with the reason on stderr; `REQUIRE_BACKENDS`
 //! (comma-separated names) turns that into a failure. `UPDATE_GOLDENS=1` blesses the reference
 //! backend's outputs instead of checking them, and checks the other backends against those.
+//!
+//! The speed checks are tests too, `<scene>::speed::<pass>::<backend>`, the verdicts of
+//! `harness check`: each (scene, backend) is probed once, in a child process (the harness
+//! binary, one rasterizer thread), while no render of this process runs. `HARNESS_NO_SPEED=1`
+//! marks them ignored.
 
 use std::collections::HashMap;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock, RwLock};
 
 use engine::backend::{self, BackendKind};
-use engine::plan::TargetId;
+use engine::plan::{PassId, TargetId};
 use engine::renderer::Frame;
 use harness::golden::bless::{bless_pass, BlessRequest};
 use harness::golden::suite::{self, Case, REFERENCE_BACKEND};
@@ -19,11 +24,17 @@ use harness::golden::{self, GoldenStore};
 use libtest_mimic::{Arguments, Failed, Trial};
 
 type Rendered = Arc<OnceLock<Result<Frame, String>>>;
+type Probed = Arc<OnceLock<Result<Vec<harness::golden::speed::SpeedCheck>, String>>>;
+
+/// Held for reading by every render and for writing by every speed probe: a probe times its
+/// passes while this process renders nothing.
+static QUIET: RwLock<()> = RwLock::new(());
 
 struct Suite {
     cases: Vec<Case>,
     store: GoldenStore,
     frames: Mutex<HashMap<(usize, BackendKind), Rendered>>,
+    probes: Mutex<HashMap<(usize, BackendKind), Probed>>,
     update: bool,
     /// Checks that did not pass, for the HTML report written at the end.
     failures: Mutex<Vec<harness::golden::suite::PassCheck>>,
@@ -38,8 +49,74 @@ impl Suite {
             .entry((case, kind))
             .or_default()
             .clone();
-        cell.get_or_init(|| self.cases[case].render(kind).map_err(|e| e.to_string()));
+        cell.get_or_init(|| {
+            let _rendering = QUIET.read().unwrap_or_else(|e| e.into_inner());
+            self.cases[case].render(kind).map_err(|e| e.to_string())
+        });
         cell
+    }
+
+    /// The speed checks of one scene on one backend, probed once.
+    fn probe(&self, case: usize, kind: BackendKind) -> Probed {
+        let cell = self
+            .probes
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .entry((case, kind))
+            .or_default()
+            .clone();
+        cell.get_or_init(|| {
+            let _quiet = QUIET.write().unwrap_or_else(|e| e.into_inner());
+            let case = &self.cases[case];
+            let driver = backend::probe(kind)
+                .info
+                .map(|info| golden::fingerprint(&info))
+                .unwrap_or_default();
+            let run = harness::golden::speed::check_scenes(
+                std::path::Path::new(env!("CARGO_BIN_EXE_harness")),
+                self.store.root(),
+                &[(case.name().to_owned(), case.argument())],
+                &[(kind, driver)],
+                Default::default(),
+                &[],
+                |_| {},
+            );
+            match run.errors.first() {
+                Some(e) => Err(e.clone()),
+                None => Ok(run.checks),
+            }
+        });
+        cell
+    }
+
+    fn run_speed(&self, case: usize, pass: PassId, kind: BackendKind) -> Result<(), Failed> {
+        let probed = self.probe(case, kind);
+        let checks = match probed.get() {
+            Some(Ok(checks)) => checks,
+            Some(Err(e)) => return Err(format!("speed probe failed: {e}").into()),
+            None => return Err("speed probe did not run".into()),
+        };
+        let Some(check) = checks.iter().find(|c| c.pass == pass) else {
+            return Err(format!("{pass} was not timed on {kind}").into());
+        };
+        if check.failed() {
+            return Err(format!(
+                "{} on {kind}: {}\n  bless a deliberate change: harness bless --scene {} --speed-only",
+                check.pass,
+                check.describe(),
+                self.cases[case].argument()
+            )
+            .into());
+        }
+        if !matches!(check.outcome, harness::golden::speed::SpeedOutcome::Passed) {
+            eprintln!(
+                "note: {}/{} on {kind}: {}",
+                check.scene,
+                pass,
+                check.describe()
+            );
+        }
+        Ok(())
     }
 
     fn run(&self, case_index: usize, pass: TargetId, kind: BackendKind) -> Result<(), Failed> {
@@ -154,9 +231,26 @@ fn main() {
         cases,
         store: GoldenStore::workspace(),
         frames: Mutex::default(),
+        probes: Mutex::default(),
         update: std::env::var("UPDATE_GOLDENS").is_ok_and(|v| v == "1"),
         failures: Mutex::default(),
     });
+    // The speed tests first: their probes then run before the renders start.
+    let no_speed = std::env::var("HARNESS_NO_SPEED").is_ok_and(|v| v == "1");
+    for (index, case) in suite.cases.iter().enumerate() {
+        let plan = case.frame.plan();
+        for kind in BackendKind::ALL {
+            let passes = plan.passes.iter().map(|p| p.id);
+            for pass in passes.filter(|&id| harness::measure::bench::has_floor(plan, id)) {
+                let name = format!("{}::speed::{pass}::{kind}", case.name());
+                let suite = suite.clone();
+                trials.push(
+                    Trial::test(name, move || suite.run_speed(index, pass, kind))
+                        .with_ignored_flag(no_speed || !available.contains(&kind)),
+                );
+            }
+        }
+    }
     for (index, case) in suite.cases.iter().enumerate() {
         for &pass in &case.passes {
             for kind in BackendKind::ALL {
@@ -206,6 +300,7 @@ fn write_failure_report(suite: &Suite) {
         cross: vec![],
         timings: vec![],
         driver_notes: vec![],
+        speed: Default::default(),
     };
     let html = harness::report::html(&run, &outputs, &suite.store, None, &[]);
     match harness::images::write_atomically(&report_path(), html.as_bytes()) {

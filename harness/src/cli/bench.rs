@@ -16,12 +16,12 @@ pub(crate) fn pass_table(
     scenes: &[String],
     backends: &[BackendKind],
     frames: usize,
-    repeat: Option<(engine::plan::PassId, u32)>,
+    slow: Option<engine::renderer::SlowPass>,
     out: &Path,
     json: bool,
 ) -> anyhow::Result<ExitCode> {
     let variations = engine::renderer::Variations {
-        repeat_pass: repeat,
+        slow_pass: slow,
         ..Default::default()
     };
     let names = scenes_or_canonical(scenes);
@@ -197,4 +197,198 @@ fn save_bench_json(dir: &Path, name: &str, text: &str) -> anyhow::Result<()> {
         path.display()
     );
     Ok(())
+}
+
+/// `harness speed --in-process`: the probe in this process, as JSON (or a table); exits 1 when
+/// a backend asked for is missing or a scene fails.
+pub(crate) fn speed_in_process(
+    scenes: &[String],
+    backends: &[BackendKind],
+    rounds: usize,
+    variations: engine::renderer::Variations,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    let names = scenes_or_canonical(scenes);
+    let loaded = names
+        .iter()
+        .map(|n| harness::load_scene(n).map(|l| l.scene))
+        .collect::<Result<Vec<_>, _>>()?;
+    let kinds: Vec<BackendKind> = if backends.is_empty() {
+        BackendKind::ALL.to_vec()
+    } else {
+        backends.to_vec()
+    };
+    let mut results = Vec::new();
+    let mut failed = false;
+    for kind in kinds {
+        if let Err(e) = engine::backend::create(kind) {
+            eprintln!("skipping {kind}: {e}");
+            failed |= !backends.is_empty();
+            continue;
+        }
+        for scene in &loaded {
+            eprintln!("probing {} on {kind} ({rounds} rounds) ...", scene.name);
+            match harness::measure::speed::probe(scene, kind, rounds, variations) {
+                Ok(result) => {
+                    if !json {
+                        print_speed(&result);
+                    }
+                    results.push(result);
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    failed = true;
+                }
+            }
+        }
+    }
+    if json {
+        println!("{}", serde_json::to_string_pretty(&results)?);
+    }
+    Ok(if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// `harness speed`: the speed probe of each scene asked for (every canonical one by default) on
+/// each backend (every available one by default), each backend in a child process on one
+/// rasterizer thread, as a table or JSON; exits 1 when a backend asked for is missing or a
+/// scene fails.
+pub(crate) fn speed(
+    scenes: &[String],
+    backends: &[BackendKind],
+    rounds: usize,
+    variations: engine::renderer::Variations,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    let exe = std::env::current_exe()?;
+    let names = scenes_or_canonical(scenes);
+    let kinds: Vec<BackendKind> = if backends.is_empty() {
+        BackendKind::ALL.to_vec()
+    } else {
+        backends.to_vec()
+    };
+    let mut results = Vec::new();
+    let mut failed = false;
+    for kind in kinds {
+        let status = engine::backend::probe(kind);
+        if !status.available {
+            eprintln!("skipping {kind}: {}", status.reason.unwrap_or_default());
+            failed |= !backends.is_empty();
+            continue;
+        }
+        eprintln!(
+            "probing {} scene(s) on {kind} ({rounds} rounds, one rasterizer thread) ...",
+            names.len()
+        );
+        let (probed, errors) =
+            harness::measure::speed::probe_in_child(&exe, &names, kind, rounds, variations, &[]);
+        for e in &errors {
+            eprintln!("error: {e}");
+        }
+        failed |= !errors.is_empty();
+        for result in probed {
+            if !json {
+                print_speed(&result);
+            }
+            results.push(result);
+        }
+    }
+    if json {
+        println!("{}", serde_json::to_string_pretty(&results)?);
+    }
+    Ok(if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// One probe as a table: each pass's fastest time, its floor's, and the ratio.
+fn print_speed(result: &harness::measure::speed::SceneSpeed) {
+    println!("{} on {}", result.scene, result.backend);
+    for pass in &result.passes {
+        println!(
+            "  {:<24} {:>8.3} ms  floor {:>7.3} ms  ratio {:>7.3}",
+            pass.pass,
+            pass.min_ms().unwrap_or(f64::NAN),
+            pass.floor_min_ms().unwrap_or(f64::NAN),
+            pass.ratio().unwrap_or(f64::NAN)
+        );
+    }
+}
+
+/// The arguments of `harness speed`.
+#[derive(clap::Args)]
+pub(crate) struct SpeedArgs {
+    /// Only these scenes (canonical names or scene files; repeatable).
+    #[arg(long = "scene")]
+    pub scenes: Vec<String>,
+    /// Only this backend (repeatable). Default: every available one.
+    #[arg(long = "backend")]
+    pub backends: Vec<BackendKind>,
+    /// The most rounds per scene and backend (a pass stops once it has settled).
+    #[arg(long, default_value_t = harness::measure::speed::SPEED_ROUNDS)]
+    pub rounds: usize,
+    /// Slow this pass down by --slowdown (what the speed self-test injects).
+    #[arg(long)]
+    pub slow_pass: Option<String>,
+    /// How many times over --slow-pass submits its pass's work (1.5: half of it again).
+    #[arg(long, default_value_t = 2.0, requires = "slow_pass")]
+    pub slowdown: f32,
+    /// Give the lighting passes the generic, unspecialised shader variant (a debug setting
+    /// that reproduces a real slowdown).
+    #[arg(long)]
+    pub debug_unspecialised_lighting: bool,
+    /// Print JSON with every sample.
+    #[arg(long)]
+    pub json: bool,
+    /// Probe in this process, with the drivers as the environment sets them (what the
+    /// child processes that `speed`, `check`, `bless` and `noise` start do). Without it,
+    /// each backend is probed in a child process on one rasterizer thread.
+    #[arg(long, hide = true)]
+    pub in_process: bool,
+}
+
+/// `harness speed`: parses the slowdown asked for and probes, in child processes (or in this
+/// one with `--in-process`).
+pub(crate) fn speed_command(args: SpeedArgs) -> anyhow::Result<ExitCode> {
+    let slow = match args
+        .slow_pass
+        .map(|name| name.parse::<engine::plan::PassId>())
+    {
+        Some(Ok(pass)) => Some(engine::renderer::SlowPass {
+            pass,
+            factor: args.slowdown,
+        }),
+        Some(Err(e)) => {
+            eprintln!("error: --slow-pass: {e}");
+            return Ok(ExitCode::from(2));
+        }
+        None => None,
+    };
+    let variations = engine::renderer::Variations {
+        slow_pass: slow,
+        unspecialised_lighting: args.debug_unspecialised_lighting,
+        ..Default::default()
+    };
+    if args.in_process {
+        speed_in_process(
+            &args.scenes,
+            &args.backends,
+            args.rounds,
+            variations,
+            args.json,
+        )
+    } else {
+        speed(
+            &args.scenes,
+            &args.backends,
+            args.rounds,
+            variations,
+            args.json,
+        )
+    }
 }

@@ -9,24 +9,92 @@ use harness::golden::bless::{bless_pass, BlessOutcome, BlessRequest};
 
 use super::load_cases;
 
+/// What `bless` rewrites, beyond the scenes and passes named.
+pub(crate) struct Options {
+    /// Every pass considered, also those within tolerance.
+    pub every_pass: bool,
+    /// Decide and print; write nothing.
+    pub dry_run: bool,
+    /// Bless the images (on the one backend asked for).
+    pub images: bool,
+    /// Bless the timing goldens (on every available backend).
+    pub speed: bool,
+}
+
 /// Renders each scene asked for on `kind` and rewrites the passes outside tolerance, without a
-/// golden, named with `--pass`, or all of them with `--every-pass` (nothing with `--dry-run`).
+/// golden, named with `--pass`, or all of them with `--every-pass` (nothing with `--dry-run`);
+/// then probes every available backend and rewrites the timing goldens the same way.
 pub(crate) fn run(
     scenes: &[String],
     passes: &[String],
     kind: BackendKind,
     all: bool,
-    every_pass: bool,
-    dry_run: bool,
+    options: Options,
 ) -> anyhow::Result<ExitCode> {
     if scenes.is_empty() && !all {
         anyhow::bail!("name what to bless with --scene (and optionally --pass), or bless everything with --all");
     }
     let cases = load_cases(scenes)?;
     let store = harness::golden::GoldenStore::workspace();
+    if options.images {
+        bless_images(&cases, &store, passes, kind, &options)?;
+    }
+    if options.speed {
+        bless_speed(&cases, &store, &options)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Probes every available backend and rewrites the timing goldens that moved.
+fn bless_speed(
+    cases: &[harness::golden::suite::Case],
+    store: &harness::golden::GoldenStore,
+    options: &Options,
+) -> anyhow::Result<()> {
+    let backends: Vec<(BackendKind, String)> = BackendKind::ALL
+        .into_iter()
+        .filter_map(|kind| {
+            let status = engine::backend::probe(kind);
+            match (status.available, status.info) {
+                (true, Some(info)) => Some((kind, harness::golden::fingerprint(&info))),
+                _ => {
+                    eprintln!("note: no timing goldens for {kind}: it is unavailable here");
+                    None
+                }
+            }
+        })
+        .collect();
+    let scenes: Vec<(String, String)> = cases
+        .iter()
+        .map(|c| (c.name().to_owned(), c.argument()))
+        .collect();
+    let lines = harness::golden::speed::bless_scenes(
+        &std::env::current_exe()?,
+        store.root(),
+        &scenes,
+        &backends,
+        options.every_pass,
+        options.dry_run,
+        |what| eprintln!("{what} ..."),
+    )?;
+    for line in lines {
+        println!("{line}");
+    }
+    Ok(())
+}
+
+/// Renders each scene on `kind` and rewrites its image goldens as asked.
+fn bless_images(
+    cases: &[harness::golden::suite::Case],
+    store: &harness::golden::GoldenStore,
+    passes: &[String],
+    kind: BackendKind,
+    options: &Options,
+) -> anyhow::Result<()> {
+    let (every_pass, dry_run) = (options.every_pass, options.dry_run);
     let mut backend = engine::backend::create(kind)?;
     let driver = harness::golden::fingerprint(backend.info());
-    for case in &cases {
+    for case in cases {
         // Names given on the command line (an edge), as the case's golden passes.
         let mut named: Vec<TargetId> = Vec::new();
         for name in passes {
@@ -60,7 +128,7 @@ pub(crate) fn run(
         let mut kept = 0;
         for pass in wanted {
             let blessed = bless_pass(
-                &store,
+                store,
                 case,
                 pass,
                 &frame.outputs[&pass],
@@ -79,5 +147,5 @@ pub(crate) fn run(
             );
         }
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }

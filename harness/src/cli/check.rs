@@ -11,15 +11,35 @@ use harness::golden::suite::{Case, LimitSource};
 
 use super::load_cases_isolated;
 
+/// How `check` runs, beyond what it checks.
+pub(crate) struct Options {
+    /// Print JSON instead of the table.
+    pub json: bool,
+    /// Run the speed checks.
+    pub speed: bool,
+    /// Debug: the lighting passes unspecialised, in the renders and the speed probes.
+    pub unspecialised_lighting: bool,
+}
+
 /// Runs the check on the scenes and backends asked for (all by default), writes report.html
 /// and the failure images under `out` and prints the results; exits 1 on any failure.
 pub(crate) fn run(
     out: &Path,
     scenes: &[String],
     backends: &[BackendKind],
-    json: bool,
+    options: Options,
 ) -> anyhow::Result<ExitCode> {
-    let (cases, broken) = load_cases_isolated(scenes)?;
+    let json = options.json;
+    let (mut cases, broken) = load_cases_isolated(scenes)?;
+    let variations = engine::renderer::Variations {
+        unspecialised_lighting: options.unspecialised_lighting,
+        ..Default::default()
+    };
+    if options.unspecialised_lighting {
+        for case in &mut cases {
+            case.frame = case.frame.clone().with_variations(variations);
+        }
+    }
     let store = harness::golden::GoldenStore::workspace();
     let bar = indicatif::ProgressBar::new(0).with_style(
         indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} renders  {msg}")
@@ -32,8 +52,31 @@ pub(crate) fn run(
             bar.set_position(done as u64);
             bar.set_message(what.to_owned());
         });
-    bar.finish_and_clear();
     let mut run = run;
+    if options.speed {
+        let exe = std::env::current_exe()?;
+        let scenes: Vec<(String, String)> = cases
+            .iter()
+            .map(|c| (c.name().to_owned(), c.argument()))
+            .collect();
+        let available: Vec<(BackendKind, String)> = run
+            .backends
+            .iter()
+            .filter(|b| b.unavailable.is_none())
+            .map(|b| (b.backend, b.fingerprint.clone().unwrap_or_default()))
+            .collect();
+        run.speed = harness::golden::speed::check_scenes(
+            &exe,
+            store.root(),
+            &scenes,
+            &available,
+            variations,
+            &[],
+            |what| bar.set_message(what.to_owned()),
+        );
+        harness::golden::speed::append_history(out, &run.speed, &available);
+    }
+    bar.finish_and_clear();
     run.load_errors = broken;
     for b in &run.backends {
         if let Some(reason) = &b.unavailable {
@@ -149,15 +192,19 @@ fn print_table(run: &CheckRun, report: &Path, failures: &Path) {
             worst_cross.join(", ")
         );
     }
-    let failed = run.results.iter().filter(|r| !r.outcome.passed()).count();
+    print_speed(run);
+    let failed = run.results.iter().filter(|r| !r.outcome.passed()).count()
+        + run.speed.checks.iter().filter(|c| c.failed()).count()
+        + run.speed.errors.len();
     let unloaded = if run.load_errors.is_empty() {
         String::new()
     } else {
         format!(", {} scene(s) did not load", run.load_errors.len())
     };
     println!(
-        "{} checks, {failed} failed{unloaded}; report: {}",
-        run.results.len(),
+        "{} checks ({} of speed), {failed} failed{unloaded}; report: {}",
+        run.results.len() + run.speed.checks.len(),
+        run.speed.checks.len(),
         report.display()
     );
     if failed > 0 {
@@ -169,5 +216,55 @@ fn print_table(run: &CheckRun, report: &Path, failures: &Path) {
         for command in run.bless_commands() {
             println!("  {command}");
         }
+    }
+}
+
+/// The speed section of the table: a line per scene, pass and backend (the value against the
+/// limit, or why it is untimed), the probes that failed, and the passes that got faster.
+fn print_speed(run: &CheckRun) {
+    use harness::golden::speed::SpeedOutcome;
+    if run.speed.checks.is_empty() && run.speed.errors.is_empty() {
+        return;
+    }
+    println!(
+        "\nspeed: each pass alone over its floor, against its timing golden \
+         (golden/<scene>/timing.toml; limits from golden/timing-noise.toml)"
+    );
+    println!(
+        "{:<8} {:<22} {:<12} {:<8} value",
+        "scene", "pass", "backend", "result"
+    );
+    for c in &run.speed.checks {
+        let label = match c.outcome {
+            SpeedOutcome::Passed => "ok",
+            SpeedOutcome::Slower => "SLOWER",
+            SpeedOutcome::Faster => "faster",
+            SpeedOutcome::Untimed(_) => "untimed",
+            SpeedOutcome::MissingGolden => "MISSING",
+        };
+        println!(
+            "{:<8} {:<22} {:<12} {label:<8} {}",
+            c.scene,
+            c.pass,
+            c.backend,
+            c.describe()
+        );
+    }
+    for e in &run.speed.errors {
+        println!("speed probe FAILED: {e}");
+    }
+    let faster: Vec<String> = run
+        .speed
+        .checks
+        .iter()
+        .filter(|c| c.outcome == SpeedOutcome::Faster)
+        .map(|c| format!("{}/{} on {}", c.scene, c.pass, c.backend))
+        .collect();
+    if !faster.is_empty() {
+        println!(
+            "note: faster than their timing goldens beyond the limit (bless if intended, \
+             `harness bless --scene S --speed-only`): {}",
+            faster.join(", ")
+        );
     }
 }

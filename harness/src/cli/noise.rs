@@ -16,6 +16,25 @@ use super::load_cases;
 /// The sources that cannot be measured here, each with why.
 type Unmeasured = Vec<(String, String)>;
 
+/// `harness noise`: the image noise model, or with `timing` the timing-noise model, each with
+/// its default margin unless one is given.
+pub(crate) fn command(
+    sources: &[String],
+    scenes: &[String],
+    write: bool,
+    margin: Option<f64>,
+    json: bool,
+    timing: bool,
+) -> anyhow::Result<ExitCode> {
+    if timing {
+        let margin = margin.unwrap_or(harness::golden::speed::DEFAULT_TIMING_MARGIN);
+        self::timing(scenes, write, margin, json)
+    } else {
+        let margin = margin.unwrap_or(harness::golden::noise::DEFAULT_MARGIN);
+        run(sources, scenes, write, margin, json)
+    }
+}
+
 /// Measures the sources named (every one by default) on the scenes named (every canonical one by
 /// default), writes golden/noise.toml with `write`, and prints each source's worst value against
 /// every limit (or JSON); exits 1 when one is above half its limit or a render failed.
@@ -257,4 +276,131 @@ fn print_table(
         too_noisy.len(),
         failed_render_count
     );
+}
+
+/// `harness noise --timing`: probes the scenes named (every canonical one by default) on every
+/// available backend under every timing source, prints each pass's worst factor per tier with
+/// its limit and its score (or JSON), and with `write` records golden/timing-noise.toml. Exits 1
+/// when a measurement is above half its limit or a probe failed.
+pub(crate) fn timing(
+    scenes: &[String],
+    write: bool,
+    margin: f64,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    use harness::golden::speed::{measure, Tier, TimingNoise};
+    let store = GoldenStore::workspace();
+    let cases = load_cases(scenes)?;
+    let scenes: Vec<(String, String)> = cases
+        .iter()
+        .map(|c| (c.name().to_owned(), c.argument()))
+        .collect();
+    let (sources, missing) = measure::timing_sources();
+    for (name, why) in &missing {
+        eprintln!("note: timing source {name} not measured: {why}");
+    }
+    if write && !missing.is_empty() {
+        anyhow::bail!("--write needs every timing source; install the missing ones first");
+    }
+    let backends: Vec<BackendKind> = BackendKind::ALL
+        .into_iter()
+        .filter(|k| engine::backend::probe(*k).available)
+        .collect();
+    let exe = std::env::current_exe()?;
+    let (measurements, errors) =
+        measure::measure_timing(&exe, store.root(), &scenes, &backends, &sources, |what| {
+            eprintln!("timing noise: {what} ...")
+        });
+    for e in &errors {
+        eprintln!("error: {e}");
+    }
+    let model = if write {
+        let mut model = measure::model_from(&measurements, &sources, margin);
+        // Scenes not measured in this run keep their figures.
+        if let Ok(old) = TimingNoise::load(store.root()) {
+            for (scene, figures) in old.scenes {
+                model.scenes.entry(scene).or_insert(figures);
+            }
+        }
+        model.save(store.root())?;
+        eprintln!("wrote {}", TimingNoise::path(store.root()).display());
+        model
+    } else {
+        TimingNoise::load(store.root())?
+    };
+    let scores = measure::scores(&model, &measurements);
+    let too_noisy = scores
+        .iter()
+        .filter(|(_, _, s)| *s > MAX_NOISE_RATIO)
+        .count();
+    if json {
+        let rows: Vec<serde_json::Value> = scores
+            .iter()
+            .map(|(m, limit, score)| {
+                serde_json::json!({
+                    "source": m.source, "tier": m.tier, "scene": m.scene,
+                    "backend": m.backend, "pass": m.pass, "factor": m.factor,
+                    "limit": limit, "score": score,
+                })
+            })
+            .collect();
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({
+                "measurements": rows, "errors": errors,
+            }))?
+        );
+    } else {
+        println!(
+            "{:<8} {:<12} {:<22} {:>14} {:>14} {:>10} {:>10}",
+            "scene", "backend", "pass", "host noise", "driver noise", "limit", "elsewhere"
+        );
+        for (scene, backends) in &model.scenes {
+            for (backend, passes) in backends {
+                for (pass, noise) in passes {
+                    let here = model.limit(noise.noise(Tier::SameHost).0);
+                    let elsewhere = model.limit(noise.noise(Tier::OtherHost).0);
+                    let untimed = |limit: f64| {
+                        if limit >= harness::golden::speed::MUST_CATCH {
+                            "(untimed)"
+                        } else {
+                            ""
+                        }
+                    };
+                    println!(
+                        "{scene:<8} {backend:<12} {pass:<22} {:>14} {:>14} {:>10} {:>10} {}",
+                        format!("x{:.2} {}", noise.host, short(&noise.host_at)),
+                        format!("x{:.2} {}", noise.drivers, short(&noise.drivers_at)),
+                        format!("x{here:.2}{}", untimed(here)),
+                        format!("x{elsewhere:.2}"),
+                        untimed(elsewhere)
+                    );
+                }
+            }
+        }
+        let worst = scores
+            .iter()
+            .max_by(|a, b| a.2.total_cmp(&b.2))
+            .map(|(m, limit, score)| {
+                format!(
+                    "{score:.2} of its limit ({} {} {} under {}: x{:.3}, limit x{limit:.2})",
+                    m.scene, m.backend, m.pass, m.source, m.factor
+                )
+            })
+            .unwrap_or_else(|| "-".to_owned());
+        println!(
+            "{} measurements, {too_noisy} above {MAX_NOISE_RATIO} of their limits; worst {worst}",
+            scores.len()
+        );
+    }
+    Ok(if too_noisy == 0 && errors.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}
+
+/// A source name short enough for the table.
+fn short(source: &str) -> &str {
+    source.get(..source.len().min(12)).unwrap_or(source)
 }

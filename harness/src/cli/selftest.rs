@@ -7,6 +7,20 @@ use engine::backend::BackendKind;
 
 use super::load_cases_isolated;
 
+/// `harness selftest`: the mutation self-test, or with `speed` the speed self-test.
+pub(crate) fn command(
+    json: bool,
+    speed: bool,
+    scenes: &[String],
+    backends: &[BackendKind],
+) -> anyhow::Result<ExitCode> {
+    if speed {
+        self::speed(scenes, backends, json)
+    } else {
+        run(json)
+    }
+}
+
 /// Runs the mutation self-test on every available backend and prints the margin and noise
 /// tables (or JSON); exits 1 when a change goes unnoticed or an unchanged render is too noisy.
 pub(crate) fn run(json: bool) -> anyhow::Result<ExitCode> {
@@ -82,6 +96,78 @@ pub(crate) fn run(json: bool) -> anyhow::Result<ExitCode> {
         }
     }
     Ok(if result.passed() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}
+
+/// `harness selftest --speed`: slows each pass of each scene named (every canonical one by
+/// default) down x1.5 and x2 in turn on every available backend (or those named) and prints
+/// the margin table; exits 1 when an injection is missed where its pass is timed, or flagged
+/// in another pass.
+pub(crate) fn speed(
+    scenes: &[String],
+    backends: &[BackendKind],
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    use harness::golden::speed::selftest;
+    let (cases, broken) = load_cases_isolated(scenes)?;
+    if let Some(b) = broken.first() {
+        anyhow::bail!("scene `{}` did not load: {}", b.scene, b.error);
+    }
+    let store = harness::golden::GoldenStore::workspace();
+    let available: Vec<(BackendKind, String)> = BackendKind::ALL
+        .into_iter()
+        .filter(|k| backends.is_empty() || backends.contains(k))
+        .filter_map(|k| {
+            let status = engine::backend::probe(k);
+            status
+                .info
+                .filter(|_| status.available)
+                .map(|info| (k, harness::golden::fingerprint(&info)))
+        })
+        .collect();
+    if available.is_empty() {
+        anyhow::bail!("no backend is available; run `harness backends` for the reasons");
+    }
+    // The passes with a floor, in plan order: those the speed checks time.
+    let scenes: Vec<(String, String, Vec<engine::plan::PassId>)> = cases
+        .iter()
+        .map(|c| {
+            let plan = c.frame.plan();
+            let passes = plan.passes.iter().map(|p| p.id);
+            let timed = passes.filter(|&id| harness::measure::bench::has_floor(plan, id));
+            (c.name().to_owned(), c.argument(), timed.collect())
+        })
+        .collect();
+    let (injections, errors) = selftest::run(
+        &std::env::current_exe()?,
+        store.root(),
+        &scenes,
+        &available,
+        &selftest::INJECTED,
+        |what| eprintln!("speed self-test: {what} ..."),
+    );
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({
+                "injections": injections, "errors": errors,
+            }))?
+        );
+    } else {
+        println!(
+            "Injected slowdowns: value / limit in the pass slowed (above 1 is flagged), the \
+             worst other pass of the scene, and the smallest slowdown each pass detects"
+        );
+        print!("{}", selftest::table(&injections));
+        for e in &errors {
+            println!("ERROR: {e}");
+        }
+    }
+    let wrong = injections.iter().filter(|i| !i.correct()).count();
+    Ok(if wrong == 0 && errors.is_empty() {
         ExitCode::SUCCESS
     } else {
         ExitCode::FAILURE

@@ -81,6 +81,9 @@ pub struct CheckRun {
     /// were blessed with.
     #[serde(default)]
     pub driver_notes: Vec<String>,
+    /// The speed checks (none with `--no-speed`).
+    #[serde(default)]
+    pub speed: crate::golden::speed::SpeedRun,
 }
 
 impl CheckRun {
@@ -89,6 +92,7 @@ impl CheckRun {
         self.render_errors.is_empty()
             && self.load_errors.is_empty()
             && self.results.iter().all(|r| r.outcome.passed())
+            && self.speed.passed()
     }
 
     /// One `harness bless` command per scene with a failing or missing pass, in the order of
@@ -98,6 +102,18 @@ impl CheckRun {
         for r in self.results.iter().filter(|r| !r.outcome.passed()) {
             let command = suite::bless_command(&r.scene_argument);
             if !commands.contains(&command) {
+                commands.push(command);
+            }
+        }
+        for c in self.speed.checks.iter().filter(|c| c.failed()) {
+            let argument = self
+                .results
+                .iter()
+                .find(|r| r.scene == c.scene)
+                .map_or_else(|| c.scene.clone(), |r| r.scene_argument.clone());
+            let command = format!("{} --speed-only", suite::bless_command(&argument));
+            if !commands.contains(&command) && !commands.contains(&suite::bless_command(&argument))
+            {
                 commands.push(command);
             }
         }
@@ -322,6 +338,7 @@ pub fn run_with(
             load_errors: Vec::new(),
             cross,
             timings,
+            speed: Default::default(),
         },
         outputs,
     )

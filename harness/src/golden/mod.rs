@@ -10,6 +10,7 @@ pub mod noise;
 pub mod pass_kind;
 pub mod portability;
 pub mod selftest;
+pub mod speed;
 mod store;
 pub mod suite;
 pub mod tolerance;

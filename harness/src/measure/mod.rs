@@ -5,6 +5,7 @@
 
 pub mod bench;
 pub mod hard_cases;
+pub mod speed;
 pub mod sweep;
 
 use std::path::Path;

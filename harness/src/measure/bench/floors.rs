@@ -11,6 +11,18 @@ use engine::backend::{
 use engine::plan::{PassId, RenderPlan};
 use engine::shaders;
 
+/// Whether plan pass `pass` has a floor: it writes a depth target or 1 to 5 color targets (the
+/// floor shader's outputs). The passes the speed checks time are these.
+pub fn has_floor(plan: &RenderPlan, pass: PassId) -> bool {
+    let Some(spec) = plan.passes.iter().find(|p| p.id == pass) else {
+        return false;
+    };
+    let targets: Vec<_> = spec.writes.iter().filter_map(|w| plan.target(*w)).collect();
+    let colors = targets.iter().filter(|t| !t.format.is_depth()).count();
+    let depth = targets.iter().any(|t| t.format.is_depth());
+    colors <= 5 && (colors > 0 || depth)
+}
+
 /// Floor passes for every pass of a plan, created once on a backend and submitted on demand.
 pub struct Floors {
     scope: ResourceScope,
@@ -49,7 +61,7 @@ impl Floors {
             let targets: Vec<_> = spec.writes.iter().filter_map(|w| plan.target(*w)).collect();
             let colors: Vec<_> = targets.iter().filter(|t| !t.format.is_depth()).collect();
             let depth = targets.iter().find(|t| t.format.is_depth());
-            if colors.len() > 5 || (colors.is_empty() && depth.is_none()) {
+            if !has_floor(plan, spec.id) {
                 continue;
             }
             let key = format!(
@@ -148,6 +160,24 @@ impl Floors {
         };
         let timings = backend.submit(std::slice::from_ref(floor))?;
         Ok(timings.first().and_then(|t| t.gpu_ns))
+    }
+
+    /// Submits the floor of plan pass `pass` `copies` times in one submission: the GPU ns of
+    /// one, on average (None without timestamps or when the pass has no floor). A floor far
+    /// shorter than its pass is repeated so that its time is not all timer and start-up.
+    pub fn time_repeated(
+        &self,
+        backend: &mut dyn Backend,
+        pass: PassId,
+        copies: usize,
+    ) -> backend::Result<Option<f64>> {
+        let Some(floor) = self.passes.get(&pass) else {
+            return Ok(None);
+        };
+        let copies = copies.max(1);
+        let timings = backend.submit(&vec![floor.clone(); copies])?;
+        let total: Option<f64> = timings.iter().map(|t| t.gpu_ns).sum();
+        Ok(total.map(|ns| ns / copies as f64))
     }
 
     /// Destroys the floors' resources.

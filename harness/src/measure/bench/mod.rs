@@ -28,13 +28,25 @@ mod timing;
 
 use engine::backend::BackendKind;
 
-pub use floors::Floors;
+pub use floors::{has_floor, Floors};
 pub use lighting_breakdown::{breakdown, BreakdownRow, PassBreakdown, BREAKDOWN_FRAMES};
 pub use precompute::{precompute, Precompute};
 pub use report::{report_sections, series_svg, BENCH_JSON, SERIES_JSON};
 pub use series::{series, Series, SeriesPoint};
 pub use tables::{breakdown_table, series_table, table};
 pub use timing::{bench_scene, bench_scene_with, timed_render, PassBench, SceneBench};
+
+/// Criterion's warm-up and measurement time for a routine whose iteration takes `one` (the
+/// time it reports): `samples` samples of two iterations each. Flat sampling warns "Unable to
+/// complete N samples" whenever a sample gets one iteration; two each keep it quiet at twice
+/// the cost of one.
+pub fn criterion_budget(
+    one: std::time::Duration,
+    samples: usize,
+) -> (std::time::Duration, std::time::Duration) {
+    let one = one.max(std::time::Duration::from_micros(10));
+    (one, one.mul_f64(samples as f64 * 1.5))
+}
 
 /// Frames timed per scene and backend by `harness bench` and its series unless told otherwise.
 pub const BENCH_FRAMES: usize = 5;

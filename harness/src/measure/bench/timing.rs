@@ -218,7 +218,7 @@ pub fn bench_scene(
 }
 
 /// [`bench_scene`] with `variations` applied to the frames timed (not to the input floor's):
-/// `repeat_pass` shows how a slower pass shows in the ratios.
+/// `slow_pass` shows how a slower pass shows in the ratios.
 pub fn bench_scene_with(
     scene: &Scene,
     kind: BackendKind,

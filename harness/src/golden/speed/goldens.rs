@@ -1,0 +1,178 @@
+//! `golden/<scene>/timing.toml`: a scene's timing goldens, one section per backend, blessed
+//! with its images.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use engine::backend::BackendKind;
+use engine::plan::PassId;
+
+use super::SpeedError;
+use crate::measure::speed::SceneSpeed;
+
+/// The timing goldens' file name in a scene's golden folder.
+pub const TIMING_FILE: &str = "timing.toml";
+
+const HEADER: &str = "\
+# Timing goldens, written by `harness bless` (see harness/src/golden/speed/mod.rs).
+# Per backend and pass: the speed ratio `harness check` compares (the pass submitted alone,
+# its fastest time over its floor's fastest, one rasterizer thread). `ms`, `floor_ms` and
+# `host` are for information only: milliseconds do not travel between hosts, ratios do.
+";
+
+/// One pass's timing golden.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PassTiming {
+    /// The speed ratio.
+    pub ratio: f64,
+    /// The pass's fastest time, ms (information).
+    pub ms: f64,
+    /// Its floor's fastest time, ms (information).
+    pub floor_ms: f64,
+}
+
+/// One backend's timing goldens.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct BackendTimings {
+    /// UTC time of the bless (RFC 3339).
+    pub blessed: String,
+    /// The host that blessed ([`super::host_fingerprint`]).
+    pub host: String,
+    /// Rounds the probe timed.
+    pub rounds: usize,
+    /// Per pass.
+    pub passes: BTreeMap<PassId, PassTiming>,
+}
+
+/// A scene's timing goldens, per backend.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TimingGoldens {
+    /// Per backend.
+    #[serde(flatten)]
+    pub backends: BTreeMap<BackendKind, BackendTimings>,
+}
+
+impl TimingGoldens {
+    /// The file of `scene` under the golden root.
+    pub fn path(root: &Path, scene: &str) -> PathBuf {
+        root.join(scene).join(TIMING_FILE)
+    }
+
+    /// Reads a scene's timing goldens; none yet is an empty set.
+    pub fn load(root: &Path, scene: &str) -> Result<Self, SpeedError> {
+        let path = Self::path(root, scene);
+        let text = match std::fs::read_to_string(&path) {
+            Ok(text) => text,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Self::default()),
+            Err(e) => {
+                return Err(SpeedError::File {
+                    path,
+                    message: e.to_string(),
+                })
+            }
+        };
+        toml::from_str(&text).map_err(|e| SpeedError::File {
+            path,
+            message: e.to_string(),
+        })
+    }
+
+    /// Writes them atomically (a temporary file renamed over the old one).
+    pub fn save(&self, root: &Path, scene: &str) -> Result<(), SpeedError> {
+        let path = Self::path(root, scene);
+        let body = toml::to_string(self).map_err(|e| SpeedError::File {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+        crate::images::write_atomically(&path, format!("{HEADER}\n{body}").as_bytes()).map_err(
+            |e| SpeedError::File {
+                path: path.clone(),
+                message: e.to_string(),
+            },
+        )
+    }
+
+    /// Records `probe`'s passes for its backend: every pass (`only` empty) or those in `only`,
+    /// keeping the others' goldens. `host` is the blessing host's fingerprint.
+    pub fn record(&mut self, probe: &SceneSpeed, only: &[PassId], host: &str, blessed: &str) {
+        let entry = self
+            .backends
+            .entry(probe.backend)
+            .or_insert_with(|| BackendTimings {
+                blessed: blessed.to_owned(),
+                host: host.to_owned(),
+                rounds: probe.rounds,
+                passes: BTreeMap::new(),
+            });
+        entry.blessed = blessed.to_owned();
+        entry.host = host.to_owned();
+        entry.rounds = probe.rounds;
+        for pass in &probe.passes {
+            if !only.is_empty() && !only.contains(&pass.pass) {
+                continue;
+            }
+            let (Some(ratio), Some(ms), Some(floor_ms)) =
+                (pass.ratio(), pass.min_ms(), pass.floor_min_ms())
+            else {
+                continue;
+            };
+            // Rounded so the file reads well; no limit depends on the fifth digit.
+            let round = |x: f64, digits: i32| (x * 10f64.powi(digits)).round() / 10f64.powi(digits);
+            entry.passes.insert(
+                pass.pass,
+                PassTiming {
+                    ratio: round(ratio, 4),
+                    ms: round(ms, 3),
+                    floor_ms: round(floor_ms, 3),
+                },
+            );
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::speed::PassSpeed;
+
+    #[test]
+    fn goldens_round_trip_and_a_partial_bless_keeps_the_other_passes() {
+        let dir = tempfile::tempdir().unwrap();
+        let probe = |ratio: f64| SceneSpeed {
+            scene: "s".to_owned(),
+            backend: BackendKind::Gl,
+            rounds: 3,
+            passes: vec![
+                PassSpeed {
+                    pass: PassId::Geometry,
+                    pass_ms: vec![ratio, ratio * 2.0],
+                    floor_ms: vec![1.0],
+                },
+                PassSpeed {
+                    pass: PassId::ToneMap,
+                    pass_ms: vec![ratio],
+                    floor_ms: vec![1.0],
+                },
+            ],
+        };
+        let mut goldens = TimingGoldens::default();
+        goldens.record(&probe(2.0), &[], "host a", "t0");
+        goldens.save(dir.path(), "s").unwrap();
+        let mut loaded = TimingGoldens::load(dir.path(), "s").unwrap();
+        assert_eq!(loaded, goldens);
+        loaded.record(&probe(3.0), &[PassId::ToneMap], "host b", "t1");
+        let gl = &loaded.backends[&BackendKind::Gl];
+        assert_eq!(gl.passes[&PassId::Geometry].ratio, 2.0);
+        assert_eq!(gl.passes[&PassId::ToneMap].ratio, 3.0);
+        assert_eq!(gl.host, "host b");
+        assert_eq!(
+            TimingGoldens::load(dir.path(), "none").unwrap(),
+            TimingGoldens::default()
+        );
+        std::fs::write(TimingGoldens::path(dir.path(), "s"), "[gl]\nblessed = 3").unwrap();
+        let error = TimingGoldens::load(dir.path(), "s")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("timing.toml"), "{error}");
+    }
+}

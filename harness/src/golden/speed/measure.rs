@@ -1,0 +1,316 @@
+//! Measuring the timing-noise model: unchanged builds probed under every source a user's
+//! machine can bring, each pass's ratio as a factor of its golden.
+//!
+//! This host's sources ([`Tier::SameHost`]): repeated runs, and runs beside a busy neighbour
+//! (a process spinning on one core, started and stopped here). Another host's
+//! ([`Tier::OtherHost`]): llvmpipe's other CPU code paths and the second Mesa, each as a
+//! child's environment. Each backend is measured against its own goldens, so the backends
+//! are sources of each other's figures only as far as they share the model's passes.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use engine::backend::BackendKind;
+use engine::plan::PassId;
+
+use super::{PassNoise, Tier, TimingGoldens, TimingNoise, CHECK_ROUNDS};
+
+/// A source of timing variation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimingSource {
+    /// Name (`runs`, `busy-neighbour`, `cpu-sse4.1`, `mesa-25.0.7`, ...).
+    pub name: String,
+    /// What it is.
+    pub description: String,
+    /// Whose noise it is.
+    pub tier: Tier,
+    /// Environment of the probes.
+    pub env: Vec<(String, String)>,
+    /// Whether a busy neighbour spins on one core during its probes.
+    pub busy: bool,
+    /// Probes taken.
+    pub probes: usize,
+}
+
+/// Probes of each source: the plain runs' count.
+pub const PLAIN_PROBES: usize = 4;
+
+/// Every timing source this machine can produce, and those it cannot with why.
+pub fn timing_sources() -> (Vec<TimingSource>, Vec<(String, String)>) {
+    let source =
+        |name: &str, description: &str, tier, env: &[(&str, &str)], busy, probes| TimingSource {
+            name: name.to_owned(),
+            description: description.to_owned(),
+            tier,
+            env: env
+                .iter()
+                .map(|(k, v)| ((*k).to_owned(), (*v).to_owned()))
+                .collect(),
+            busy,
+            probes,
+        };
+    let mut sources = vec![
+        source(
+            "runs",
+            "repeated probes of an unchanged build",
+            Tier::SameHost,
+            &[],
+            false,
+            PLAIN_PROBES,
+        ),
+        source(
+            "busy-neighbour",
+            "probes beside a process spinning on one core",
+            Tier::SameHost,
+            &[],
+            true,
+            2,
+        ),
+        source(
+            "cpu-sse4.1",
+            "llvmpipe/lavapipe limited to SSE4.1 code",
+            Tier::OtherHost,
+            &[("GALLIUM_OVERRIDE_CPU_CAPS", "sse4.1")],
+            false,
+            1,
+        ),
+        source(
+            "cpu-avx",
+            "llvmpipe/lavapipe limited to AVX code",
+            Tier::OtherHost,
+            &[("GALLIUM_OVERRIDE_CPU_CAPS", "avx")],
+            false,
+            1,
+        ),
+    ];
+    let mut missing = Vec::new();
+    match crate::golden::portability::mesa_backports() {
+        Ok((version, vars)) => {
+            let short = version.split('-').next().unwrap_or(&version).to_owned();
+            sources.push(TimingSource {
+                name: format!("mesa-{short}"),
+                description: format!("Mesa {version} from bookworm-backports, private prefix"),
+                tier: Tier::OtherHost,
+                env: vars,
+                busy: false,
+                probes: 2,
+            });
+        }
+        Err(why) => missing.push(("mesa".to_owned(), why)),
+    }
+    (sources, missing)
+}
+
+/// One pass's ratio under a source, as a factor of its golden.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct TimingMeasurement {
+    /// Source name.
+    pub source: String,
+    /// Its tier.
+    pub tier: Tier,
+    /// Scene.
+    pub scene: String,
+    /// Backend.
+    pub backend: BackendKind,
+    /// Pass.
+    pub pass: PassId,
+    /// Largest ratio / golden over the source's probes.
+    pub factor: f64,
+}
+
+/// A process spinning on one core while it lives: the busy neighbour.
+struct BusyNeighbour(Option<std::process::Child>);
+
+impl BusyNeighbour {
+    fn start() -> Self {
+        let child = std::process::Command::new("sh")
+            .args(["-c", "while :; do :; done"])
+            .stdin(std::process::Stdio::null())
+            .spawn();
+        if let Err(e) = &child {
+            eprintln!("warning: could not start the busy neighbour (sh): {e}");
+        }
+        Self(child.ok())
+    }
+}
+
+impl Drop for BusyNeighbour {
+    fn drop(&mut self) {
+        if let Some(child) = &mut self.0 {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+    }
+}
+
+/// Probes `scenes` (name, argument) on `backends` under each source, and each pass's largest
+/// factor over its golden under `root`; with the probes that failed.
+pub fn measure_timing(
+    exe: &Path,
+    root: &Path,
+    scenes: &[(String, String)],
+    backends: &[BackendKind],
+    sources: &[TimingSource],
+    mut progress: impl FnMut(&str),
+) -> (Vec<TimingMeasurement>, Vec<String>) {
+    let arguments: Vec<String> = scenes.iter().map(|(_, a)| a.clone()).collect();
+    let mut goldens = BTreeMap::new();
+    let mut errors = Vec::new();
+    for (scene, _) in scenes {
+        match TimingGoldens::load(root, scene) {
+            Ok(g) => {
+                goldens.insert(scene.clone(), g);
+            }
+            Err(e) => errors.push(e.to_string()),
+        }
+    }
+    let mut worst: BTreeMap<(String, String, BackendKind, PassId), (Tier, f64)> = BTreeMap::new();
+    for source in sources {
+        for &kind in backends {
+            for probe_index in 1..=source.probes {
+                progress(&format!(
+                    "{} on {kind}, probe {probe_index} of {}",
+                    source.name, source.probes
+                ));
+                let _neighbour = source.busy.then(BusyNeighbour::start);
+                let (probes, failed) = crate::measure::speed::probe_in_child(
+                    exe,
+                    &arguments,
+                    kind,
+                    CHECK_ROUNDS,
+                    Default::default(),
+                    &source.env,
+                );
+                errors.extend(failed.into_iter().map(|e| format!("{}: {e}", source.name)));
+                for probe in probes {
+                    let Some(golden) = goldens
+                        .get(&probe.scene)
+                        .and_then(|g| g.backends.get(&kind))
+                    else {
+                        continue;
+                    };
+                    for pass in &probe.passes {
+                        let (Some(ratio), Some(g)) = (pass.ratio(), golden.passes.get(&pass.pass))
+                        else {
+                            continue;
+                        };
+                        let factor = ratio / g.ratio;
+                        let key = (source.name.clone(), probe.scene.clone(), kind, pass.pass);
+                        let entry = worst.entry(key).or_insert((source.tier, factor));
+                        entry.1 = entry.1.max(factor);
+                    }
+                }
+            }
+        }
+    }
+    let measurements = worst
+        .into_iter()
+        .map(
+            |((source, scene, backend, pass), (tier, factor))| TimingMeasurement {
+                source,
+                tier,
+                scene,
+                backend,
+                pass,
+                factor,
+            },
+        )
+        .collect();
+    (measurements, errors)
+}
+
+/// The model from `measurements`: per pass, the largest factor of each tier and where.
+pub fn model_from(
+    measurements: &[TimingMeasurement],
+    sources: &[TimingSource],
+    margin: f64,
+) -> TimingNoise {
+    let mut model = TimingNoise {
+        margin,
+        sources: sources
+            .iter()
+            .map(|s| (s.name.clone(), s.description.clone()))
+            .collect(),
+        ..TimingNoise::default()
+    };
+    for m in measurements {
+        let entry = model
+            .scenes
+            .entry(m.scene.clone())
+            .or_default()
+            .entry(m.backend)
+            .or_default()
+            .entry(m.pass)
+            .or_insert_with(|| PassNoise {
+                host: 0.0,
+                host_at: "-".to_owned(),
+                drivers: 0.0,
+                drivers_at: "-".to_owned(),
+            });
+        let (value, at) = match m.tier {
+            Tier::SameHost => (&mut entry.host, &mut entry.host_at),
+            Tier::OtherHost => (&mut entry.drivers, &mut entry.drivers_at),
+        };
+        if m.factor > *value {
+            *value = ceil4(m.factor);
+            *at = m.source.clone();
+        }
+    }
+    model
+}
+
+/// `x` rounded up to 4 decimals (the file stays readable, and no measurement lies above its
+/// recorded figure).
+pub fn ceil4(x: f64) -> f64 {
+    (x * 1e4).ceil() / 1e4
+}
+
+/// Each measurement against the limit of its tier: `ln factor / ln limit` (at most 0.5 for
+/// every source under a margin of 2).
+pub fn scores(
+    model: &TimingNoise,
+    measurements: &[TimingMeasurement],
+) -> Vec<(TimingMeasurement, f64, f64)> {
+    measurements
+        .iter()
+        .filter_map(|m| {
+            let (figures, _) = model.figures(&m.scene, m.backend, m.pass)?;
+            let limit = model.limit(figures.noise(m.tier).0);
+            Some((m.clone(), limit, m.factor.max(1.0).ln() / limit.ln()))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_model_keeps_each_tiers_worst_source_and_scores_stay_at_half_the_limit() {
+        let m = |source: &str, tier, factor| TimingMeasurement {
+            source: source.to_owned(),
+            tier,
+            scene: "s".to_owned(),
+            backend: BackendKind::Gl,
+            pass: PassId::ToneMap,
+            factor,
+        };
+        let measurements = vec![
+            m("runs", Tier::SameHost, 1.1),
+            m("busy-neighbour", Tier::SameHost, 1.2),
+            m("cpu-avx", Tier::OtherHost, 1.3),
+            m("cpu-sse4.1", Tier::OtherHost, 0.9),
+        ];
+        let (sources, _) = timing_sources();
+        let model = model_from(&measurements, &sources, 2.0);
+        let noise = &model.scenes["s"][&BackendKind::Gl][&PassId::ToneMap];
+        assert_eq!(
+            (noise.host, noise.host_at.as_str()),
+            (1.2, "busy-neighbour")
+        );
+        assert_eq!((noise.drivers, noise.drivers_at.as_str()), (1.3, "cpu-avx"));
+        for (m, _, score) in scores(&model, &measurements) {
+            assert!(score <= 0.5 + 1e-9, "{m:?}: {score}");
+        }
+    }
+}

@@ -1,0 +1,185 @@
+//! Speed goldens: a slower pass fails the suite like a changed pixel.
+//!
+//! Each canonical scene's `golden/<scene>/timing.toml` records, per backend and pass, the
+//! pass's **speed ratio** from the speed probe ([`crate::measure::speed`]: the pass alone, its
+//! fastest time over its floor's fastest, interleaved round by round), blessed with the images.
+//! The milliseconds and the host are kept for information only; the ratio is what travels.
+//!
+//! `golden/timing-noise.toml` is the timing-noise model ([`TimingNoise`]), measured like the
+//! image one by `harness noise --timing --write`: per pass, the largest factor by which an
+//! unchanged build's ratio came out above its golden, under the sources of one host (repeated
+//! runs, a busy neighbour on one core, the other backends' own goldens) and under the sources
+//! of another host (llvmpipe's other CPU code paths, the second Mesa). A pass's limit is
+//!
+//! `limit = noise ^ margin`, i.e. `ln limit = margin x ln noise`,
+//!
+//! on the log scale, where slowdowns multiply; `noise` is at least [`MIN_NOISE`]. A check is
+//! scored as `ln(ratio / golden) / ln(limit)`: 1 at the limit, and unchanged runs under every
+//! measured source at 1/margin or less. On a host whose driver fingerprint differs from the one
+//! that blessed, the other-host figures count too, and a pass whose limit there would not catch
+//! a doubling is reported as untimed on that host, with the reason.
+//!
+//! The probe runs with llvmpipe/lavapipe on one rasterizer thread ([`PROBE_THREADS`]): the
+//! ratio then does not depend on the host's core count, and a busy neighbour on a two-core
+//! machine leaves the rasterizer a core of its own.
+
+mod bless;
+mod goldens;
+pub mod history;
+pub mod measure;
+mod model;
+pub mod selftest;
+mod verdict;
+
+use engine::backend::BackendKind;
+
+pub use bless::{bless_scenes, median_probe, SpeedBlessed};
+pub use goldens::{BackendTimings, PassTiming, TimingGoldens, TIMING_FILE};
+pub use model::{PassNoise, Tier, TimingNoise, TIMING_NOISE_FILE};
+pub use verdict::{check_speed, SpeedCheck, SpeedOutcome};
+
+/// The environment the speed probe runs under: one rasterizer thread.
+pub const PROBE_THREADS: (&str, &str) = ("LP_NUM_THREADS", "1");
+/// `ln limit = margin x ln noise`.
+pub const DEFAULT_TIMING_MARGIN: f64 = 2.0;
+/// The smallest noise factor a limit is derived from: no finite set of runs rules out a few
+/// per cent on the next one.
+pub const MIN_NOISE: f64 = 1.08;
+/// A limit that would not catch a pass taking this many times as long is no check: such a pass
+/// is untimed, with the reason.
+pub const MUST_CATCH: f64 = 2.0;
+/// Passes faster than this (their fastest sample, ms) are too short to time: timer resolution
+/// and fixed costs dominate.
+pub const MIN_PASS_MS: f64 = 0.15;
+
+/// Why timing goldens or the timing-noise model could not be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum SpeedError {
+    /// A file could not be read, parsed or written.
+    #[error("{path}: {message}")]
+    File {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// A speed probe failed.
+    #[error("speed probe: {0}")]
+    Probe(String),
+}
+
+/// The host as a speed check sees it: the backend's driver fingerprint, the CPU model, and the
+/// variables that change llvmpipe's code paths. Two hosts with the same one time alike.
+pub fn host_fingerprint(driver: &str) -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|text| {
+            text.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, name)| name.trim().to_owned())
+        })
+        .unwrap_or_else(|| "unknown CPU".to_owned());
+    format!("{driver} | CPU {cpu}")
+}
+
+/// Rounds of one speed check (each pass alone, then its floor, per round).
+pub const CHECK_ROUNDS: usize = crate::measure::speed::SPEED_ROUNDS;
+/// Probes a bless takes per backend; each pass's golden is the one with the median ratio.
+pub const BLESS_PROBES: usize = 3;
+
+/// The speed checks of a run, and what kept some from running.
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
+pub struct SpeedRun {
+    /// One per scene, backend and pass probed.
+    pub checks: Vec<SpeedCheck>,
+    /// Probes that failed (a backend or scene), each a failure of the run.
+    pub errors: Vec<String>,
+}
+
+impl SpeedRun {
+    /// Whether nothing failed: no pass slower than its limit, none without a golden, no probe
+    /// error.
+    pub fn passed(&self) -> bool {
+        self.errors.is_empty() && !self.checks.iter().any(SpeedCheck::failed)
+    }
+}
+
+/// Probes each of `scenes` (their command-line arguments, names or files) on each backend of
+/// `backends` (with its driver fingerprint) in a child process of `exe`, and checks every pass
+/// against the goldens under `root` and the timing-noise model there. `variations` are the
+/// slowdowns a self-test injects (none for a plain check); `env` is added to the children's.
+pub fn check_scenes(
+    exe: &std::path::Path,
+    root: &std::path::Path,
+    scenes: &[(String, String)],
+    backends: &[(BackendKind, String)],
+    variations: engine::renderer::Variations,
+    env: &[(String, String)],
+    mut progress: impl FnMut(&str),
+) -> SpeedRun {
+    let mut run = SpeedRun::default();
+    let noise = match TimingNoise::load(root) {
+        Ok(noise) => noise,
+        Err(e) => {
+            run.errors.push(e.to_string());
+            return run;
+        }
+    };
+    let arguments: Vec<String> = scenes
+        .iter()
+        .map(|(_, argument)| argument.clone())
+        .collect();
+    for (kind, driver) in backends {
+        progress(&format!("timing {} scene(s) on {kind}", scenes.len()));
+        let host = host_fingerprint(driver);
+        let (probes, errors) = crate::measure::speed::probe_in_child(
+            exe,
+            &arguments,
+            *kind,
+            CHECK_ROUNDS,
+            variations,
+            env,
+        );
+        run.errors.extend(errors);
+        for probe in probes {
+            match TimingGoldens::load(root, &probe.scene) {
+                Ok(goldens) => run
+                    .checks
+                    .extend(check_speed(&probe, &goldens, &noise, &host)),
+                Err(e) => run.errors.push(e.to_string()),
+            }
+        }
+    }
+    run
+}
+
+/// Appends a check's ratios to the speed history in `out` ([`history`]).
+pub fn append_history(out: &std::path::Path, run: &SpeedRun, backends: &[(BackendKind, String)]) {
+    if run.checks.is_empty() {
+        return;
+    }
+    history::append(
+        out,
+        &history::HistoryEntry {
+            time: humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string(),
+            command: "check".to_owned(),
+            commit: history::commit(),
+            hosts: backends
+                .iter()
+                .map(|(kind, driver)| (*kind, host_fingerprint(driver)))
+                .collect(),
+            ratios: run
+                .checks
+                .iter()
+                .map(|c| history::HistoryRatio {
+                    scene: c.scene.clone(),
+                    backend: c.backend,
+                    pass: c.pass,
+                    ratio: c.ratio,
+                    ms: c.ms,
+                })
+                .collect(),
+        },
+    );
+}

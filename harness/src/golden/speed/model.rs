@@ -1,0 +1,235 @@
+//! `golden/timing-noise.toml`: the timing-noise model, per scene, backend and pass, written by
+//! `harness noise --timing --write`, and the limits derived from it.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use engine::backend::BackendKind;
+use engine::plan::PassId;
+
+use super::{SpeedError, DEFAULT_TIMING_MARGIN, MIN_NOISE};
+
+/// The timing-noise model's file, in the golden folder.
+pub const TIMING_NOISE_FILE: &str = "timing-noise.toml";
+
+const HEADER: &str = "\
+# The timing-noise model, written by `harness noise --timing --write`.
+# Per scene, backend and pass: the largest factor an unchanged build's speed ratio came out
+# above its golden, under this host's sources (`host`: repeated runs, a busy neighbour) and
+# under another host's (`drivers`: llvmpipe's other CPU code paths, the second Mesa), with
+# where each was measured. A check's limit is max(noise, min_noise) ^ margin (on the log
+# scale, margin x the noise); on a host that did not bless, the `drivers` figure counts too.
+# See harness/src/golden/speed/mod.rs.
+";
+
+/// Which of a pass's figures a check's limit comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Tier {
+    /// The host that blessed the goldens (same driver fingerprint and CPU): its own noise.
+    SameHost,
+    /// Another host: its noise and the drivers' too.
+    OtherHost,
+}
+
+/// One pass's measured timing noise.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PassNoise {
+    /// Largest factor above the golden under this host's sources.
+    pub host: f64,
+    /// Where it was measured (`<source>`).
+    pub host_at: String,
+    /// Largest factor above the golden under another host's sources.
+    pub drivers: f64,
+    /// Where it was measured.
+    pub drivers_at: String,
+}
+
+impl PassNoise {
+    /// The noise a check in `tier` allows for, and where it was measured.
+    pub fn noise(&self, tier: Tier) -> (f64, &str) {
+        match tier {
+            Tier::OtherHost if self.drivers > self.host => (self.drivers, &self.drivers_at),
+            _ => (self.host, &self.host_at),
+        }
+    }
+}
+
+/// The timing-noise model.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TimingNoise {
+    /// `ln limit = margin x ln noise`.
+    pub margin: f64,
+    /// The smallest noise factor a limit is derived from.
+    pub min_noise: f64,
+    /// The command that regenerates the model.
+    #[serde(default)]
+    pub regenerate: String,
+    /// What each source is (name: description).
+    #[serde(default)]
+    pub sources: BTreeMap<String, String>,
+    /// Per scene, backend and pass.
+    #[serde(default)]
+    pub scenes: BTreeMap<String, BTreeMap<BackendKind, BTreeMap<PassId, PassNoise>>>,
+}
+
+impl Default for TimingNoise {
+    fn default() -> Self {
+        Self {
+            margin: DEFAULT_TIMING_MARGIN,
+            min_noise: MIN_NOISE,
+            regenerate: REGENERATE.to_owned(),
+            sources: BTreeMap::new(),
+            scenes: BTreeMap::new(),
+        }
+    }
+}
+
+/// The command that regenerates the model.
+pub const REGENERATE: &str =
+    "scripts/mesa-backports.sh && cargo run --release -p harness -- noise --timing --write";
+
+impl TimingNoise {
+    /// The file under the golden root.
+    pub fn path(root: &Path) -> PathBuf {
+        root.join(TIMING_NOISE_FILE)
+    }
+
+    /// Reads the model; none yet is an empty one (every pass then borrows nothing and is
+    /// untimed, with the reason).
+    pub fn load(root: &Path) -> Result<Self, SpeedError> {
+        let path = Self::path(root);
+        let text = match std::fs::read_to_string(&path) {
+            Ok(text) => text,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Self::default()),
+            Err(e) => {
+                return Err(SpeedError::File {
+                    path,
+                    message: e.to_string(),
+                })
+            }
+        };
+        let model: Self = toml::from_str(&text).map_err(|e| SpeedError::File {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+        if !(model.margin >= 1.0 && model.min_noise > 1.0) {
+            return Err(SpeedError::File {
+                path,
+                message: format!(
+                    "margin must be at least 1 and min_noise above 1 (they are {} and {})",
+                    model.margin, model.min_noise
+                ),
+            });
+        }
+        Ok(model)
+    }
+
+    /// Writes the model atomically.
+    pub fn save(&self, root: &Path) -> Result<(), SpeedError> {
+        let path = Self::path(root);
+        let body = toml::to_string(self).map_err(|e| SpeedError::File {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+        crate::images::write_atomically(&path, format!("{HEADER}\n{body}").as_bytes()).map_err(
+            |e| SpeedError::File {
+                path: path.clone(),
+                message: e.to_string(),
+            },
+        )
+    }
+
+    /// The figures of one pass: its own, or where the scene has none (a scene outside the
+    /// canonical set) the largest of the same backend and pass over the scenes that have them,
+    /// marked borrowed (true).
+    pub fn figures(
+        &self,
+        scene: &str,
+        backend: BackendKind,
+        pass: PassId,
+    ) -> Option<(PassNoise, bool)> {
+        if let Some(own) = self
+            .scenes
+            .get(scene)
+            .and_then(|b| b.get(&backend))
+            .and_then(|p| p.get(&pass))
+        {
+            return Some((own.clone(), false));
+        }
+        let others = self
+            .scenes
+            .values()
+            .filter_map(|b| b.get(&backend).and_then(|p| p.get(&pass)));
+        others
+            .fold(None::<PassNoise>, |worst, n| match worst {
+                None => Some(n.clone()),
+                Some(w) => Some(PassNoise {
+                    host: w.host.max(n.host),
+                    host_at: if n.host > w.host {
+                        n.host_at.clone()
+                    } else {
+                        w.host_at
+                    },
+                    drivers: w.drivers.max(n.drivers),
+                    drivers_at: if n.drivers > w.drivers {
+                        n.drivers_at.clone()
+                    } else {
+                        w.drivers_at
+                    },
+                }),
+            })
+            .map(|n| (n, true))
+    }
+
+    /// The limit (a factor) for a noise figure: `max(noise, min_noise) ^ margin`.
+    pub fn limit(&self, noise: f64) -> f64 {
+        noise.max(self.min_noise).powf(self.margin)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn noise(host: f64, drivers: f64) -> PassNoise {
+        PassNoise {
+            host,
+            host_at: "busy".to_owned(),
+            drivers,
+            drivers_at: "cpu-avx".to_owned(),
+        }
+    }
+
+    #[test]
+    fn limits_are_noise_to_the_margin_and_another_host_counts_the_drivers() {
+        let mut model = TimingNoise::default();
+        model.scenes.entry("a".to_owned()).or_default().insert(
+            BackendKind::Gl,
+            BTreeMap::from([(PassId::ToneMap, noise(1.2, 1.3))]),
+        );
+        model.scenes.entry("b".to_owned()).or_default().insert(
+            BackendKind::Gl,
+            BTreeMap::from([(PassId::ToneMap, noise(1.1, 1.5))]),
+        );
+        assert!((model.limit(1.2) - 1.44).abs() < 1e-12);
+        assert!((model.limit(1.01) - MIN_NOISE * MIN_NOISE).abs() < 1e-12);
+        let (own, borrowed) = model
+            .figures("a", BackendKind::Gl, PassId::ToneMap)
+            .unwrap();
+        assert!(!borrowed);
+        assert_eq!(own.noise(Tier::SameHost).0, 1.2);
+        assert_eq!(own.noise(Tier::OtherHost), (1.3, "cpu-avx"));
+        let (worst, borrowed) = model
+            .figures("new", BackendKind::Gl, PassId::ToneMap)
+            .unwrap();
+        assert!(borrowed);
+        assert_eq!((worst.host, worst.drivers), (1.2, 1.5));
+        assert!(model
+            .figures("a", BackendKind::WgpuGl, PassId::ToneMap)
+            .is_none());
+        let dir = tempfile::tempdir().unwrap();
+        model.save(dir.path()).unwrap();
+        assert_eq!(TimingNoise::load(dir.path()).unwrap(), model);
+    }
+}

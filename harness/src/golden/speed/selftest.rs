@@ -1,0 +1,147 @@
+//! The speed self-test: proof that the speed checks catch a slower pass, in that pass and in no
+//! other. Each pass of each scene is slowed down in turn ([`SlowPass`]: its work submitted
+//! ×1.5 and ×2), on every backend, and the check must flag it there and nowhere else. The
+//! unchanged side (every source at or below half its limit) is `harness noise --timing`'s.
+
+use engine::backend::BackendKind;
+use engine::plan::PassId;
+use engine::renderer::{SlowPass, Variations};
+
+use super::{check_scenes, SpeedCheck, SpeedOutcome};
+
+/// The slowdowns injected.
+pub const INJECTED: [f32; 2] = [1.5, 2.0];
+
+/// One injection's result.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Injection {
+    /// Scene.
+    pub scene: String,
+    /// Backend.
+    pub backend: BackendKind,
+    /// The pass slowed down.
+    pub pass: PassId,
+    /// By how much its work was multiplied.
+    pub factor: f32,
+    /// The slowdown measured in that pass (ratio / golden).
+    pub measured: Option<f64>,
+    /// Its score (`ln slowdown / ln limit`; above 1 is flagged).
+    pub score: Option<f64>,
+    /// Its limit; None when the pass is untimed (with the reason in `untimed`).
+    pub limit: Option<f64>,
+    /// Why the pass is not timed, if it is not.
+    pub untimed: Option<String>,
+    /// Whether the check flagged the pass.
+    pub flagged: bool,
+    /// Other passes of the scene the check flagged (must be none).
+    pub flagged_elsewhere: Vec<PassId>,
+    /// The largest score among the other passes.
+    pub worst_elsewhere: Option<f64>,
+}
+
+impl Injection {
+    /// Whether the injection behaved: flagged where it was injected (unless that pass is
+    /// untimed, which the table shows) and nowhere else.
+    pub fn correct(&self) -> bool {
+        (self.flagged || self.untimed.is_some()) && self.flagged_elsewhere.is_empty()
+    }
+}
+
+/// Injects each slowdown of `factors` into each pass of each scene on each backend and checks
+/// it (a child process per scene, backend and injection, under the same-host limits: run this
+/// on the host that blessed). `passes` limits the passes slowed (all when empty).
+pub fn run(
+    exe: &std::path::Path,
+    root: &std::path::Path,
+    scenes: &[(String, String, Vec<PassId>)],
+    backends: &[(BackendKind, String)],
+    factors: &[f32],
+    mut progress: impl FnMut(&str),
+) -> (Vec<Injection>, Vec<String>) {
+    let mut injections = Vec::new();
+    let mut errors = Vec::new();
+    for (scene, argument, passes) in scenes {
+        for backend in backends {
+            for &pass in passes {
+                for &factor in factors {
+                    progress(&format!("{scene} on {}: {pass} x{factor}", backend.0));
+                    let run = check_scenes(
+                        exe,
+                        root,
+                        &[(scene.clone(), argument.clone())],
+                        std::slice::from_ref(backend),
+                        Variations {
+                            slow_pass: Some(SlowPass { pass, factor }),
+                            ..Default::default()
+                        },
+                        &[],
+                        |_| {},
+                    );
+                    errors.extend(run.errors.iter().cloned());
+                    let own = run.checks.iter().find(|c| c.pass == pass);
+                    let others: Vec<&SpeedCheck> =
+                        run.checks.iter().filter(|c| c.pass != pass).collect();
+                    injections.push(Injection {
+                        scene: scene.clone(),
+                        backend: backend.0,
+                        pass,
+                        factor,
+                        measured: own.and_then(SpeedCheck::slowdown),
+                        score: own.and_then(SpeedCheck::score),
+                        limit: own.and_then(|c| c.limit),
+                        untimed: own.and_then(|c| match &c.outcome {
+                            SpeedOutcome::Untimed(why) => Some(why.clone()),
+                            _ => None,
+                        }),
+                        flagged: own.is_some_and(|c| c.outcome == SpeedOutcome::Slower),
+                        flagged_elsewhere: others
+                            .iter()
+                            .filter(|c| c.outcome == SpeedOutcome::Slower)
+                            .map(|c| c.pass)
+                            .collect(),
+                        worst_elsewhere: others.iter().filter_map(|c| c.score()).reduce(f64::max),
+                    });
+                }
+            }
+        }
+    }
+    (injections, errors)
+}
+
+/// The margin table: a row per injection with the value against the limit in its pass, the
+/// worst other pass, and the smallest slowdown the pass's limit detects.
+pub fn table(injections: &[Injection]) -> String {
+    let mut out = format!(
+        "{:<8} {:<12} {:<22} {:>6} {:>10} {:>12} {:>10} {:>14}  {}\n",
+        "scene",
+        "backend",
+        "pass",
+        "inject",
+        "measured",
+        "value/limit",
+        "detects",
+        "others' worst",
+        "verdict"
+    );
+    for i in injections {
+        let verdict = match (&i.untimed, i.correct()) {
+            (Some(why), _) => format!("untimed: {why}"),
+            (None, true) => "flagged here only".to_owned(),
+            (None, false) if !i.flagged => "MISSED".to_owned(),
+            (None, false) => format!("ALSO FLAGGED {}", crate::names(&i.flagged_elsewhere)),
+        };
+        out += &format!(
+            "{:<8} {:<12} {:<22} {:>6} {:>10} {:>12} {:>10} {:>14}  {verdict}\n",
+            i.scene,
+            i.backend.name(),
+            i.pass.to_string(),
+            format!("x{}", i.factor),
+            i.measured.map_or("-".to_owned(), |m| format!("x{m:.3}")),
+            i.score.map_or("-".to_owned(), |s| format!("{s:.2}")),
+            i.limit.map_or("-".to_owned(), |l| format!("x{l:.2}")),
+            i.worst_elsewhere
+                .map_or("-".to_owned(), |s| format!("{s:.2}")),
+        );
+    }
+    out
+}

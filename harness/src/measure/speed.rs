@@ -1,0 +1,329 @@
+//! The speed probe: what a timing golden records and `harness check` compares, a pass's cost as
+//! a number that travels between hosts.
+//!
+//! A frame is recorded once ([`RecordedFrame`]) and submitted whole once (every input filled,
+//! every pipeline compiled). Then, round after round, each pass is submitted alone and its
+//! floor (the cheapest pass writing the same targets, [`Floors`]) right after it, a short floor
+//! repeated in one submission to last [`MIN_FLOOR_MS`] (a 0.1 ms floor is mostly timer). The pass's
+//! **speed ratio** is the minimum of its times over the minimum of its floor's: a busy
+//! neighbour or a frequency step only ever adds time, so the fastest of several samples is the
+//! one closest to the work itself, and the floor, timed moments later in every round, cancels
+//! what the host's speed does to both. Rounds interleave the passes, so slow drift reaches each
+//! alike, and a pass stops sampling once it has settled (at least [`MIN_ROUNDS`] rounds, the
+//! last two finding nothing faster): a quiet machine takes few rounds, a busy one more.
+
+use engine::backend::{self, BackendKind};
+use engine::plan::PassId;
+use engine::renderer::{PreparedFrame, RecordedFrame, Variations};
+use engine::scene::Scene;
+
+use super::bench::{BenchError, Floors};
+
+/// The most rounds the speed probe takes by default (each: every pass that has not settled
+/// alone, then its floor); a quiet machine settles after [`MIN_ROUNDS`] or a few more.
+pub const SPEED_ROUNDS: usize = 12;
+
+/// One pass's samples from the speed probe.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct PassSpeed {
+    /// The plan pass.
+    pub pass: PassId,
+    /// Its GPU ms alone, one per round.
+    pub pass_ms: Vec<f64>,
+    /// Its floor's GPU ms, one per round, each timed right after the pass (the mean of its
+    /// copies where a short floor is repeated to last [`MIN_FLOOR_MS`]).
+    pub floor_ms: Vec<f64>,
+}
+
+impl PassSpeed {
+    /// The fastest of the pass's samples, ms.
+    pub fn min_ms(&self) -> Option<f64> {
+        self.pass_ms.iter().copied().reduce(f64::min)
+    }
+
+    /// The fastest of the floor's samples, ms.
+    pub fn floor_min_ms(&self) -> Option<f64> {
+        self.floor_ms.iter().copied().reduce(f64::min)
+    }
+
+    /// The speed ratio: the pass's fastest sample over its floor's fastest.
+    pub fn ratio(&self) -> Option<f64> {
+        let (pass, floor) = (self.min_ms()?, self.floor_min_ms()?);
+        (floor > 0.0).then(|| pass / floor)
+    }
+}
+
+/// The speed probe of one scene on one backend.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct SceneSpeed {
+    /// Scene name.
+    pub scene: String,
+    /// Backend.
+    pub backend: BackendKind,
+    /// The most rounds allowed (a pass that settles earlier has fewer samples).
+    pub rounds: usize,
+    /// Every plan pass that has a floor and a time, in plan order.
+    pub passes: Vec<PassSpeed>,
+}
+
+impl SceneSpeed {
+    /// The samples of `pass`.
+    pub fn pass(&self, pass: PassId) -> Option<&PassSpeed> {
+        self.passes.iter().find(|p| p.pass == pass)
+    }
+}
+
+/// Probes `scene` on `kind` for at most `rounds` rounds with `variations` applied to the frame (a
+/// [`SlowPass`](engine::renderer::SlowPass) injected by the speed self-test, the unspecialised
+/// lighting of `--debug-unspecialised-lighting`); the floors are never varied. A backend
+/// without timestamps gives no passes.
+pub fn probe(
+    scene: &Scene,
+    kind: BackendKind,
+    rounds: usize,
+    variations: Variations,
+) -> Result<SceneSpeed, BenchError> {
+    let backend_error = |e: backend::BackendError| BenchError::Backend {
+        backend: kind,
+        message: e.to_string(),
+    };
+    let render_error = |e: engine::renderer::RenderError| BenchError::Render {
+        scene: scene.name.clone(),
+        backend: kind,
+        message: e.to_string(),
+    };
+    let mut backend = backend::create(kind).map_err(backend_error)?;
+    let prepared = PreparedFrame::new(scene)
+        .map_err(render_error)?
+        .with_variations(variations);
+    let floors = Floors::new(backend.as_mut(), prepared.plan()).map_err(backend_error)?;
+    let recorded = match RecordedFrame::record(backend.as_mut(), &prepared) {
+        Ok(recorded) => recorded,
+        Err(e) => {
+            floors.destroy(backend.as_mut());
+            return Err(render_error(e));
+        }
+    };
+    let ids: Vec<PassId> = prepared.plan().passes.iter().map(|p| p.id).collect();
+    let result = sample(backend.as_mut(), &recorded, &floors, &ids, rounds.max(1));
+    recorded.destroy(backend.as_mut());
+    floors.destroy(backend.as_mut());
+    let passes = result.map_err(|e| match e {
+        SampleError::Render(e) => render_error(e),
+        SampleError::Backend(e) => backend_error(e),
+    })?;
+    Ok(SceneSpeed {
+        scene: scene.name.clone(),
+        backend: kind,
+        rounds: rounds.max(1),
+        passes,
+    })
+}
+
+/// The environment every speed probe runs under, on top of the caller's: one rasterizer
+/// thread (see [`crate::golden::speed`]).
+pub const PROBE_ENV: [(&str, &str); 1] = [crate::golden::speed::PROBE_THREADS];
+
+/// Runs the probe of `scenes` (names or scene files) on `backend` in a child process, `exe
+/// speed --in-process --json` (the harness binary), under [`PROBE_ENV`] and `env`: one
+/// rasterizer thread, which a process cannot choose for itself once its drivers have started.
+/// `variations` may hold a slowed pass and the unspecialised lighting (the ones `harness speed`
+/// takes); the others are not passed on. The scenes that were probed, and an error per scene
+/// or backend that failed.
+pub fn probe_in_child(
+    exe: &std::path::Path,
+    scenes: &[String],
+    backend: BackendKind,
+    rounds: usize,
+    variations: Variations,
+    env: &[(String, String)],
+) -> (Vec<SceneSpeed>, Vec<String>) {
+    let mut command = std::process::Command::new(exe);
+    command
+        .args([
+            "speed",
+            "--in-process",
+            "--json",
+            "--backend",
+            backend.name(),
+        ])
+        .args(["--rounds", &rounds.to_string()]);
+    for scene in scenes {
+        command.args(["--scene", scene]);
+    }
+    if let Some(slow) = variations.slow_pass {
+        command
+            .args(["--slow-pass", &slow.pass.to_string()])
+            .args(["--slowdown", &slow.factor.to_string()]);
+    }
+    if variations.unspecialised_lighting {
+        command.arg("--debug-unspecialised-lighting");
+    }
+    command.envs(PROBE_ENV.iter().map(|(k, v)| (*k, *v)));
+    command.envs(env.iter().map(|(k, v)| (k, v)));
+    let output = match command.output() {
+        Ok(output) => output,
+        Err(e) => {
+            return (
+                Vec::new(),
+                vec![format!("cannot run {}: {e}", exe.display())],
+            )
+        }
+    };
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let mut errors: Vec<String> = stderr
+        .lines()
+        .filter_map(|l| l.strip_prefix("error: "))
+        .map(|l| format!("{backend}: {l}"))
+        .collect();
+    match serde_json::from_slice::<Vec<SceneSpeed>>(&output.stdout) {
+        Ok(results) => (results, errors),
+        Err(_) => {
+            let tail: Vec<&str> = stderr
+                .lines()
+                .filter(|l| !l.contains("XDG_RUNTIME_DIR") && !l.contains("eglInitialize"))
+                .collect();
+            errors.push(format!(
+                "{backend}: the speed probe died ({}): {}",
+                output.status,
+                tail[tail.len().saturating_sub(3)..].join(" / ")
+            ));
+            (Vec::new(), errors)
+        }
+    }
+}
+
+/// A floor is timed at least this long (repeated in one submission), ms.
+pub const MIN_FLOOR_MS: f64 = 1.0;
+/// At most this many copies of a floor per sample.
+const MAX_FLOOR_COPIES: usize = 16;
+
+/// Copies of a floor whose one submission took `floor_ms` that last at least [`MIN_FLOOR_MS`].
+fn floor_copies(floor_ms: f64) -> usize {
+    if floor_ms <= 0.0 {
+        return MAX_FLOOR_COPIES;
+    }
+    ((MIN_FLOOR_MS / floor_ms).ceil() as usize).clamp(1, MAX_FLOOR_COPIES)
+}
+
+enum SampleError {
+    Render(engine::renderer::RenderError),
+    Backend(backend::BackendError),
+}
+
+/// The rounds: the whole frame once (every pass warm), every floor once (sizing its repeats),
+/// then round after round each pass that has not settled alone and its floor, until every pass
+/// has settled ([`settled`]) or `rounds` rounds were taken.
+fn sample(
+    backend: &mut dyn backend::Backend,
+    recorded: &RecordedFrame,
+    floors: &Floors,
+    ids: &[PassId],
+    rounds: usize,
+) -> Result<Vec<PassSpeed>, SampleError> {
+    recorded.submit(backend).map_err(SampleError::Render)?;
+    let mut passes: Vec<PassSpeed> = Vec::new();
+    let mut copies = Vec::new();
+    for &id in ids {
+        if let Some(floor_ns) = floors.time(backend, id).map_err(SampleError::Backend)? {
+            passes.push(PassSpeed {
+                pass: id,
+                pass_ms: Vec::with_capacity(rounds),
+                floor_ms: Vec::with_capacity(rounds),
+            });
+            copies.push(floor_copies(floor_ns / 1e6));
+        }
+    }
+    for _ in 0..rounds {
+        let mut sampled = false;
+        for (speed, &n) in passes.iter_mut().zip(&copies) {
+            if settled(speed) {
+                continue;
+            }
+            let pass_ns = recorded
+                .submit_pass(backend, speed.pass)
+                .map_err(SampleError::Render)?;
+            let floor_ns = floors
+                .time_repeated(backend, speed.pass, n)
+                .map_err(SampleError::Backend)?;
+            if let (Some(pass_ns), Some(floor_ns)) = (pass_ns, floor_ns) {
+                speed.pass_ms.push(pass_ns / 1e6);
+                speed.floor_ms.push(floor_ns / 1e6);
+                sampled = true;
+            }
+        }
+        if !sampled {
+            break;
+        }
+    }
+    passes.retain(|p| !p.pass_ms.is_empty());
+    Ok(passes)
+}
+
+/// Rounds every pass is sampled at least.
+pub const MIN_ROUNDS: usize = 4;
+/// A pass has settled when its last this many rounds improved neither its fastest time nor its
+/// floor's by more than [`SETTLE_TOLERANCE`].
+const SETTLE_ROUNDS: usize = 2;
+/// See [`SETTLE_ROUNDS`].
+const SETTLE_TOLERANCE: f64 = 0.01;
+
+/// Whether a pass needs no more rounds: [`MIN_ROUNDS`] taken, and the last [`SETTLE_ROUNDS`]
+/// found nothing faster by more than [`SETTLE_TOLERANCE`] (a busy neighbour keeps a pass
+/// sampling until it gets a quiet moment or the rounds run out).
+fn settled(speed: &PassSpeed) -> bool {
+    let n = speed.pass_ms.len();
+    if n < MIN_ROUNDS {
+        return false;
+    }
+    let still = |samples: &[f64]| {
+        let (earlier, last) = samples.split_at(n - SETTLE_ROUNDS);
+        let best_before = earlier.iter().copied().fold(f64::INFINITY, f64::min);
+        let best_last = last.iter().copied().fold(f64::INFINITY, f64::min);
+        best_last >= best_before * (1.0 - SETTLE_TOLERANCE)
+    };
+    still(&speed.pass_ms) && still(&speed.floor_ms)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_pass_settles_once_its_last_rounds_find_nothing_faster() {
+        let speed = |pass_ms: &[f64], floor_ms: &[f64]| PassSpeed {
+            pass: PassId::ToneMap,
+            pass_ms: pass_ms.to_vec(),
+            floor_ms: floor_ms.to_vec(),
+        };
+        let floor = [1.0; 4];
+        assert!(!settled(&speed(&[2.0, 2.0, 2.0], &floor[..3])));
+        assert!(settled(&speed(&[2.0, 1.9, 2.1, 1.95], &floor)));
+        assert!(!settled(&speed(&[2.0, 2.0, 2.0, 1.5], &floor)));
+        assert!(!settled(&speed(&[2.0; 4], &[1.0, 1.0, 0.9, 1.0])));
+    }
+
+    #[test]
+    fn short_floors_are_repeated_to_a_millisecond() {
+        assert_eq!(floor_copies(2.0), 1);
+        assert_eq!(floor_copies(0.3), 4);
+        assert_eq!(floor_copies(0.01), MAX_FLOOR_COPIES);
+        assert_eq!(floor_copies(0.0), MAX_FLOOR_COPIES);
+    }
+
+    #[test]
+    fn the_ratio_is_fastest_over_fastest() {
+        let speed = PassSpeed {
+            pass: PassId::ToneMap,
+            pass_ms: vec![3.0, 2.0, 9.0],
+            floor_ms: vec![1.0, 4.0, 0.5],
+        };
+        assert_eq!(speed.ratio(), Some(4.0));
+        let empty = PassSpeed {
+            pass: PassId::ToneMap,
+            pass_ms: vec![],
+            floor_ms: vec![],
+        };
+        assert_eq!(empty.ratio(), None);
+    }
+}
