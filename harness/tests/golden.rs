@@ -89,6 +89,31 @@ impl Suite {
         cell
     }
 
+    /// Fails when a pass was timed that has no timing golden for `kind`.
+    fn run_speed_goldens(&self, case: usize, kind: BackendKind) -> Result<(), Failed> {
+        let probed = self.probe(case, kind);
+        let checks = match probed.get() {
+            Some(Ok(checks)) => checks,
+            Some(Err(e)) => return Err(format!("speed probe failed: {e}").into()),
+            None => return Err("speed probe did not run".into()),
+        };
+        let missing: Vec<PassId> = checks
+            .iter()
+            .filter(|c| c.outcome == harness::golden::speed::SpeedOutcome::MissingGolden)
+            .map(|c| c.pass)
+            .collect();
+        if missing.is_empty() {
+            Ok(())
+        } else {
+            Err(format!(
+                "no timing golden on {kind} for {}; bless them: harness bless --scene {} --speed-only",
+                harness::names(&missing),
+                self.cases[case].argument()
+            )
+            .into())
+        }
+    }
+
     fn run_speed(&self, case: usize, pass: PassId, kind: BackendKind) -> Result<(), Failed> {
         let probed = self.probe(case, kind);
         let checks = match probed.get() {
@@ -238,15 +263,25 @@ fn main() {
     // The speed tests first: their probes then run before the renders start.
     let no_speed = std::env::var("HARNESS_NO_SPEED").is_ok_and(|v| v == "1");
     for (index, case) in suite.cases.iter().enumerate() {
-        let plan = case.frame.plan();
+        let goldens = harness::golden::speed::TimingGoldens::load(suite.store.root(), case.name())
+            .unwrap_or_default();
         for kind in BackendKind::ALL {
-            let passes = plan.passes.iter().map(|p| p.id);
-            for pass in passes.filter(|&id| harness::measure::bench::has_floor(plan, id)) {
+            let ignored = no_speed || !available.contains(&kind);
+            // Every pass timed without a golden fails here (a pass new to the plan).
+            let name = format!("{}::speed::goldens::{kind}", case.name());
+            let all = suite.clone();
+            trials.push(
+                Trial::test(name, move || all.run_speed_goldens(index, kind))
+                    .with_ignored_flag(ignored),
+            );
+            let timed = case.frame.plan().passes.iter().map(|p| p.id);
+            let blessed = goldens.backends.get(&kind);
+            for pass in timed.filter(|id| blessed.is_some_and(|b| b.passes.contains_key(id))) {
                 let name = format!("{}::speed::{pass}::{kind}", case.name());
                 let suite = suite.clone();
                 trials.push(
                     Trial::test(name, move || suite.run_speed(index, pass, kind))
-                        .with_ignored_flag(no_speed || !available.contains(&kind)),
+                        .with_ignored_flag(ignored),
                 );
             }
         }

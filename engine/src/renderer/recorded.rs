@@ -97,8 +97,8 @@ pub(super) fn named(scene: &str, e: RenderError) -> RenderError {
 }
 
 /// `passes` with `slow`'s extra copies of its pass's render passes right after each of them
-/// (see [`SlowPass`]): a fractional copy's viewports keep their top, at that fraction of their
-/// height (a pass with none gets one over that fraction of the target it writes first).
+/// (see [`SlowPass`]): a fractional copy's viewports are centred boxes of that fraction of
+/// their area (a pass with none gets one in the target it writes first).
 pub(super) fn slowed(
     plan: &RenderPlan,
     passes: Vec<RenderPass>,
@@ -133,7 +133,8 @@ pub(super) fn slowed(
     (out, out_owners)
 }
 
-/// `pass` again, its viewports cut to `fraction` of their height (the whole pass at 1).
+/// `pass` again, each viewport cut to a centred box of `fraction` of its area (the whole pass
+/// at 1).
 fn partial_copy(pass: &RenderPass, fraction: f32, target_size: Option<(f32, f32)>) -> RenderPass {
     let mut copy = pass.clone();
     if fraction >= 1.0 {
@@ -151,8 +152,16 @@ fn partial_copy(pass: &RenderPass, fraction: f32, target_size: Option<(f32, f32)
             });
         }
     }
+    // A centred box of that fraction of the area: a full-screen pass reads its inputs where
+    // its fragments are, and a scene's subject is framed in the middle (a top band might be
+    // all sky, and cost nothing).
+    let side = fraction.sqrt();
     for viewport in &mut copy.viewports {
-        viewport.height = (viewport.height * fraction).max(1.0);
+        let (width, height) = (viewport.width * side, viewport.height * side);
+        viewport.x += (viewport.width - width) / 2.0;
+        viewport.y += (viewport.height - height) / 2.0;
+        viewport.width = width.max(1.0);
+        viewport.height = height.max(1.0);
     }
     copy
 }
@@ -172,7 +181,7 @@ mod tests {
     }
 
     #[test]
-    fn a_fractional_copy_cuts_each_viewport_to_the_fraction_of_its_height() {
+    fn a_fractional_copy_cuts_each_viewport_to_a_centred_box_of_that_area() {
         let viewport = Viewport {
             x: 8.0,
             y: 16.0,
@@ -181,21 +190,16 @@ mod tests {
             min_depth: 0.0,
             max_depth: 1.0,
         };
-        let half = partial_copy(&pass("face", vec![viewport; 2]), 0.5, None);
-        assert!(half
+        let quarter = partial_copy(&pass("face", vec![viewport; 2]), 0.25, None);
+        assert!(quarter
             .viewports
             .iter()
-            .all(|v| v.height == 16.0 && v.y == 16.0 && v.width == 64.0));
+            .all(|v| (v.x, v.y, v.width, v.height) == (24.0, 24.0, 32.0, 16.0)));
         let whole = partial_copy(&pass("face", vec![viewport]), 1.0, None);
         assert_eq!(whole.viewports, vec![viewport]);
         let full_target = partial_copy(&pass("tonemap", vec![]), 0.25, Some((100.0, 40.0)));
         assert_eq!(full_target.viewports.len(), 1);
-        assert_eq!(
-            (
-                full_target.viewports[0].width,
-                full_target.viewports[0].height
-            ),
-            (100.0, 10.0)
-        );
+        let v = full_target.viewports[0];
+        assert_eq!((v.x, v.y, v.width, v.height), (25.0, 10.0, 50.0, 20.0));
     }
 }

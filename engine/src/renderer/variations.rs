@@ -35,8 +35,9 @@ pub struct Variations {
 
 /// An injected slowdown of one plan pass: its render passes are submitted `factor` times over.
 /// The whole part of `factor - 1` adds whole copies; the fraction adds one more copy whose
-/// viewports are that fraction of their height, so ×1.5 rasterises half the pass again (about
-/// half its fragment work; a vertex-bound pass slows by more).
+/// viewports are centred boxes of that fraction of their area, so ×1.5 rasterises the middle
+/// half of the pass again (about half its fragment work where the subject is framed in the
+/// middle; a vertex-bound pass slows by more, and a pass whose cost lies at the edges by less).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SlowPass {
     /// The pass slowed down.

@@ -131,16 +131,15 @@ pub(crate) fn speed(
     if available.is_empty() {
         anyhow::bail!("no backend is available; run `harness backends` for the reasons");
     }
-    // The passes with a floor, in plan order: those the speed checks time.
-    let scenes: Vec<(String, String, Vec<engine::plan::PassId>)> = cases
-        .iter()
-        .map(|c| {
-            let plan = c.frame.plan();
-            let passes = plan.passes.iter().map(|p| p.id);
-            let timed = passes.filter(|&id| harness::measure::bench::has_floor(plan, id));
-            (c.name().to_owned(), c.argument(), timed.collect())
-        })
-        .collect();
+    // The passes with timing goldens, in plan order: those the speed checks time.
+    let mut scenes: Vec<(String, String, Vec<engine::plan::PassId>)> = Vec::new();
+    for c in &cases {
+        let goldens = harness::golden::speed::TimingGoldens::load(store.root(), c.name())?;
+        let timed = c.frame.plan().passes.iter().map(|p| p.id);
+        let blessed =
+            timed.filter(|id| goldens.backends.values().any(|b| b.passes.contains_key(id)));
+        scenes.push((c.name().to_owned(), c.argument(), blessed.collect()));
+    }
     let (injections, errors) = selftest::run(
         &std::env::current_exe()?,
         store.root(),

@@ -67,6 +67,20 @@ pub struct SceneSpeed {
 }
 
 impl SceneSpeed {
+    /// This probe's samples and `other`'s together (the same scene and backend probed again):
+    /// each pass's samples of both, in order.
+    pub fn merged(&self, other: &SceneSpeed) -> SceneSpeed {
+        let mut merged = self.clone();
+        merged.rounds += other.rounds;
+        for pass in &mut merged.passes {
+            if let Some(more) = other.pass(pass.pass) {
+                pass.pass_ms.extend(&more.pass_ms);
+                pass.floor_ms.extend(&more.floor_ms);
+            }
+        }
+        merged
+    }
+
     /// The samples of `pass`.
     pub fn pass(&self, pass: PassId) -> Option<&PassSpeed> {
         self.passes.iter().find(|p| p.pass == pass)
@@ -309,6 +323,24 @@ mod tests {
         assert_eq!(floor_copies(0.3), 4);
         assert_eq!(floor_copies(0.01), MAX_FLOOR_COPIES);
         assert_eq!(floor_copies(0.0), MAX_FLOOR_COPIES);
+    }
+
+    #[test]
+    fn merged_probes_keep_every_sample() {
+        let probe = |pass_ms: f64| SceneSpeed {
+            scene: "s".to_owned(),
+            backend: BackendKind::Gl,
+            rounds: 4,
+            passes: vec![PassSpeed {
+                pass: PassId::ToneMap,
+                pass_ms: vec![pass_ms],
+                floor_ms: vec![1.0],
+            }],
+        };
+        let merged = probe(3.0).merged(&probe(2.0));
+        assert_eq!(merged.rounds, 8);
+        assert_eq!(merged.passes[0].pass_ms, vec![3.0, 2.0]);
+        assert_eq!(merged.passes[0].ratio(), Some(2.0));
     }
 
     #[test]

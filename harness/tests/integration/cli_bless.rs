@@ -27,9 +27,11 @@ fn snapshot(dir: &Path) -> std::collections::BTreeMap<PathBuf, (Vec<u8>, std::ti
 /// Runs `harness bless ARGS` against the workspace copy at `root`; fails the test unless it
 /// succeeds. Returns its stdout.
 fn bless_in(root: &Path, args: &[&str]) -> String {
+    // Images only: the timing goldens' bless is tested in speed.rs.
     let output = common::harness_command()
         .arg("bless")
         .args(args)
+        .arg("--no-speed")
         .env("HARNESS_ROOT", root)
         .output()
         .unwrap();
@@ -172,6 +174,7 @@ fn bless_after_a_light_change_rewrites_only_the_changed_passes() {
     let output = common::harness_command()
         .args([
             "check",
+            "--no-speed",
             "--backend",
             "gl",
             "--scene",
@@ -216,7 +219,15 @@ fn an_extracted_sun_gets_its_shadow_goldens() {
         assert!(records.contains(&format!("[passes.{pass}]")), "{records}");
     }
     let output = common::harness_command()
-        .args(["check", "--scene", "ibl_sun", "--backend", "gl", "--out"])
+        .args([
+            "check",
+            "--no-speed",
+            "--scene",
+            "ibl_sun",
+            "--backend",
+            "gl",
+            "--out",
+        ])
         .arg(root.path().join("out"))
         .env("HARNESS_ROOT", root.path())
         .output()

@@ -23,7 +23,14 @@ fn a_broken_scene_is_one_failed_case_and_the_others_are_checked() {
     std::fs::create_dir_all(stale.parent().unwrap()).unwrap();
     std::fs::write(&stale, b"old").unwrap();
     let output = common::harness_command()
-        .args(["check", "--backend", "gl", "--out", out.to_str().unwrap()])
+        .args([
+            "check",
+            "--no-speed",
+            "--backend",
+            "gl",
+            "--out",
+            out.to_str().unwrap(),
+        ])
         .env("HARNESS_ROOT", root.path())
         .output()
         .unwrap();
@@ -100,7 +107,14 @@ fn check_reports_failures_with_images_and_the_bless_command() {
     std::fs::remove_file(root.path().join("golden/arrow/light.exr")).unwrap();
     let out = root.path().join("out");
     let output = common::harness_command()
-        .args(["check", "--scene", "arrow", "--out", out.to_str().unwrap()])
+        .args([
+            "check",
+            "--no-speed",
+            "--scene",
+            "arrow",
+            "--out",
+            out.to_str().unwrap(),
+        ])
         .env("HARNESS_ROOT", root.path())
         .output()
         .unwrap();
@@ -215,7 +229,15 @@ fn check_notes_a_driver_other_than_the_blessing_one() {
     std::fs::write(&record, moved).unwrap();
     let out = root.path().join("out");
     let output = common::harness_command()
-        .args(["check", "--scene", "arrow", "--backend", "gl", "--out"])
+        .args([
+            "check",
+            "--no-speed",
+            "--scene",
+            "arrow",
+            "--backend",
+            "gl",
+            "--out",
+        ])
         .arg(&out)
         .env("HARNESS_ROOT", root.path())
         .output()

@@ -282,6 +282,7 @@ fn a_full_disk_while_writing_the_report_names_the_file_and_fails() {
     let output = with_full_disk(
         &[
             "check",
+            "--no-speed",
             "--scene",
             "arrow",
             "--backend",

@@ -32,4 +32,5 @@ mod renderer;
 mod report;
 mod selftest;
 mod shadows;
+mod speed;
 mod sweeps;

@@ -282,7 +282,15 @@ fn check_after_a_light_change() -> (tempfile::TempDir, PathBuf) {
     std::fs::write(&scene, text.replace("intensity = 2.5", "intensity = 3.0")).unwrap();
     let out = root.path().join("out");
     let output = common::harness_command()
-        .args(["check", "--scene", "arrow", "--backend", "gl", "--out"])
+        .args([
+            "check",
+            "--no-speed",
+            "--scene",
+            "arrow",
+            "--backend",
+            "gl",
+            "--out",
+        ])
         .arg(&out)
         .env("HARNESS_ROOT", root.path())
         .output()
