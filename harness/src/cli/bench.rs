@@ -284,7 +284,7 @@ pub(crate) fn speed(
             names.len()
         );
         let (probed, errors) =
-            harness::measure::speed::probe_in_child(&exe, &names, kind, rounds, variations, &[]);
+            harness::measure::speed::probe_in_child(&exe, &names, &[kind], rounds, variations, &[]);
         for e in &errors {
             eprintln!("error: {e}");
         }

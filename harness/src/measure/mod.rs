@@ -39,7 +39,21 @@ impl Section for HardCasesSection {
     }
 }
 
+/// The review page's plots of the speed history kept by `harness check`.
+pub struct SpeedHistorySection;
+
+impl Section for SpeedHistorySection {
+    fn html(&self, dir: &Path) -> String {
+        crate::golden::speed::history::report_section(dir)
+    }
+}
+
 /// Every section the measurements add to the review page, in page order.
-pub fn report_sections() -> [&'static dyn Section; 3] {
-    [&BenchSection, &SweepSection, &HardCasesSection]
+pub fn report_sections() -> [&'static dyn Section; 4] {
+    [
+        &SpeedHistorySection,
+        &BenchSection,
+        &SweepSection,
+        &HardCasesSection,
+    ]
 }

@@ -138,8 +138,9 @@ pub fn probe(
 /// thread (see [`crate::golden::speed`]).
 pub const PROBE_ENV: [(&str, &str); 1] = [crate::golden::speed::PROBE_THREADS];
 
-/// Runs the probe of `scenes` (names or scene files) on `backend` in a child process, `exe
-/// speed --in-process --json` (the harness binary), under [`PROBE_ENV`] and `env`: one
+/// Runs the probe of `scenes` (names or scene files) on `backends` (one after the other) in one
+/// child process, `exe speed --in-process --json` (the harness binary), under [`PROBE_ENV`] and
+/// `env`: one
 /// rasterizer thread, which a process cannot choose for itself once its drivers have started.
 /// `variations` may hold a slowed pass and the unspecialised lighting (the ones `harness speed`
 /// takes); the others are not passed on. The scenes that were probed, and an error per scene
@@ -147,21 +148,19 @@ pub const PROBE_ENV: [(&str, &str); 1] = [crate::golden::speed::PROBE_THREADS];
 pub fn probe_in_child(
     exe: &std::path::Path,
     scenes: &[String],
-    backend: BackendKind,
+    backends: &[BackendKind],
     rounds: usize,
     variations: Variations,
     env: &[(String, String)],
 ) -> (Vec<SceneSpeed>, Vec<String>) {
     let mut command = std::process::Command::new(exe);
     command
-        .args([
-            "speed",
-            "--in-process",
-            "--json",
-            "--backend",
-            backend.name(),
-        ])
+        .args(["speed", "--in-process", "--json"])
         .args(["--rounds", &rounds.to_string()]);
+    for backend in backends {
+        command.args(["--backend", backend.name()]);
+    }
+    let backend = crate::names(backends);
     for scene in scenes {
         command.args(["--scene", scene]);
     }

@@ -115,10 +115,10 @@ pub fn html(
     let _ = write!(
         out,
         "<h1>Render check: {}</h1><p>{} checks, {} failed, {} render errors, {} scenes that did \
-         not load.</p><div class=\"controls\"><label><input type=\"checkbox\" \
+         not load; {} speed checks, {} failed.</p><div class=\"controls\"><label><input type=\"checkbox\" \
          id=\"failures-only\"> show failures only</label> · <a href=\"#summary\">summary</a> · \
          <a href=\"#failing\">failing passes</a> · <a href=\"#passing\">passing passes</a> · \
-         <a href=\"#backends\">backends</a></div>",
+         <a href=\"#speed\">speed</a> · <a href=\"#backends\">backends</a></div>",
         if run.passed() {
             "<span class=\"pass\">passed</span>"
         } else {
@@ -127,7 +127,9 @@ pub fn html(
         run.results.len(),
         failed,
         run.render_errors.len(),
-        run.load_errors.len()
+        run.load_errors.len(),
+        run.speed.checks.len(),
+        run.speed.checks.iter().filter(|c| c.failed()).count() + run.speed.errors.len()
     );
     for broken in &run.load_errors {
         let _ = write!(
@@ -160,6 +162,7 @@ pub fn html(
     summary(&mut out, run);
     let mut blobs = Blobs::default();
     cases(&mut out, run, outputs, store, page_dir, &mut blobs);
+    tables::speed(&mut out, run);
     details(&mut out, run);
     if let Some(dir) = page_dir {
         for section in sections {

@@ -1,5 +1,5 @@
-//! The page's tables: the summary of every check (failing first), and the backends, their
-//! cross-backend agreement and GPU times per pass.
+//! The page's tables: the summary of every check (failing first), the speed checks, and the
+//! backends, their cross-backend agreement and GPU times per pass.
 
 use std::fmt::Write as _;
 
@@ -92,6 +92,65 @@ pub(super) fn details(out: &mut String, run: &CheckRun) {
             t.backend,
             t.pass,
             t.ms.map_or("-".to_owned(), |ms| format!("{ms:.3}"))
+        );
+    }
+    out.push_str("</table>");
+}
+
+/// The speed checks: one row per scene, backend and pass, failing first, with the slowdown
+/// against the golden, the limit and the value as a fraction of it, or why it is untimed.
+pub(super) fn speed(out: &mut String, run: &CheckRun) {
+    use crate::golden::speed::SpeedOutcome;
+    if run.speed.checks.is_empty() && run.speed.errors.is_empty() {
+        return;
+    }
+    out.push_str(
+        "<h2 id=\"speed\">Speed</h2><p>Each pass submitted alone, its fastest time over its \
+         floor's, against its timing golden (<code>golden/&lt;scene&gt;/timing.toml</code>; \
+         limits from <code>golden/timing-noise.toml</code>). A slower pass beyond its limit \
+         fails; a faster one is a note: bless it with <code>harness bless --scene S \
+         --speed-only</code> if intended.</p><table class=\"summary\"><tr><th>scene</th>\
+         <th>pass</th><th>backend</th><th>result</th><th>against golden</th><th>limit</th>\
+         <th>value / limit</th><th>ms</th><th>detail</th></tr>",
+    );
+    for e in &run.speed.errors {
+        let _ = write!(
+            out,
+            "<tr class=\"failed\"><td colspan=\"9\">speed probe failed: {}</td></tr>",
+            escape(e)
+        );
+    }
+    let mut rows: Vec<_> = run.speed.checks.iter().collect();
+    rows.sort_by_key(|c| !c.failed());
+    for c in rows {
+        let (class, label) = match &c.outcome {
+            SpeedOutcome::Passed => ("passed", "ok"),
+            SpeedOutcome::Slower => ("failed", "SLOWER"),
+            SpeedOutcome::Faster => ("passed", "faster"),
+            SpeedOutcome::Untimed(_) => ("passed", "untimed"),
+            SpeedOutcome::MissingGolden => ("failed", "no golden"),
+        };
+        let factor = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("x{v:.3}"));
+        let detail = match &c.outcome {
+            SpeedOutcome::Untimed(why) => why.clone(),
+            _ => c
+                .noise
+                .as_ref()
+                .map(|(n, at)| format!("noise x{n:.2} at {at}"))
+                .unwrap_or_default(),
+        };
+        let _ = write!(
+            out,
+            "<tr class=\"{class}\"><td>{}</td><td>{}</td><td>{}</td><td>{label}</td><td>{}</td>\
+             <td>{}</td><td>{}</td><td>{:.2}</td><td>{}</td></tr>",
+            escape(&c.scene),
+            c.pass,
+            c.backend,
+            factor(c.slowdown()),
+            factor(c.limit),
+            c.score().map_or("-".to_owned(), |s| format!("{s:.2}")),
+            c.ms,
+            escape(&detail)
         );
     }
     out.push_str("</table>");

@@ -101,7 +101,7 @@ pub fn bless_scenes(
             let (results, errors) = crate::measure::speed::probe_in_child(
                 exe,
                 &arguments,
-                *kind,
+                &[*kind],
                 CHECK_ROUNDS,
                 Default::default(),
                 &[],

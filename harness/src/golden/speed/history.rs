@@ -93,6 +93,105 @@ pub fn read(out: &Path) -> (Vec<HistoryEntry>, usize) {
     (entries, skipped)
 }
 
+/// The review page's plots of the history in `dir`: per scene and backend, each pass's speed
+/// ratio over the `check` runs recorded, as a factor of its first value there (a slow drift
+/// shows as a line climbing before it crosses a limit). Empty with fewer than two runs.
+pub fn report_section(dir: &Path) -> String {
+    let (entries, skipped) = read(dir);
+    let checks: Vec<&HistoryEntry> = entries.iter().filter(|e| e.command == "check").collect();
+    if checks.len() < 2 {
+        return String::new();
+    }
+    // (scene, backend) -> pass -> (run index, ratio)
+    let mut series: BTreeMap<(String, BackendKind), BTreeMap<PassId, Vec<(usize, f64)>>> =
+        BTreeMap::new();
+    for (index, entry) in checks.iter().enumerate() {
+        for r in &entry.ratios {
+            series
+                .entry((r.scene.clone(), r.backend))
+                .or_default()
+                .entry(r.pass)
+                .or_default()
+                .push((index, r.ratio));
+        }
+    }
+    let mut out = format!(
+        "<h2 id=\"speed-history\">Speed history</h2><p>Each pass's speed ratio over the last {} \
+         <code>check</code> runs in <code>{HISTORY_FILE}</code> (first {}, last {}), as a \
+         factor of its first value there.{}</p>",
+        checks.len(),
+        crate::html::escape(&checks[0].time),
+        crate::html::escape(&checks[checks.len() - 1].time),
+        if skipped > 0 {
+            format!(" {skipped} line(s) that did not parse were skipped.")
+        } else {
+            String::new()
+        }
+    );
+    for ((scene, backend), passes) in &series {
+        out.push_str(&format!(
+            "<figure>{}</figure>",
+            history_svg(&format!("{scene} on {backend}"), passes, checks.len())
+        ));
+    }
+    out
+}
+
+/// One plot (plotters): a line per pass, its ratios over runs divided by its first.
+fn history_svg(title: &str, passes: &BTreeMap<PassId, Vec<(usize, f64)>>, runs: usize) -> String {
+    use plotters::prelude::*;
+    let lines: Vec<(String, Vec<(f64, f64)>)> = passes
+        .iter()
+        .filter_map(|(pass, points)| {
+            let first = points.first()?.1;
+            (first > 0.0).then(|| {
+                let line = points.iter().map(|&(i, r)| (i as f64, r / first)).collect();
+                (pass.to_string(), line)
+            })
+        })
+        .collect();
+    let (lo, hi) = lines
+        .iter()
+        .flat_map(|(_, l)| l.iter().map(|p| p.1))
+        .fold((0.9f64, 1.1f64), |(a, b), y| (a.min(y), b.max(y)));
+    let mut svg = String::new();
+    let drawn = (|| -> Result<(), Box<dyn std::error::Error>> {
+        let root = SVGBackend::with_string(&mut svg, (480, 240)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 14))
+            .margin(10)
+            .x_label_area_size(28)
+            .y_label_area_size(44)
+            .build_cartesian_2d(0.0..(runs.max(2) - 1) as f64, (lo * 0.98)..(hi * 1.02))?;
+        chart
+            .configure_mesh()
+            .x_desc("check run")
+            .y_desc("ratio / first")
+            .label_style(("sans-serif", 10))
+            .draw()?;
+        for (index, (name, line)) in lines.iter().enumerate() {
+            let color = Palette99::pick(index).to_rgba();
+            chart
+                .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))?
+                .label(name.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], color));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 10))
+            .draw()?;
+        root.present()?;
+        Ok(())
+    })();
+    match drawn {
+        Ok(()) => svg,
+        Err(e) => format!("<p>plot failed: {e}</p>"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -130,5 +229,14 @@ mod tests {
         let (entries, skipped) = read(dir.path());
         assert_eq!(entries, vec![entry(2.0), entry(3.0)]);
         assert_eq!(skipped, 1);
+        let section = report_section(dir.path());
+        assert!(
+            section.contains("<svg") && section.contains("chess on gl"),
+            "{section}"
+        );
+        assert!(
+            section.contains("tonemap") && section.contains("1 line(s)"),
+            "{section}"
+        );
     }
 }

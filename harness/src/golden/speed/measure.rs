@@ -176,7 +176,7 @@ pub fn measure_timing(
                 let (probes, failed) = crate::measure::speed::probe_in_child(
                     exe,
                     &arguments,
-                    kind,
+                    &[kind],
                     CHECK_ROUNDS,
                     Default::default(),
                     &source.env,

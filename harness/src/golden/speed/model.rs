@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use engine::backend::BackendKind;
 use engine::plan::PassId;
 
-use super::{SpeedError, DEFAULT_TIMING_MARGIN, MIN_NOISE};
+use super::{SpeedError, DEFAULT_TIMING_MARGIN, MIN_NOISE, MIN_NOISE_SHORT, SHORT_PASS_MS};
 
 /// The timing-noise model's file, in the golden folder.
 pub const TIMING_NOISE_FILE: &str = "timing-noise.toml";
@@ -186,6 +186,17 @@ impl TimingNoise {
     pub fn limit(&self, noise: f64) -> f64 {
         noise.max(self.min_noise).powf(self.margin)
     }
+
+    /// The limit for a pass that takes `ms`: as [`TimingNoise::limit`], with the noise at
+    /// least [`MIN_NOISE_SHORT`] for a pass under [`SHORT_PASS_MS`].
+    pub fn limit_for(&self, noise: f64, ms: f64) -> f64 {
+        let floor = if ms < SHORT_PASS_MS {
+            MIN_NOISE_SHORT.max(self.min_noise)
+        } else {
+            self.min_noise
+        };
+        noise.max(floor).powf(self.margin)
+    }
 }
 
 #[cfg(test)]
@@ -214,6 +225,8 @@ mod tests {
         );
         assert!((model.limit(1.2) - 1.44).abs() < 1e-12);
         assert!((model.limit(1.01) - MIN_NOISE * MIN_NOISE).abs() < 1e-12);
+        assert_eq!(model.limit_for(1.2, 5.0), model.limit(1.2));
+        assert!((model.limit_for(1.1, 0.5) - MIN_NOISE_SHORT.powi(2)).abs() < 1e-12);
         let (own, borrowed) = model
             .figures("a", BackendKind::Gl, PassId::ToneMap)
             .unwrap();

@@ -137,7 +137,7 @@ pub fn check_speed(
             }
             None => (None, false),
         };
-        let limit = noise_figure.as_ref().map(|(n, _)| noise.limit(*n));
+        let limit = noise_figure.as_ref().map(|(n, _)| noise.limit_for(*n, ms));
         let outcome = if golden.is_none() {
             SpeedOutcome::MissingGolden
         } else if ms < MIN_PASS_MS {
@@ -238,8 +238,9 @@ mod tests {
 
     #[test]
     fn a_slower_pass_fails_a_faster_one_is_a_note_and_noise_decides_what_is_timed() {
+        // Tone mapping takes 3 ms (its floor 0.5 ms), geometry 4 ms (its floor 1 ms).
         let mut goldens = TimingGoldens::default();
-        goldens.record(&probe(1.0, 4.0), &[], "here", "t");
+        goldens.record(&probe(3.0, 4.0), &[], "here", "t");
         let noise = model();
         let verdict = |p: &SceneSpeed, host: &str, pass: PassId| {
             check_speed(p, &goldens, &noise, host)
@@ -247,7 +248,7 @@ mod tests {
                 .find(|c| c.pass == pass)
                 .unwrap()
         };
-        let same = verdict(&probe(1.0, 4.0), "here", PassId::ToneMap);
+        let same = verdict(&probe(3.0, 4.0), "here", PassId::ToneMap);
         assert_eq!(
             (same.outcome.clone(), same.tier),
             (SpeedOutcome::Passed, Tier::SameHost)
@@ -255,32 +256,43 @@ mod tests {
         assert_eq!(same.score(), Some(0.0));
         // Limit 1.1^2 = 1.21 here: x1.3 fails, x1.15 passes, x0.8 is a note.
         assert_eq!(
-            verdict(&probe(1.3, 4.0), "here", PassId::ToneMap).outcome,
+            verdict(&probe(3.9, 4.0), "here", PassId::ToneMap).outcome,
             SpeedOutcome::Slower
         );
-        let within = verdict(&probe(1.15, 4.0), "here", PassId::ToneMap);
+        let within = verdict(&probe(3.45, 4.0), "here", PassId::ToneMap);
         assert_eq!(within.outcome, SpeedOutcome::Passed);
         assert!((within.score().unwrap() - 1.15f64.ln() / 1.21f64.ln()).abs() < 1e-9);
         assert_eq!(
-            verdict(&probe(0.8, 4.0), "here", PassId::ToneMap).outcome,
+            verdict(&probe(2.4, 4.0), "here", PassId::ToneMap).outcome,
             SpeedOutcome::Faster
         );
         // Another host: 1.2^2 = 1.44 for tone mapping, 1.5^2 = 2.25 for geometry (untimed).
-        let other = verdict(&probe(1.3, 4.0), "there", PassId::ToneMap);
+        let other = verdict(&probe(3.9, 4.0), "there", PassId::ToneMap);
         assert_eq!(
             (other.outcome, other.tier),
             (SpeedOutcome::Passed, Tier::OtherHost)
         );
-        let noisy = verdict(&probe(1.0, 8.0), "there", PassId::Geometry);
+        let noisy = verdict(&probe(3.0, 8.0), "there", PassId::Geometry);
         assert!(
             matches!(&noisy.outcome, SpeedOutcome::Untimed(why) if why.contains("x1.50 (cpu-sse4.1)")),
             "{noisy:?}"
         );
         assert!(!noisy.failed());
         assert_eq!(
-            verdict(&probe(1.0, 8.0), "here", PassId::Geometry).outcome,
+            verdict(&probe(3.0, 8.0), "here", PassId::Geometry).outcome,
             SpeedOutcome::Slower
         );
+        // A short pass (under 2 ms) has a noise floor of 1.2: limit 1.44 even here.
+        let mut short_goldens = TimingGoldens::default();
+        short_goldens.record(&probe(1.0, 4.0), &[], "here", "t");
+        let short_pass = |ms: f64| {
+            check_speed(&probe(ms, 4.0), &short_goldens, &noise, "here")
+                .into_iter()
+                .find(|c| c.pass == PassId::ToneMap)
+                .unwrap()
+        };
+        assert_eq!(short_pass(1.3).outcome, SpeedOutcome::Passed);
+        assert_eq!(short_pass(1.5).outcome, SpeedOutcome::Slower);
         // Too short, and no golden.
         let short = verdict(&probe(0.1, 4.0), "here", PassId::ToneMap);
         assert!(
