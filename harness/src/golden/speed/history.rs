@@ -102,9 +102,7 @@ pub fn report_section(dir: &Path) -> String {
     if checks.len() < 2 {
         return String::new();
     }
-    // (scene, backend) -> pass -> (run index, ratio)
-    let mut series: BTreeMap<(String, BackendKind), BTreeMap<PassId, Vec<(usize, f64)>>> =
-        BTreeMap::new();
+    let mut series: BTreeMap<(String, BackendKind), PassSeries> = BTreeMap::new();
     for (index, entry) in checks.iter().enumerate() {
         for r in &entry.ratios {
             series
@@ -137,8 +135,11 @@ pub fn report_section(dir: &Path) -> String {
     out
 }
 
+/// Each pass's (run index, ratio) points.
+type PassSeries = BTreeMap<PassId, Vec<(usize, f64)>>;
+
 /// One plot (plotters): a line per pass, its ratios over runs divided by its first.
-fn history_svg(title: &str, passes: &BTreeMap<PassId, Vec<(usize, f64)>>, runs: usize) -> String {
+fn history_svg(title: &str, passes: &PassSeries, runs: usize) -> String {
     use plotters::prelude::*;
     let lines: Vec<(String, Vec<(f64, f64)>)> = passes
         .iter()
