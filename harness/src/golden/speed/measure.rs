@@ -32,8 +32,9 @@ pub struct TimingSource {
     pub probes: usize,
 }
 
-/// Probes of each source: the plain runs' count.
-pub const PLAIN_PROBES: usize = 4;
+/// Probes of the plain runs: enough to reach the tail of a pass's spread (with 4, check runs of
+/// the same build later came out up to x1.16 where the runs had seen x1.05).
+pub const PLAIN_PROBES: usize = 12;
 
 /// Every timing source this machine can produce, and those it cannot with why.
 pub fn timing_sources() -> (Vec<TimingSource>, Vec<(String, String)>) {
@@ -64,7 +65,7 @@ pub fn timing_sources() -> (Vec<TimingSource>, Vec<(String, String)>) {
             Tier::SameHost,
             &[],
             true,
-            2,
+            4,
         ),
         source(
             "cpu-sse4.1",
