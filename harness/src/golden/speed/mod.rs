@@ -8,8 +8,8 @@
 //! `golden/timing-noise.toml` is the timing-noise model ([`TimingNoise`]), measured like the
 //! image one by `harness noise --timing --write`: per pass, the largest factor by which an
 //! unchanged build's ratio came out above its golden, under the sources of one host (repeated
-//! runs, a busy neighbour on one core, the other backends' own goldens) and under the sources
-//! of another host (llvmpipe's other CPU code paths, the second Mesa). A pass's limit is
+//! runs, a busy neighbour on one core; each backend against its own goldens) and under the
+//! sources of another host (llvmpipe's other CPU code paths, the second Mesa). A pass's limit is
 //!
 //! `limit = noise ^ margin`, i.e. `ln limit = margin x ln noise`,
 //!
