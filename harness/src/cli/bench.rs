@@ -24,42 +24,15 @@ pub(crate) fn pass_table(
         slow_pass: slow,
         ..Default::default()
     };
-    let names = scenes_or_canonical(scenes);
-    let loaded = names
-        .iter()
-        .map(|n| harness::load_scene(n).map(|l| l.scene))
-        .collect::<Result<Vec<_>, _>>()?;
-    let kinds: Vec<BackendKind> = if backends.is_empty() {
-        BackendKind::ALL.to_vec()
-    } else {
-        backends.to_vec()
-    };
-    let mut results = Vec::new();
-    let mut failed = false;
-    for kind in kinds {
-        if let Err(e) = engine::backend::create(kind) {
-            eprintln!("skipping {kind}: {e}");
-            if !backends.is_empty() {
-                failed = true;
-            }
-            continue;
+    let loaded = load_scenes(scenes)?;
+    let (results, failed) = each_scene_and_backend(&loaded, backends, |scene, kind| {
+        eprintln!("timing {} on {kind} ({frames} frames) ...", scene.name);
+        let result = harness::measure::bench::bench_scene_with(scene, kind, frames, variations)?;
+        if !json {
+            println!("{}", harness::measure::bench::table(&result));
         }
-        for scene in &loaded {
-            eprintln!("timing {} on {kind} ({frames} frames) ...", scene.name);
-            match harness::measure::bench::bench_scene_with(scene, kind, frames, variations) {
-                Ok(result) => {
-                    if !json {
-                        println!("{}", harness::measure::bench::table(&result));
-                    }
-                    results.push(result);
-                }
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    failed = true;
-                }
-            }
-        }
-    }
+        Ok(result)
+    });
     let precompute = harness::measure::bench::precompute(&loaded);
     if !json {
         println!("precomputation (apart from frames):");
@@ -208,40 +181,15 @@ pub(crate) fn speed_in_process(
     variations: engine::renderer::Variations,
     json: bool,
 ) -> anyhow::Result<ExitCode> {
-    let names = scenes_or_canonical(scenes);
-    let loaded = names
-        .iter()
-        .map(|n| harness::load_scene(n).map(|l| l.scene))
-        .collect::<Result<Vec<_>, _>>()?;
-    let kinds: Vec<BackendKind> = if backends.is_empty() {
-        BackendKind::ALL.to_vec()
-    } else {
-        backends.to_vec()
-    };
-    let mut results = Vec::new();
-    let mut failed = false;
-    for kind in kinds {
-        if let Err(e) = engine::backend::create(kind) {
-            eprintln!("skipping {kind}: {e}");
-            failed |= !backends.is_empty();
-            continue;
+    let loaded = load_scenes(scenes)?;
+    let (results, failed) = each_scene_and_backend(&loaded, backends, |scene, kind| {
+        eprintln!("probing {} on {kind} ({rounds} rounds) ...", scene.name);
+        let result = harness::measure::speed::probe(scene, kind, rounds, variations)?;
+        if !json {
+            print_speed(&result);
         }
-        for scene in &loaded {
-            eprintln!("probing {} on {kind} ({rounds} rounds) ...", scene.name);
-            match harness::measure::speed::probe(scene, kind, rounds, variations) {
-                Ok(result) => {
-                    if !json {
-                        print_speed(&result);
-                    }
-                    results.push(result);
-                }
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    failed = true;
-                }
-            }
-        }
-    }
+        Ok(result)
+    });
     if json {
         println!("{}", serde_json::to_string_pretty(&results)?);
     }
@@ -391,4 +339,49 @@ pub(crate) fn speed_command(args: SpeedArgs) -> anyhow::Result<ExitCode> {
             args.json,
         )
     }
+}
+
+/// The scenes asked for (every canonical one when none is).
+fn load_scenes(scenes: &[String]) -> anyhow::Result<Vec<engine::scene::Scene>> {
+    Ok(scenes_or_canonical(scenes)
+        .iter()
+        .map(|n| harness::load_scene(n).map(|l| l.scene))
+        .collect::<Result<Vec<_>, _>>()?)
+}
+
+/// Runs `measure` on each scene on each backend asked for (every one when none is; a backend
+/// that does not start is skipped with a note, a failure when it was asked for), printing each
+/// error: the results and whether anything failed.
+fn each_scene_and_backend<R>(
+    scenes: &[engine::scene::Scene],
+    backends: &[BackendKind],
+    mut measure: impl FnMut(
+        &engine::scene::Scene,
+        BackendKind,
+    ) -> Result<R, harness::measure::bench::BenchError>,
+) -> (Vec<R>, bool) {
+    let kinds: Vec<BackendKind> = if backends.is_empty() {
+        BackendKind::ALL.to_vec()
+    } else {
+        backends.to_vec()
+    };
+    let mut results = Vec::new();
+    let mut failed = false;
+    for kind in kinds {
+        if let Err(e) = engine::backend::create(kind) {
+            eprintln!("skipping {kind}: {e}");
+            failed |= !backends.is_empty();
+            continue;
+        }
+        for scene in scenes {
+            match measure(scene, kind) {
+                Ok(result) => results.push(result),
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    failed = true;
+                }
+            }
+        }
+    }
+    (results, failed)
 }

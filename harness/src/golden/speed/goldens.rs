@@ -60,36 +60,12 @@ impl TimingGoldens {
 
     /// Reads a scene's timing goldens; none yet is an empty set.
     pub fn load(root: &Path, scene: &str) -> Result<Self, SpeedError> {
-        let path = Self::path(root, scene);
-        let text = match std::fs::read_to_string(&path) {
-            Ok(text) => text,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Self::default()),
-            Err(e) => {
-                return Err(SpeedError::File {
-                    path,
-                    message: e.to_string(),
-                })
-            }
-        };
-        toml::from_str(&text).map_err(|e| SpeedError::File {
-            path,
-            message: e.to_string(),
-        })
+        Ok(super::read_toml(&Self::path(root, scene))?.unwrap_or_default())
     }
 
     /// Writes them atomically (a temporary file renamed over the old one).
     pub fn save(&self, root: &Path, scene: &str) -> Result<(), SpeedError> {
-        let path = Self::path(root, scene);
-        let body = toml::to_string(self).map_err(|e| SpeedError::File {
-            path: path.clone(),
-            message: e.to_string(),
-        })?;
-        crate::images::write_atomically(&path, format!("{HEADER}\n{body}").as_bytes()).map_err(
-            |e| SpeedError::File {
-                path: path.clone(),
-                message: e.to_string(),
-            },
-        )
+        super::write_toml(&Self::path(root, scene), HEADER, self)
     }
 
     /// Records `probe`'s passes for its backend: every pass (`only` empty) or those in `only`,

@@ -80,6 +80,38 @@ pub enum SpeedError {
     Probe(String),
 }
 
+/// Reads a TOML file of the speed goldens: its value, or `None` when there is no file yet.
+fn read_toml<T: serde::de::DeserializeOwned>(
+    path: &std::path::Path,
+) -> Result<Option<T>, SpeedError> {
+    let error = |message: String| SpeedError::File {
+        path: path.to_owned(),
+        message,
+    };
+    match std::fs::read_to_string(path) {
+        Ok(text) => toml::from_str(&text)
+            .map(Some)
+            .map_err(|e| error(e.to_string())),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(error(e.to_string())),
+    }
+}
+
+/// Writes `value` as TOML under `header` atomically (a temporary file renamed over the old one).
+fn write_toml<T: serde::Serialize>(
+    path: &std::path::Path,
+    header: &str,
+    value: &T,
+) -> Result<(), SpeedError> {
+    let error = |message: String| SpeedError::File {
+        path: path.to_owned(),
+        message,
+    };
+    let body = toml::to_string(value).map_err(|e| error(e.to_string()))?;
+    crate::images::write_atomically(path, format!("{header}\n{body}").as_bytes())
+        .map_err(|e| error(e.to_string()))
+}
+
 /// The host as a speed check sees it: the backend's driver fingerprint, the CPU model, and the
 /// variables that change llvmpipe's code paths. Two hosts with the same one time alike.
 pub fn host_fingerprint(driver: &str) -> String {

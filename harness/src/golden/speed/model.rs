@@ -99,20 +99,9 @@ impl TimingNoise {
     /// untimed, with the reason).
     pub fn load(root: &Path) -> Result<Self, SpeedError> {
         let path = Self::path(root);
-        let text = match std::fs::read_to_string(&path) {
-            Ok(text) => text,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Self::default()),
-            Err(e) => {
-                return Err(SpeedError::File {
-                    path,
-                    message: e.to_string(),
-                })
-            }
+        let Some(model) = super::read_toml::<Self>(&path)? else {
+            return Ok(Self::default());
         };
-        let model: Self = toml::from_str(&text).map_err(|e| SpeedError::File {
-            path: path.clone(),
-            message: e.to_string(),
-        })?;
         if !(model.margin >= 1.0 && model.min_noise > 1.0) {
             return Err(SpeedError::File {
                 path,
@@ -127,17 +116,7 @@ impl TimingNoise {
 
     /// Writes the model atomically.
     pub fn save(&self, root: &Path) -> Result<(), SpeedError> {
-        let path = Self::path(root);
-        let body = toml::to_string(self).map_err(|e| SpeedError::File {
-            path: path.clone(),
-            message: e.to_string(),
-        })?;
-        crate::images::write_atomically(&path, format!("{HEADER}\n{body}").as_bytes()).map_err(
-            |e| SpeedError::File {
-                path: path.clone(),
-                message: e.to_string(),
-            },
-        )
+        super::write_toml(&Self::path(root), HEADER, self)
     }
 
     /// The figures of one pass: its own, or where the scene has none (a scene outside the
