@@ -34,12 +34,17 @@ fn timed_render(
     })
 }
 
-/// Sets the group's warm-up and measurement time for a benchmark whose iteration takes `one`.
+/// Sets the group's warm-up and measurement time for a benchmark from one run of its routine,
+/// timed by wall clock: criterion sizes its samples from the wall time of its warm-up, whatever
+/// time the routine reports.
 fn budget(
     group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
-    one: Duration,
+    run_once: impl FnOnce(),
 ) {
-    let (warm_up, measurement) = harness::measure::bench::criterion_budget(one, SAMPLES);
+    let start = std::time::Instant::now();
+    run_once();
+    let (warm_up, measurement) =
+        harness::measure::bench::criterion_budget(start.elapsed(), SAMPLES);
     group.warm_up_time(warm_up);
     group.measurement_time(measurement);
 }
@@ -71,7 +76,9 @@ fn passes(c: &mut Criterion) {
             let mut group = c.benchmark_group(format!("{}/{kind}", scene.name));
             group.sampling_mode(SamplingMode::Flat);
             group.sample_size(SAMPLES);
-            budget(&mut group, timed_render(backend.as_mut(), &prepared, None));
+            budget(&mut group, || {
+                timed_render(backend.as_mut(), &prepared, None);
+            });
             group.bench_function("frame", |b| {
                 b.iter_custom(|iters| {
                     (0..iters)
@@ -81,10 +88,9 @@ fn passes(c: &mut Criterion) {
             });
             for spec in &plan.passes {
                 let name = spec.id.to_string();
-                budget(
-                    &mut group,
-                    timed_render(backend.as_mut(), &prepared, Some(spec.id)),
-                );
+                budget(&mut group, || {
+                    timed_render(backend.as_mut(), &prepared, Some(spec.id));
+                });
                 group.bench_function(BenchmarkId::new(&name, "pass"), |b| {
                     b.iter_custom(|iters| {
                         (0..iters)
@@ -92,11 +98,9 @@ fn passes(c: &mut Criterion) {
                             .sum()
                     })
                 });
-                let floor_ns = floors.time(backend.as_mut(), spec.id).expect("floor pass");
-                budget(
-                    &mut group,
-                    Duration::from_nanos(floor_ns.unwrap_or(1e6) as u64),
-                );
+                budget(&mut group, || {
+                    floors.time(backend.as_mut(), spec.id).expect("floor pass");
+                });
                 group.bench_function(BenchmarkId::new(&name, "floor"), |b| {
                     b.iter_custom(|iters| {
                         (0..iters)

@@ -67,12 +67,17 @@ fn with_filter(scene: &Scene, filter: ShadowFilter) -> Scene {
     scene
 }
 
-/// Sets the group's warm-up and measurement time for a benchmark whose iteration takes `one`.
+/// Sets the group's warm-up and measurement time for a benchmark from one run of its routine,
+/// timed by wall clock: criterion sizes its samples from the wall time of its warm-up, whatever
+/// time the routine reports.
 fn budget(
     group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
-    one: Duration,
+    run_once: impl FnOnce(),
 ) {
-    let (warm_up, measurement) = harness::measure::bench::criterion_budget(one, SAMPLES);
+    let start = std::time::Instant::now();
+    run_once();
+    let (warm_up, measurement) =
+        harness::measure::bench::criterion_budget(start.elapsed(), SAMPLES);
     group.warm_up_time(warm_up);
     group.measurement_time(measurement);
 }
@@ -106,10 +111,9 @@ fn shadows(c: &mut Criterion) {
             let mut scene = arrow.clone();
             scene.quality.point_shadows = path;
             let scene = prepared(&scene);
-            budget(
-                &mut group,
-                timed_render(backend.as_mut(), &scene, shadow_0_map),
-            );
+            budget(&mut group, || {
+                timed_render(backend.as_mut(), &scene, shadow_0_map);
+            });
             group.bench_function(BenchmarkId::new("shadow_0", path.name()), |b| {
                 b.iter_custom(|iters| {
                     (0..iters)
@@ -136,7 +140,9 @@ fn shadows(c: &mut Criterion) {
             let selections: [(&str, &dyn Fn(PassId) -> bool); 2] =
                 [("shadow_0_map", &shadow_0_map), ("shadow_term_0", &term)];
             for (label, of) in selections {
-                budget(&mut group, timed_render(backend.as_mut(), &scene, of));
+                budget(&mut group, || {
+                    timed_render(backend.as_mut(), &scene, of);
+                });
                 group.bench_function(BenchmarkId::new(label, filter.name()), |b| {
                     b.iter_custom(|iters| {
                         (0..iters)

@@ -8,7 +8,7 @@
 //! backend's outputs instead of checking them, and checks the other backends against those.
 //!
 //! The speed checks are tests too, `<scene>::speed::<pass>::<backend>`, the verdicts of
-//! `harness check`: each (scene, backend) is probed once, in a child process (the harness
+//! `harness check`: each backend's scenes are probed once, in a child process (the harness
 //! binary, one rasterizer thread), while no render of this process runs. `HARNESS_NO_SPEED=1`
 //! marks them ignored.
 
@@ -34,7 +34,7 @@ struct Suite {
     cases: Vec<Case>,
     store: GoldenStore,
     frames: Mutex<HashMap<(usize, BackendKind), Rendered>>,
-    probes: Mutex<HashMap<(usize, BackendKind), Probed>>,
+    probes: Mutex<HashMap<BackendKind, Probed>>,
     update: bool,
     /// Checks that did not pass, for the HTML report written at the end.
     failures: Mutex<Vec<harness::golden::suite::PassCheck>>,
@@ -56,26 +56,31 @@ impl Suite {
         cell
     }
 
-    /// The speed checks of one scene on one backend, probed once.
-    fn probe(&self, case: usize, kind: BackendKind) -> Probed {
+    /// The speed checks of every scene on one backend, probed once (one child process: one
+    /// start and one compile of each scene's pipelines for the backend).
+    fn probe(&self, kind: BackendKind) -> Probed {
         let cell = self
             .probes
             .lock()
             .unwrap_or_else(|e| e.into_inner())
-            .entry((case, kind))
+            .entry(kind)
             .or_default()
             .clone();
         cell.get_or_init(|| {
             let _quiet = QUIET.write().unwrap_or_else(|e| e.into_inner());
-            let case = &self.cases[case];
             let driver = backend::probe(kind)
                 .info
                 .map(|info| golden::fingerprint(&info))
                 .unwrap_or_default();
+            let scenes: Vec<(String, String)> = self
+                .cases
+                .iter()
+                .map(|c| (c.name().to_owned(), c.argument()))
+                .collect();
             let run = harness::golden::speed::check_scenes(
                 std::path::Path::new(env!("CARGO_BIN_EXE_harness")),
                 self.store.root(),
-                &[(case.name().to_owned(), case.argument())],
+                &scenes,
                 &[(kind, driver)],
                 Default::default(),
                 &[],
@@ -89,14 +94,28 @@ impl Suite {
         cell
     }
 
+    /// The speed checks of one scene on one backend.
+    fn speed_checks(
+        &self,
+        case: usize,
+        kind: BackendKind,
+    ) -> Result<Vec<harness::golden::speed::SpeedCheck>, Failed> {
+        let probed = self.probe(kind);
+        let scene = self.cases[case].name();
+        match probed.get() {
+            Some(Ok(checks)) => Ok(checks
+                .iter()
+                .filter(|c| c.scene == scene)
+                .cloned()
+                .collect()),
+            Some(Err(e)) => Err(format!("speed probe failed: {e}").into()),
+            None => Err("speed probe did not run".into()),
+        }
+    }
+
     /// Fails when a pass was timed that has no timing golden for `kind`.
     fn run_speed_goldens(&self, case: usize, kind: BackendKind) -> Result<(), Failed> {
-        let probed = self.probe(case, kind);
-        let checks = match probed.get() {
-            Some(Ok(checks)) => checks,
-            Some(Err(e)) => return Err(format!("speed probe failed: {e}").into()),
-            None => return Err("speed probe did not run".into()),
-        };
+        let checks = self.speed_checks(case, kind)?;
         let missing: Vec<PassId> = checks
             .iter()
             .filter(|c| c.outcome == harness::golden::speed::SpeedOutcome::MissingGolden)
@@ -115,12 +134,7 @@ impl Suite {
     }
 
     fn run_speed(&self, case: usize, pass: PassId, kind: BackendKind) -> Result<(), Failed> {
-        let probed = self.probe(case, kind);
-        let checks = match probed.get() {
-            Some(Ok(checks)) => checks,
-            Some(Err(e)) => return Err(format!("speed probe failed: {e}").into()),
-            None => return Err("speed probe did not run".into()),
-        };
+        let checks = self.speed_checks(case, kind)?;
         let Some(check) = checks.iter().find(|c| c.pass == pass) else {
             return Err(format!("{pass} was not timed on {kind}").into());
         };

@@ -36,8 +36,9 @@ pub use series::{series, Series, SeriesPoint};
 pub use tables::{breakdown_table, series_table, table};
 pub use timing::{bench_scene, bench_scene_with, timed_render, PassBench, SceneBench};
 
-/// Criterion's warm-up and measurement time for a routine whose iteration takes `one` (the
-/// time it reports): `samples` samples of two iterations each. Flat sampling warns "Unable to
+/// Criterion's warm-up and measurement time for a routine whose iteration takes `one` by wall
+/// clock (criterion sizes samples from its warm-up's wall time, not from the GPU time a routine
+/// reports): `samples` samples of two iterations each. Flat sampling warns "Unable to
 /// complete N samples" whenever a sample gets one iteration; two each keep it quiet at twice
 /// the cost of one.
 pub fn criterion_budget(
