@@ -44,6 +44,7 @@ pub(crate) fn pass_table(
         &serde_json::json!({ "precompute": precompute, "scenes": results }),
     )?;
     save_bench_json(out, harness::measure::bench::BENCH_JSON, &text)?;
+    append_bench_history(out, &results);
     if json {
         println!("{text}");
     }
@@ -384,4 +385,33 @@ fn each_scene_and_backend<R>(
         }
     }
     (results, failed)
+}
+
+/// Appends the pass table's ratios (each pass over its floor, interleaved frames, lower
+/// quartile) to the speed history in `out`, as a `bench` entry.
+fn append_bench_history(out: &Path, results: &[harness::measure::bench::SceneBench]) {
+    use harness::golden::speed::{history, host_fingerprint};
+    let mut hosts = std::collections::BTreeMap::new();
+    let mut ratios = Vec::new();
+    for result in results {
+        hosts.entry(result.backend).or_insert_with(|| {
+            let driver = engine::backend::probe(result.backend)
+                .info
+                .map(|info| harness::golden::fingerprint(&info))
+                .unwrap_or_default();
+            host_fingerprint(&driver)
+        });
+        for pass in &result.passes {
+            if let (Some(ratio), Some(ms)) = (pass.ratio, pass.median_ms) {
+                ratios.push(history::HistoryRatio {
+                    scene: result.scene.clone(),
+                    backend: result.backend,
+                    pass: pass.pass,
+                    ratio,
+                    ms,
+                });
+            }
+        }
+    }
+    history::record(out, "bench", hosts, ratios);
 }

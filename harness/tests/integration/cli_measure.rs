@@ -7,7 +7,8 @@ use common::cli::{darken, harness};
 
 /// `harness bench --json`: for each scene, backend and pass, the median GPU time and its ratio
 /// to the floor (a trivial pass writing the same targets): each frame's ratio, with the floor
-/// submitted right after that frame, and their lower quartile; kept for the check report.
+/// submitted right after that frame, and their lower quartile; kept for the check report and
+/// appended to the speed history.
 #[test]
 fn bench_json_gives_each_pass_its_time_and_ratio_to_the_floor() {
     let dir = tempfile::tempdir().unwrap();
@@ -68,6 +69,12 @@ fn bench_json_gives_each_pass_its_time_and_ratio_to_the_floor() {
     }
     assert!(json["precompute"][0]["ms"].as_f64().unwrap() >= 0.0);
     assert!(dir.path().join("bench.json").is_file());
+    // And the speed history has a `bench` entry with each pass's ratio.
+    let (entries, skipped) = harness::golden::speed::history::read(dir.path());
+    assert_eq!((entries.len(), skipped), (1, 0));
+    assert_eq!(entries[0].command, "bench");
+    assert_eq!(entries[0].ratios.len(), passes.len());
+    assert!(entries[0].hosts.contains_key(&engine::BackendKind::Gl));
 }
 
 /// `harness sweep --out DIR` keeps its results in DIR, where `harness check --out DIR` finds

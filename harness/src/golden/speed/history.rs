@@ -74,6 +74,30 @@ pub fn append(out: &Path, entry: &HistoryEntry) {
     }
 }
 
+/// Appends one entry of `command` (`check` or `bench`) to the history in `out`, stamped with
+/// the time and the commit: `hosts` by backend, `ratios` as measured. Nothing when there are
+/// no ratios.
+pub fn record(
+    out: &Path,
+    command: &str,
+    hosts: BTreeMap<BackendKind, String>,
+    ratios: Vec<HistoryRatio>,
+) {
+    if ratios.is_empty() {
+        return;
+    }
+    append(
+        out,
+        &HistoryEntry {
+            time: humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string(),
+            command: command.to_owned(),
+            commit: commit(),
+            hosts,
+            ratios,
+        },
+    );
+}
+
 /// Reads the history in `out`: its entries in order, skipping lines that do not parse (a
 /// line cut short by a crash), with how many were skipped.
 pub fn read(out: &Path) -> (Vec<HistoryEntry>, usize) {

@@ -234,30 +234,20 @@ pub fn check_scenes(
 
 /// Appends a check's ratios to the speed history in `out` ([`history`]).
 pub fn append_history(out: &std::path::Path, run: &SpeedRun, backends: &[(BackendKind, String)]) {
-    if run.checks.is_empty() {
-        return;
-    }
-    history::append(
-        out,
-        &history::HistoryEntry {
-            time: humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string(),
-            command: "check".to_owned(),
-            commit: history::commit(),
-            hosts: backends
-                .iter()
-                .map(|(kind, driver)| (*kind, host_fingerprint(driver)))
-                .collect(),
-            ratios: run
-                .checks
-                .iter()
-                .map(|c| history::HistoryRatio {
-                    scene: c.scene.clone(),
-                    backend: c.backend,
-                    pass: c.pass,
-                    ratio: c.ratio,
-                    ms: c.ms,
-                })
-                .collect(),
-        },
-    );
+    let hosts = backends
+        .iter()
+        .map(|(kind, driver)| (*kind, host_fingerprint(driver)))
+        .collect();
+    let ratios = run
+        .checks
+        .iter()
+        .map(|c| history::HistoryRatio {
+            scene: c.scene.clone(),
+            backend: c.backend,
+            pass: c.pass,
+            ratio: c.ratio,
+            ms: c.ms,
+        })
+        .collect();
+    history::record(out, "check", hosts, ratios);
 }
