@@ -34,17 +34,13 @@ fn timed_render(
     })
 }
 
-/// Sets the group's warm-up and measurement time for a benchmark from one run of its routine,
-/// timed by wall clock: criterion sizes its samples from the wall time of its warm-up, whatever
-/// time the routine reports.
+/// Sets the group's warm-up and measurement time for a benchmark from one run of its routine
+/// ([`harness::measure::bench::criterion_budget`]).
 fn budget(
     group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
     run_once: impl FnOnce(),
 ) {
-    let start = std::time::Instant::now();
-    run_once();
-    let (warm_up, measurement) =
-        harness::measure::bench::criterion_budget(start.elapsed(), SAMPLES);
+    let (warm_up, measurement) = harness::measure::bench::criterion_budget(run_once, SAMPLES);
     group.warm_up_time(warm_up);
     group.measurement_time(measurement);
 }

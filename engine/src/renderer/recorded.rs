@@ -59,18 +59,17 @@ impl RecordedFrame {
         backend: &mut dyn Backend,
         pass: PassId,
     ) -> Result<Option<f64>, RenderError> {
-        let passes: Vec<RenderPass> = self
-            .passes
-            .iter()
-            .zip(&self.owners)
-            .filter(|(_, owner)| **owner == pass)
-            .map(|(p, _)| p.clone())
-            .collect();
-        if passes.is_empty() {
+        // A plan pass records its render passes in a row (a slowed pass's copies right after
+        // each of them), so they are one slice: nothing to clone between a pass and its floor.
+        let Some(start) = self.owners.iter().position(|owner| *owner == pass) else {
             return Ok(None);
-        }
+        };
+        let count = self.owners[start..]
+            .iter()
+            .take_while(|owner| **owner == pass)
+            .count();
         let timings = backend
-            .submit(&passes)
+            .submit(&self.passes[start..start + count])
             .map_err(|e| named(&self.scene, e.into()))?;
         Ok(timings.iter().map(|t| t.gpu_ns).sum())
     }

@@ -214,11 +214,7 @@ pub(crate) fn speed(
 ) -> anyhow::Result<ExitCode> {
     let exe = std::env::current_exe()?;
     let names = scenes_or_canonical(scenes);
-    let kinds: Vec<BackendKind> = if backends.is_empty() {
-        BackendKind::ALL.to_vec()
-    } else {
-        backends.to_vec()
-    };
+    let kinds = backends_or_all(backends);
     let mut results = Vec::new();
     let mut failed = false;
     for kind in kinds {
@@ -361,11 +357,7 @@ fn each_scene_and_backend<R>(
         BackendKind,
     ) -> Result<R, harness::measure::bench::BenchError>,
 ) -> (Vec<R>, bool) {
-    let kinds: Vec<BackendKind> = if backends.is_empty() {
-        BackendKind::ALL.to_vec()
-    } else {
-        backends.to_vec()
-    };
+    let kinds = backends_or_all(backends);
     let mut results = Vec::new();
     let mut failed = false;
     for kind in kinds {
@@ -414,4 +406,13 @@ fn append_bench_history(out: &Path, results: &[harness::measure::bench::SceneBen
         }
     }
     history::record(out, "bench", hosts, ratios);
+}
+
+/// The backends asked for, or every one when none is.
+fn backends_or_all(backends: &[BackendKind]) -> Vec<BackendKind> {
+    if backends.is_empty() {
+        BackendKind::ALL.to_vec()
+    } else {
+        backends.to_vec()
+    }
 }

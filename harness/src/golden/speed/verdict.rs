@@ -138,20 +138,13 @@ pub fn check_speed(
             None => (None, false),
         };
         let limit = noise_figure.as_ref().map(|(n, _)| noise.limit_for(*n, ms));
-        let outcome = if golden.is_none() {
-            SpeedOutcome::MissingGolden
-        } else if ms < MIN_PASS_MS {
-            SpeedOutcome::Untimed(format!(
+        let outcome = match (golden, &noise_figure, limit) {
+            (None, ..) => SpeedOutcome::MissingGolden,
+            _ if ms < MIN_PASS_MS => SpeedOutcome::Untimed(format!(
                 "too short to time ({ms:.3} ms, under {MIN_PASS_MS} ms)"
-            ))
-        } else {
-            match (limit, &noise_figure) {
-                (None, _) | (_, None) => SpeedOutcome::Untimed(format!(
-                    "no timing noise measured for {} on {} (measure it with `harness noise \
-                     --timing --write`)",
-                    pass.pass, probe.backend
-                )),
-                (Some(limit), Some((n, at))) if limit >= MUST_CATCH => {
+            )),
+            (Some(golden), Some((n, at)), Some(limit)) => {
+                if limit >= MUST_CATCH {
                     SpeedOutcome::Untimed(format!(
                         "too noisy to time {}: its ratio moved up to x{n:.2} ({at}), so a \
                          limit of x{limit:.2} would not catch a doubling",
@@ -160,18 +153,19 @@ pub fn check_speed(
                             Tier::OtherHost => "on a host that did not bless",
                         }
                     ))
-                }
-                (Some(limit), Some(_)) => {
-                    let slowdown = ratio / golden.unwrap_or(ratio);
-                    if slowdown > limit {
-                        SpeedOutcome::Slower
-                    } else if slowdown < 1.0 / limit {
-                        SpeedOutcome::Faster
-                    } else {
-                        SpeedOutcome::Passed
-                    }
+                } else if ratio / golden > limit {
+                    SpeedOutcome::Slower
+                } else if ratio / golden < 1.0 / limit {
+                    SpeedOutcome::Faster
+                } else {
+                    SpeedOutcome::Passed
                 }
             }
+            _ => SpeedOutcome::Untimed(format!(
+                "no timing noise measured for {} on {} (measure it with `harness noise \
+                 --timing --write`)",
+                pass.pass, probe.backend
+            )),
         };
         checks.push(SpeedCheck {
             scene: probe.scene.clone(),

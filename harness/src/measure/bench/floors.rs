@@ -11,18 +11,6 @@ use engine::backend::{
 use engine::plan::{PassId, RenderPlan};
 use engine::shaders;
 
-/// Whether plan pass `pass` has a floor: it writes a depth target or 1 to 5 color targets (the
-/// floor shader's outputs). The passes the speed checks time are these.
-pub fn has_floor(plan: &RenderPlan, pass: PassId) -> bool {
-    let Some(spec) = plan.passes.iter().find(|p| p.id == pass) else {
-        return false;
-    };
-    let targets: Vec<_> = spec.writes.iter().filter_map(|w| plan.target(*w)).collect();
-    let colors = targets.iter().filter(|t| !t.format.is_depth()).count();
-    let depth = targets.iter().any(|t| t.format.is_depth());
-    colors <= 5 && (colors > 0 || depth)
-}
-
 /// Floor passes for every pass of a plan, created once on a backend and submitted on demand.
 pub struct Floors {
     scope: ResourceScope,
@@ -61,7 +49,7 @@ impl Floors {
             let targets: Vec<_> = spec.writes.iter().filter_map(|w| plan.target(*w)).collect();
             let colors: Vec<_> = targets.iter().filter(|t| !t.format.is_depth()).collect();
             let depth = targets.iter().find(|t| t.format.is_depth());
-            if !has_floor(plan, spec.id) {
+            if colors.len() > 5 || (colors.is_empty() && depth.is_none()) {
                 continue;
             }
             let key = format!(
@@ -155,11 +143,7 @@ impl Floors {
     /// Submits the floor of plan pass `pass` once; its GPU ns (None without timestamps or when
     /// the pass has no floor).
     pub fn time(&self, backend: &mut dyn Backend, pass: PassId) -> backend::Result<Option<f64>> {
-        let Some(floor) = self.passes.get(&pass) else {
-            return Ok(None);
-        };
-        let timings = backend.submit(std::slice::from_ref(floor))?;
-        Ok(timings.first().and_then(|t| t.gpu_ns))
+        self.time_repeated(backend, pass, 1)
     }
 
     /// Submits the floor of plan pass `pass` `copies` times in one submission: the GPU ns of

@@ -28,7 +28,7 @@ mod timing;
 
 use engine::backend::BackendKind;
 
-pub use floors::{has_floor, Floors};
+pub use floors::Floors;
 pub use lighting_breakdown::{breakdown, BreakdownRow, PassBreakdown, BREAKDOWN_FRAMES};
 pub use precompute::{precompute, Precompute};
 pub use report::{report_sections, series_svg, BENCH_JSON, SERIES_JSON};
@@ -36,16 +36,18 @@ pub use series::{series, Series, SeriesPoint};
 pub use tables::{breakdown_table, series_table, table};
 pub use timing::{bench_scene, bench_scene_with, timed_render, PassBench, SceneBench};
 
-/// Criterion's warm-up and measurement time for a routine whose iteration takes `one` by wall
-/// clock (criterion sizes samples from its warm-up's wall time, not from the GPU time a routine
-/// reports): `samples` samples of two iterations each. Flat sampling warns "Unable to
+/// Criterion's warm-up and measurement time for a benchmark, from one run of its routine timed
+/// by wall clock (criterion sizes samples from its warm-up's wall time, not from the GPU time a
+/// routine reports): `samples` samples of two iterations each. Flat sampling warns "Unable to
 /// complete N samples" whenever a sample gets one iteration; two each keep it quiet at twice
 /// the cost of one.
 pub fn criterion_budget(
-    one: std::time::Duration,
+    run_once: impl FnOnce(),
     samples: usize,
 ) -> (std::time::Duration, std::time::Duration) {
-    let one = one.max(std::time::Duration::from_micros(10));
+    let start = std::time::Instant::now();
+    run_once();
+    let one = start.elapsed().max(std::time::Duration::from_micros(10));
     (one, one.mul_f64(samples as f64 * 1.5))
 }
 
