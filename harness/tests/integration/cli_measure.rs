@@ -217,11 +217,12 @@ fn noise_measures_sources_and_fails_when_a_golden_moved() {
     assert_eq!(code, 1);
     assert!(stderr.contains("--write records every source"), "{stderr}");
 
-    // A golden darkened by 2/255 is no noise: the drivers source fails against it.
+    // A golden darkened by 2/255 is no noise: a source fails against it (host-b's recorded
+    // renders: the same comparison as a rendering source's, without rendering again).
     let root = common::temp_workspace();
     darken(&root.path().join("golden/ibl/final.png"), 2);
     let output = common::harness_command()
-        .args(["noise", "--source", "drivers", "--scene", "ibl"])
+        .args(["noise", "--source", "host-b", "--scene", "ibl"])
         .env("HARNESS_ROOT", root.path())
         .output()
         .unwrap();
@@ -230,7 +231,7 @@ fn noise_measures_sources_and_fails_when_a_golden_moved() {
     assert!(
         stdout
             .lines()
-            .any(|l| l.starts_with("FAILED: drivers ibl final")),
+            .any(|l| l.starts_with("FAILED: host-b ibl final")),
         "{stdout}"
     );
 }

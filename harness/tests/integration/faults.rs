@@ -170,10 +170,10 @@ fn a_failed_readback_names_the_scene_the_output_and_the_backend() {
 /// fault is in one, and the golden suite checks every scene on every backend.)
 #[test]
 fn a_backend_lost_mid_run_fails_its_scene_and_the_run_goes_on() {
+    harness::use_ibl_cache();
     let Some(&kind) = common::available_backends().first() else {
         return;
     };
-    harness::use_ibl_cache();
     let cases = harness::golden::suite::canonical_cases().unwrap();
     let store = harness::golden::GoldenStore::workspace();
     let created = AtomicUsize::new(0);
@@ -301,7 +301,8 @@ fn a_full_disk_while_writing_the_report_names_the_file_and_fails() {
 
 /// Kills `harness bless` while its new golden sits written but not yet renamed (the write is
 /// held there by HARNESS_FAULT_WRITE_DELAY_MS): the old golden and blessed.toml are intact. The
-/// next bless removes the dead process's temporary file.
+/// next bless removes the dead process's temporary file. Images only (`--no-speed`): the
+/// timing goldens are written through the same atomic write, tested in speed.rs.
 #[test]
 fn killing_a_bless_mid_write_leaves_the_old_golden_intact() {
     if !common::gl_available() {
@@ -312,7 +313,7 @@ fn killing_a_bless_mid_write_leaves_the_old_golden_intact() {
     let before = std::fs::read(golden.join("final.png")).unwrap();
     let record = std::fs::read(golden.join("blessed.toml")).unwrap();
     let mut child = harness_bin()
-        .args(["bless", "--scene", "chess", "--pass", "final"])
+        .args(["bless", "--scene", "chess", "--pass", "final", "--no-speed"])
         .env("HARNESS_ROOT", root.path())
         .env(harness::images::WRITE_DELAY_ENV, "60000")
         .stdout(std::process::Stdio::null())
@@ -334,7 +335,7 @@ fn killing_a_bless_mid_write_leaves_the_old_golden_intact() {
     assert_eq!(std::fs::read(golden.join("blessed.toml")).unwrap(), record);
 
     let status = harness_bin()
-        .args(["bless", "--scene", "chess", "--pass", "final"])
+        .args(["bless", "--scene", "chess", "--pass", "final", "--no-speed"])
         .env("HARNESS_ROOT", root.path())
         .output()
         .unwrap();

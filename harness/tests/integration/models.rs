@@ -9,6 +9,7 @@ use engine::plan::{GBufferTarget, TargetId};
 use engine::renderer::{self, Readback};
 
 fn crate_scene() -> engine::scene_file::LoadedScene {
+    harness::use_ibl_cache();
     harness::load_scene(
         harness::workspace_root()
             .join("scenes/models/crate.toml")

@@ -21,6 +21,7 @@ const REQUIRED_SOURCES: [&str; 7] = [
 
 #[test]
 fn every_golden_check_has_figures_and_a_limit_derived_from_them() {
+    harness::use_ibl_cache();
     let store = GoldenStore::workspace();
     let model = NoiseModel::load(&store).unwrap();
     assert_eq!(model.margin, noise::DEFAULT_MARGIN);
@@ -83,6 +84,7 @@ fn every_golden_check_has_figures_and_a_limit_derived_from_them() {
 /// room: at most half of every limit.
 #[test]
 fn renders_recorded_on_another_host_pass_with_room() {
+    harness::use_ibl_cache();
     let store = GoldenStore::workspace();
     let cases = suite::canonical_cases().unwrap();
     let dir = store.root().join("evidence/host-b");

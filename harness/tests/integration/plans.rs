@@ -18,6 +18,7 @@ fn plan_of(scene: &Scene) -> RenderPlan {
 
 #[test]
 fn canonical_scene_plans() {
+    harness::use_ibl_cache();
     for name in ["chess", "arrow", "ibl", "corner"] {
         let loaded = harness::load_scene(name).unwrap_or_else(|e| panic!("{e}"));
         insta::assert_snapshot!(format!("plan_{name}"), plan_of(&loaded.scene).to_string());
@@ -62,6 +63,7 @@ fn plans_contain_only_what_the_scene_needs() {
 /// arrow's point light drawn in one pass through the geometry shader.
 #[test]
 fn shadow_variant_plans() {
+    harness::use_ibl_cache();
     let mut chess = harness::load_scene("chess").unwrap().scene;
     for light in &mut chess.lights {
         if let engine::scene::Light::Directional {

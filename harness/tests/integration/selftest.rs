@@ -13,6 +13,7 @@ use harness::golden::GoldenStore;
 
 #[test]
 fn every_mutation_fails_where_it_originates_and_no_noise_source_comes_near_a_limit() {
+    harness::use_ibl_cache();
     let backends = common::available_backends();
     assert!(
         !backends.is_empty(),
@@ -88,6 +89,7 @@ fn every_mutation_fails_where_it_originates_and_no_noise_source_comes_near_a_lim
 /// Its goldens are blessed here, into a temporary store, from the unchanged render on gl.
 #[test]
 fn a_mutation_of_an_extracted_suns_shadow_fails_in_its_shadow_term() {
+    harness::use_ibl_cache();
     if !common::gl_available() {
         return;
     }
