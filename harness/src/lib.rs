@@ -7,6 +7,7 @@
 //! [`report`] (the HTML review page); beside them the small shared helpers ([`html`],
 //! [`images`], [`stats`]) and the scenes built in code ([`test_scenes`], [`first_scene`]).
 
+pub mod ci_report;
 pub mod first_scene;
 pub mod golden;
 pub mod html;

@@ -1,6 +1,6 @@
 //! `harness`: the command line of the render regression harness.
 //!
-//! `cargo run --release -p harness` runs `check`, the main job.
+//! `cargo run -p harness` runs `check`, the main job.
 //!
 //! This file holds the clap definitions and the dispatch only; each command's body is in
 //! [`cli`], one module per command or group of small commands.
@@ -48,6 +48,14 @@ enum Command {
         /// Skip the speed checks (each pass's speed ratio against its timing golden).
         #[arg(long)]
         no_speed: bool,
+        /// Also write the results as JUnit XML (a test case per scene, pass and backend), for
+        /// CI test-report actions.
+        #[arg(long, value_name = "FILE")]
+        junit: Option<PathBuf>,
+        /// Also write a Markdown summary, failing checks first, for a CI job's page (for
+        /// example `--summary "$GITHUB_STEP_SUMMARY"`).
+        #[arg(long, value_name = "FILE")]
+        summary: Option<PathBuf>,
         /// Debug: give the lighting passes the generic, unspecialised shader variant, in the
         /// renders and the speed probes (a real slowdown, reproduced: the lighting passes'
         /// speed checks fail and nothing else does).
@@ -273,6 +281,8 @@ fn main() -> ExitCode {
         backends: vec![],
         json: false,
         no_speed: false,
+        junit: None,
+        summary: None,
         debug_unspecialised_lighting: false,
     });
     let result = match command {
@@ -283,6 +293,8 @@ fn main() -> ExitCode {
             backends,
             json,
             no_speed,
+            junit,
+            summary,
             debug_unspecialised_lighting,
         } => cli::check::run(
             &out,
@@ -292,6 +304,8 @@ fn main() -> ExitCode {
                 json,
                 speed: !no_speed,
                 unspecialised_lighting: debug_unspecialised_lighting,
+                junit,
+                summary,
             },
         ),
         Command::Speed(args) => cli::bench::speed_command(args),

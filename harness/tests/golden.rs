@@ -350,6 +350,7 @@ fn write_failure_report(suite: &Suite) {
         timings: vec![],
         driver_notes: vec![],
         speed: Default::default(),
+        diagnoses: vec![],
     };
     let html = harness::report::html(&run, &outputs, &suite.store, None, &[]);
     match harness::images::write_atomically(&report_path(), html.as_bytes()) {

@@ -1,7 +1,7 @@
 //! `harness check`, the default command: every scene's passes against their goldens and the
 //! backends against each other, as a table (or JSON) and the HTML report.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use engine::backend::BackendKind;
@@ -19,6 +19,10 @@ pub(crate) struct Options {
     pub speed: bool,
     /// Debug: the lighting passes unspecialised, in the renders and the speed probes.
     pub unspecialised_lighting: bool,
+    /// Where to write the results as JUnit XML.
+    pub junit: Option<PathBuf>,
+    /// Where to write the Markdown summary.
+    pub summary: Option<PathBuf>,
 }
 
 /// Runs the check on the scenes and backends asked for (all by default), writes report.html
@@ -99,6 +103,15 @@ pub(crate) fn run(
     );
     let report = out.join("report.html");
     harness::images::write_atomically(&report, html.as_bytes())?;
+    if let Some(path) = &options.junit {
+        let xml = harness::ci_report::junit(&run)
+            .map_err(|e| anyhow::anyhow!("cannot write JUnit XML for {}: {e}", path.display()))?;
+        harness::images::write_atomically(path, xml.as_bytes())?;
+    }
+    if let Some(path) = &options.summary {
+        let markdown = harness::ci_report::summary(&run, &report);
+        harness::images::write_atomically(path, markdown.as_bytes())?;
+    }
     if json {
         println!("{}", serde_json::to_string_pretty(&run)?);
     } else {
@@ -142,24 +155,7 @@ fn print_table(run: &CheckRun, report: &Path, failures: &Path) {
         "scene", "pass", "backend", "result"
     );
     for r in &run.results {
-        let worst = match &r.outcome {
-            harness::golden::Outcome::Passed(v) | harness::golden::Outcome::Failed(v) => {
-                // The check closest to (or furthest past) its limit, and for a failure
-                // where the largest difference is.
-                v.checks
-                    .iter()
-                    .max_by(|a, b| a.ratio().total_cmp(&b.ratio()))
-                    .map(ToString::to_string)
-                    .unwrap_or_default()
-                    + &v.largest_difference
-                        .map(|l| format!("; {l}"))
-                        .unwrap_or_default()
-            }
-            harness::golden::Outcome::MissingGolden => {
-                format!("no golden at {}", r.golden_path.display())
-            }
-            harness::golden::Outcome::Incomparable(why) => why.clone(),
-        };
+        let worst = r.worst();
         println!(
             "{:<8} {:<17} {:<12} {:<12} {worst}",
             r.scene,
@@ -192,6 +188,7 @@ fn print_table(run: &CheckRun, report: &Path, failures: &Path) {
             worst_cross.join(", ")
         );
     }
+    print_diagnoses(run);
     print_speed(run);
     let failed = run.results.iter().filter(|r| !r.outcome.passed()).count()
         + run.speed.checks.iter().filter(|c| c.failed()).count()
@@ -216,6 +213,23 @@ fn print_table(run: &CheckRun, report: &Path, failures: &Path) {
         for command in run.bless_commands() {
             println!("  {command}");
         }
+    }
+}
+
+/// Why the failing passes failed: per failing output where the change starts (or which
+/// output it moved with), how the backends moved, and the advice, once per scene and output.
+fn print_diagnoses(run: &CheckRun) {
+    if run.diagnoses.is_empty() {
+        return;
+    }
+    println!("\nwhy: where each change starts, and what to do");
+    let mut seen: Vec<(&str, engine::plan::TargetId)> = Vec::new();
+    for d in &run.diagnoses {
+        if seen.contains(&(d.scene.as_str(), d.pass)) {
+            continue;
+        }
+        seen.push((d.scene.as_str(), d.pass));
+        println!("  {}/{}: {}; {}", d.scene, d.pass, d.headline(), d.advice);
     }
 }
 

@@ -81,6 +81,16 @@ pub(crate) fn run(json: bool) -> anyhow::Result<ExitCode> {
                 harness::golden::noise::MIN_MUTATION_RATIO
             );
         }
+        for m in result.misdiagnosed() {
+            println!(
+                "MISDIAGNOSED: `{}` on {} ({}): the verdict names {} as where it starts, not {}",
+                m.mutation.describe(),
+                m.scene,
+                m.backend,
+                harness::names(&m.diagnosed_origin),
+                harness::names(&m.origin_passes)
+            );
+        }
         for n in result.noisy() {
             println!(
                 "NOISY: unchanged {} under {} on {}: {} at {:.2} of its limit",

@@ -84,6 +84,10 @@ pub struct CheckRun {
     /// The speed checks (none with `--no-speed`).
     #[serde(default)]
     pub speed: crate::golden::speed::SpeedRun,
+    /// Why each failing image check failed: where the change starts, whether the backends
+    /// moved alike, what to do.
+    #[serde(default)]
+    pub diagnoses: Vec<crate::golden::diagnosis::Diagnosis>,
 }
 
 impl CheckRun {
@@ -329,8 +333,14 @@ pub fn run_with(
     }
     progress(done, total, "done");
     let driver_notes = driver_notes(cases, store, &backends);
+    let plans = cases
+        .iter()
+        .map(|case| (case.name().to_owned(), case.frame.plan().clone()))
+        .collect();
+    let diagnoses = crate::golden::diagnosis::diagnose(&plans, &results, &cross);
     (
         CheckRun {
+            diagnoses,
             driver_notes,
             backends,
             results,

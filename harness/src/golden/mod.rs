@@ -5,6 +5,7 @@
 
 pub mod bless;
 pub mod check;
+pub mod diagnosis;
 pub mod metrics;
 pub mod noise;
 pub mod pass_kind;

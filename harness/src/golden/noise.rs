@@ -42,8 +42,7 @@ pub const MIN_MUTATION_RATIO: f64 = 3.0;
 /// The resolution of a fraction-of-pixels metric, in pixels.
 pub const RESOLUTION_PIXELS: f64 = 10.0;
 /// The command that regenerates the model.
-pub const REGENERATE: &str =
-    "scripts/mesa-backports.sh && cargo run --release -p harness -- noise --write";
+pub const REGENERATE: &str = "scripts/mesa-backports.sh && cargo run -p harness -- noise --write";
 
 /// Why the noise model could not be read or written.
 #[derive(Debug, thiserror::Error)]

@@ -323,10 +323,30 @@ pub fn bless_command(scene: &str) -> String {
     } else {
         format!("'{}'", scene.replace('\'', "'\\''"))
     };
-    format!("cargo run --release -p harness -- bless --scene {quoted}")
+    format!("cargo run -p harness -- bless --scene {quoted}")
 }
 
 impl PassCheck {
+    /// One line: the check closest to (or furthest past) its limit and, for a failure, where
+    /// the largest difference is; or why there was nothing to compare. The check table's last
+    /// column, and the message of a JUnit test case.
+    pub fn worst(&self) -> String {
+        match &self.outcome {
+            Outcome::Passed(v) | Outcome::Failed(v) => {
+                v.checks
+                    .iter()
+                    .max_by(|a, b| a.ratio().total_cmp(&b.ratio()))
+                    .map(ToString::to_string)
+                    .unwrap_or_default()
+                    + &v.largest_difference
+                        .map(|l| format!("; {l}"))
+                        .unwrap_or_default()
+            }
+            Outcome::MissingGolden => format!("no golden at {}", self.golden_path.display()),
+            Outcome::Incomparable(why) => why.clone(),
+        }
+    }
+
     /// A multi-line explanation for test output.
     pub fn message(&self) -> String {
         let golden = &self.golden_path;
@@ -550,11 +570,11 @@ mod tests {
     fn bless_commands_quote_paths_a_shell_would_split() {
         assert_eq!(
             bless_command("chess"),
-            "cargo run --release -p harness -- bless --scene chess"
+            "cargo run -p harness -- bless --scene chess"
         );
         assert_eq!(
             bless_command("my scenes/it's.toml"),
-            "cargo run --release -p harness -- bless --scene 'my scenes/it'\\''s.toml'"
+            "cargo run -p harness -- bless --scene 'my scenes/it'\\''s.toml'"
         );
     }
 

@@ -22,10 +22,20 @@ pub(super) fn summary(out: &mut String, run: &CheckRun) {
         } else {
             "failed"
         };
+        // A failing check's verdict first: where the change starts and what to do.
+        let verdict = crate::golden::diagnosis::find(&run.diagnoses, &r.scene, r.pass, r.backend)
+            .map(|d| {
+                format!(
+                    "<div class=\"verdict\"><b>{}</b>: {}</div>",
+                    escape(&d.headline()),
+                    escape(&d.advice)
+                )
+            })
+            .unwrap_or_default();
         let _ = write!(
             out,
             "<tr class=\"{class}\"><td>{}</td><td><a href=\"#{}\">{}</a></td><td>{}</td>\
-             <td>{}</td><td><code>{}</code></td></tr>",
+             <td>{}</td><td>{verdict}<code>{}</code></td></tr>",
             escape(&r.scene),
             case_id(&r.scene, r.pass),
             r.pass,

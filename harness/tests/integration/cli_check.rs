@@ -94,6 +94,83 @@ fn a_broken_scene_is_one_failed_case_and_the_others_are_checked() {
     );
 }
 
+/// `--junit` and `--summary` of the run in `check_reports_failures_with_images_and_the_bless_command`
+/// (arrow's final golden darkened, its light golden removed): the JUnit XML parses (with
+/// quick-junit's reader) into a suite for arrow, a case per pass and backend, the two failures
+/// with their messages, the verdict and the images; the Markdown lists them first with the
+/// bless command.
+fn ci_formats_name_the_failures(out: &std::path::Path, stdout: &str) {
+    use quick_junit::{NonSuccessKind, TestCaseStatus};
+    let xml = std::fs::read_to_string(out.join("junit.xml")).unwrap();
+    let report = quick_junit::Report::deserialize_from_str(&xml).unwrap();
+    let checks = stdout.lines().filter(|l| l.starts_with("arrow ")).count();
+    assert_eq!(report.tests, checks, "{xml}");
+    assert_eq!(report.test_suites.len(), 1);
+    let suite = &report.test_suites[0];
+    assert_eq!(suite.name.as_str(), "arrow");
+    let case = |name: &str| {
+        suite
+            .test_cases
+            .iter()
+            .find(|c| c.name.as_str() == name)
+            .unwrap_or_else(|| panic!("no test case {name}: {xml}"))
+    };
+    let failures: Vec<&str> = suite
+        .test_cases
+        .iter()
+        .filter(|c| !matches!(c.status, TestCaseStatus::Success { .. }))
+        .map(|c| c.name.as_str())
+        .collect();
+    assert_eq!(report.failures, failures.len());
+    assert!(
+        failures.contains(&"final::gl") && failures.contains(&"light::gl"),
+        "{failures:?}"
+    );
+    let TestCaseStatus::NonSuccess {
+        kind,
+        message,
+        description,
+        ..
+    } = &case("final::gl").status
+    else {
+        panic!("final::gl passed: {xml}");
+    };
+    assert_eq!(*kind, NonSuccessKind::Failure);
+    let message = message.as_ref().unwrap().as_str();
+    let description = description.as_ref().unwrap().as_str();
+    assert!(
+        message.contains("fraction_over") && message.contains("origin: the tonemap pass"),
+        "{message}"
+    );
+    assert!(
+        description.contains("failures/arrow/gl/final_actual.png")
+            && description.contains("final_diff.png")
+            && description.contains("bless --scene arrow"),
+        "{description}"
+    );
+    assert!(matches!(
+        case("depth::gl").status,
+        TestCaseStatus::Success { .. }
+    ));
+    assert_eq!(
+        case("depth::gl").classname.as_ref().map(|c| c.as_str()),
+        Some("arrow")
+    );
+
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    assert!(summary.starts_with("## Render check FAILED"), "{summary}");
+    let failing = summary
+        .split("### Failing")
+        .nth(1)
+        .expect("a failing section");
+    assert!(
+        failing.contains("| arrow | final | gl | FAILED | **origin: the tonemap pass")
+            && failing.contains("| arrow | light | gl | MISSING | **nothing to compare with**")
+            && failing.contains("cargo run -p harness -- bless --scene arrow"),
+        "{summary}"
+    );
+}
+
 /// A changed golden fails `check` with the metrics and leaves actual, golden, diff and the HTML
 /// report on disk; a missing golden fails with the exact bless command.
 #[test]
@@ -114,12 +191,17 @@ fn check_reports_failures_with_images_and_the_bless_command() {
             "arrow",
             "--out",
             out.to_str().unwrap(),
+            "--junit",
+            out.join("junit.xml").to_str().unwrap(),
+            "--summary",
+            out.join("summary.md").to_str().unwrap(),
         ])
         .env("HARNESS_ROOT", root.path())
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert_eq!(output.status.code(), Some(1), "{stdout}");
+    ci_formats_name_the_failures(&out, &stdout);
     let line = |pass: &str| {
         stdout
             .lines()
@@ -166,14 +248,26 @@ fn check_reports_failures_with_images_and_the_bless_command() {
         line("light").contains("MISSING") && line("light").contains("no golden at "),
         "{stdout}"
     );
-    // One bless suggestion for the scene, not one per pass.
+    // One bless suggestion for the scene, not one per pass (the verdicts above it quote the
+    // command in their advice).
     let suggestions: Vec<&str> = stdout
         .lines()
-        .filter(|l| l.contains("harness -- bless"))
+        .filter(|l| l.trim_start().starts_with("cargo run") && l.contains("harness -- bless"))
         .collect();
+    let verdict = |pass: &str| {
+        stdout
+            .lines()
+            .find(|l| l.starts_with(&format!("  arrow/{pass}: ")))
+            .unwrap_or_default()
+    };
+    assert!(
+        verdict("final").contains("origin: the tonemap pass, every backend")
+            && verdict("light").contains("nothing to compare with"),
+        "{stdout}"
+    );
     assert_eq!(
         suggestions,
-        ["  cargo run --release -p harness -- bless --scene arrow"],
+        ["  cargo run -p harness -- bless --scene arrow"],
         "{stdout}"
     );
     assert!(line("mask").contains(" ok "), "{stdout}");

@@ -19,7 +19,6 @@ fn every_mutation_fails_where_it_originates_and_no_noise_source_comes_near_a_lim
         !backends.is_empty(),
         "no backend available: the self-test needs one (see `harness backends`)"
     );
-    harness::use_ibl_cache();
     let store = GoldenStore::workspace();
     let model = NoiseModel::load(&store).unwrap();
     let cases = harness::golden::suite::canonical_cases().unwrap();
@@ -46,6 +45,23 @@ fn every_mutation_fails_where_it_originates_and_no_noise_source_comes_near_a_lim
         })
         .collect();
     assert!(weak.is_empty(), "caught by less than 3x: {weak:?}");
+    let misdiagnosed: Vec<String> = result
+        .misdiagnosed()
+        .iter()
+        .map(|m| {
+            format!(
+                "{} on {} ({}): {:?}",
+                m.mutation.describe(),
+                m.scene,
+                m.backend,
+                m.diagnosed_origin
+            )
+        })
+        .collect();
+    assert!(
+        misdiagnosed.is_empty(),
+        "the verdict names another origin: {misdiagnosed:?}"
+    );
     let noisy: Vec<String> = result
         .noisy()
         .iter()
@@ -93,7 +109,6 @@ fn a_mutation_of_an_extracted_suns_shadow_fails_in_its_shadow_term() {
     if !common::gl_available() {
         return;
     }
-    harness::use_ibl_cache();
     let dir = tempfile::tempdir().unwrap();
     let path = common::ibl_with_extracted_sun(dir.path(), "ibl_sun");
     let case = harness::golden::suite::Case::load(path.to_str().unwrap()).unwrap();

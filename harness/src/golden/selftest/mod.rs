@@ -22,7 +22,7 @@
 use std::collections::BTreeMap;
 
 use engine::backend::BackendKind;
-use engine::plan::TargetId;
+use engine::plan::{PassId, TargetId};
 
 use crate::golden::noise::{MAX_NOISE_RATIO, MIN_MUTATION_RATIO};
 
@@ -62,6 +62,12 @@ pub struct MutationResult {
     pub ratios: BTreeMap<TargetId, f64>,
     /// Why the render failed, if it did.
     pub error: Option<String>,
+    /// The plan passes `check`'s verdict names as where the change starts, from the outputs
+    /// that failed ([`crate::golden::diagnosis::origins`]).
+    pub diagnosed_origin: Vec<PassId>,
+    /// The plan passes that write the outputs the mutation reaches directly
+    /// ([`Mutation::starts_in`]): where the verdict may say it starts.
+    pub origin_passes: Vec<PassId>,
 }
 
 impl MutationResult {
@@ -73,6 +79,16 @@ impl MutationResult {
             .filter(|(pass, _)| self.mutation.is_origin(**pass))
             .map(|(_, &r)| r)
             .fold(None, |m: Option<f64>, r| Some(m.map_or(r, |m| m.max(r))))
+    }
+
+    /// Whether the verdict names where the mutation starts: some origin, and each a pass that
+    /// writes an output the mutation reaches directly.
+    pub fn origin_named(&self) -> bool {
+        !self.diagnosed_origin.is_empty()
+            && self
+                .diagnosed_origin
+                .iter()
+                .all(|p| self.origin_passes.contains(p))
     }
 
     /// Other passes that failed (ratio above 1).
@@ -124,6 +140,15 @@ impl SelfTest {
             .collect()
     }
 
+    /// Applicable mutations caught in their origin whose verdict names another origin.
+    pub fn misdiagnosed(&self) -> Vec<&MutationResult> {
+        self.mutations
+            .iter()
+            .filter(|m| m.applies && m.error.is_none() && !m.origin_named())
+            .filter(|m| m.origin_ratio().is_some_and(|r| r >= MIN_MUTATION_RATIO))
+            .collect()
+    }
+
     /// Unchanged renders above [`MAX_NOISE_RATIO`] of a limit.
     pub fn noisy(&self) -> Vec<&NoiseResult> {
         self.noise
@@ -132,9 +157,13 @@ impl SelfTest {
             .collect()
     }
 
-    /// Every mutation caught where it originates with its margin, every noise source within its
+    /// Every mutation caught where it originates with its margin and its verdict naming that
+    /// origin, every noise source within its
     /// bound, no failed render.
     pub fn passed(&self) -> bool {
-        self.weak_detections().is_empty() && self.noisy().is_empty() && self.errors.is_empty()
+        self.weak_detections().is_empty()
+            && self.misdiagnosed().is_empty()
+            && self.noisy().is_empty()
+            && self.errors.is_empty()
     }
 }

@@ -237,4 +237,18 @@ impl Mutation {
             _ => pass == self.origin(),
         }
     }
+
+    /// Whether this mutation reaches `output` directly, not through another output: where
+    /// `check`'s verdict may say it starts. Its origin, and for a change that two passes read
+    /// on their own, the other: the shadow bias also in the light buffer (the lighting passes
+    /// apply it), a moved point light also in its shadow maps (drawn from the light).
+    pub fn starts_in(self, output: TargetId) -> bool {
+        match self {
+            Mutation::ShadowBias => self.is_origin(output) || output == TargetId::Light,
+            Mutation::PointLightMoved => {
+                self.is_origin(output) || matches!(output, TargetId::Shadow { .. })
+            }
+            _ => self.is_origin(output),
+        }
+    }
 }

@@ -10,7 +10,8 @@ use engine::renderer::{self, PreparedFrame, Readback};
 use engine::Image;
 
 use super::{Mutation, MutationChecks, MutationResult, NoiseResult, SelfTest};
-use crate::golden::noise::NoiseModel;
+use crate::golden::diagnosis;
+use crate::golden::noise::{NoiseModel, MAX_NOISE_RATIO};
 use crate::golden::portability;
 use crate::golden::suite::{self, Case};
 use crate::golden::{self, GoldenStore, Outcome};
@@ -154,6 +155,8 @@ fn run_backend(
             applies: false,
             ratios: BTreeMap::new(),
             error: None,
+            diagnosed_origin: Vec::new(),
+            origin_passes: Vec::new(),
         };
         // Environment changes apply to the scene as loaded, prepared anew; the others to the
         // scene as drawn (an extracted sun's light too), re-planned with the same IBL maps.
@@ -180,7 +183,26 @@ fn run_backend(
                 .map_err(|e| e.to_string())
                 .and_then(|frame| render(&frame.with_variations(variations), &checked));
             match rendered {
-                Ok(frame) => entry.ratios = ratios(case, goldens, &frame.outputs),
+                Ok(frame) => {
+                    entry.ratios = ratios(case, goldens, &frame.outputs);
+                    let over = |bound: f64| -> Vec<TargetId> {
+                        entry
+                            .ratios
+                            .iter()
+                            .filter(|(_, &r)| r > bound)
+                            .map(|(pass, _)| *pass)
+                            .collect()
+                    };
+                    let (failing, moved) = (over(1.0), over(MAX_NOISE_RATIO));
+                    entry.diagnosed_origin = diagnosis::origins(&frame.plan, &failing, &moved);
+                    let reached: Vec<TargetId> = frame
+                        .plan
+                        .target_ids()
+                        .into_iter()
+                        .filter(|t| mutation.starts_in(*t))
+                        .collect();
+                    entry.origin_passes = diagnosis::writers(&frame.plan, &reached);
+                }
                 Err(e) => {
                     result.errors.push(format!(
                         "{} on {kind} with `{}`: {e}",

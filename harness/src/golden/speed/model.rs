@@ -87,7 +87,7 @@ impl Default for TimingNoise {
 
 /// The command that regenerates the model.
 pub const REGENERATE: &str =
-    "scripts/mesa-backports.sh && cargo run --release -p harness -- noise --timing --write";
+    "scripts/mesa-backports.sh && cargo run -p harness -- noise --timing --write";
 
 impl TimingNoise {
     /// The file under the golden root.

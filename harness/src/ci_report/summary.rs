@@ -1,0 +1,147 @@
+//! `check --summary FILE`: the run as Markdown for a CI job's page, failing checks first with
+//! what to do about them, then a count of what passed per scene.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::{counts, speed_status, Status};
+use crate::golden::check::CheckRun;
+use crate::golden::speed::SpeedOutcome;
+
+/// The run as Markdown; `report` is where its review page was written.
+pub fn summary(run: &CheckRun, report: &Path) -> String {
+    let (total, bad) = counts(run);
+    let mut out = String::new();
+    let verdict = if run.passed() { "passed" } else { "FAILED" };
+    let _ = writeln!(out, "## Render check {verdict}\n");
+    let _ = writeln!(
+        out,
+        "{bad} of {total} checks failed ({} image, {} speed); review page: `{}`\n",
+        run.results.len(),
+        run.speed.checks.len(),
+        report.display()
+    );
+    let mut failing: Vec<[String; 5]> = Vec::new();
+    for b in &run.load_errors {
+        failing.push(row(&b.scene, "-", "-", "LOAD", &b.error));
+    }
+    for (scene, backend, error) in &run.render_errors {
+        failing.push(row(scene, "-", backend.name(), "RENDER", error));
+    }
+    for r in run.results.iter().filter(|r| !r.outcome.passed()) {
+        let details =
+            match crate::golden::diagnosis::find(&run.diagnoses, &r.scene, r.pass, r.backend) {
+                Some(d) => format!("**{}**: {}. {}", d.headline(), d.advice, r.worst()),
+                None => r.worst(),
+            };
+        failing.push(row(
+            &r.scene,
+            &r.pass.to_string(),
+            r.backend.name(),
+            r.outcome.label(),
+            &details,
+        ));
+    }
+    for c in run
+        .speed
+        .checks
+        .iter()
+        .filter(|c| speed_status(c) == Status::Failed)
+    {
+        let label = if c.outcome == SpeedOutcome::Slower {
+            "SLOWER"
+        } else {
+            "MISSING"
+        };
+        let pass = format!("speed {}", c.pass);
+        failing.push(row(&c.scene, &pass, c.backend.name(), label, &c.describe()));
+    }
+    for e in &run.speed.errors {
+        failing.push(row("-", "speed probe", "-", "ERROR", e));
+    }
+    if !failing.is_empty() {
+        let _ = writeln!(out, "### Failing\n");
+        table(
+            &mut out,
+            &["scene", "pass", "backend", "result", "details"],
+            &failing,
+        );
+        let commands = run.bless_commands();
+        if !commands.is_empty() {
+            let _ = writeln!(
+                out,
+                "\nAfter reviewing the page, bless what changed on purpose (each command \
+                 rewrites only its scene's passes outside tolerance or without a golden):\n\n```sh"
+            );
+            for command in commands {
+                let _ = writeln!(out, "{command}");
+            }
+            let _ = writeln!(out, "```");
+        }
+    }
+    passing(&mut out, run);
+    out
+}
+
+/// A table row, each cell made safe for a Markdown table.
+fn row(scene: &str, pass: &str, backend: &str, result: &str, details: &str) -> [String; 5] {
+    [scene, pass, backend, result, details].map(cell)
+}
+
+/// `text` on one line, its pipes escaped.
+fn cell(text: &str) -> String {
+    text.replace('\n', " ").replace('|', "\\|")
+}
+
+/// A Markdown table.
+fn table<const N: usize>(out: &mut String, header: &[&str; N], rows: &[[String; N]]) {
+    let _ = writeln!(out, "| {} |", header.join(" | "));
+    let _ = writeln!(out, "|{}", "---|".repeat(N));
+    for r in rows {
+        let _ = writeln!(out, "| {} |", r.join(" | "));
+    }
+}
+
+/// Per scene, how many image and speed checks passed (untimed passes counted apart), folded.
+fn passing(out: &mut String, run: &CheckRun) {
+    let mut scenes: Vec<&str> = Vec::new();
+    for scene in run
+        .results
+        .iter()
+        .map(|r| r.scene.as_str())
+        .chain(run.speed.checks.iter().map(|c| c.scene.as_str()))
+    {
+        if !scenes.contains(&scene) {
+            scenes.push(scene);
+        }
+    }
+    let rows: Vec<[String; 4]> = scenes
+        .iter()
+        .map(|scene| {
+            let images = run.results.iter().filter(|r| r.scene == *scene);
+            let speed = run.speed.checks.iter().filter(|c| c.scene == *scene);
+            let passed = images.clone().filter(|r| r.outcome.passed()).count();
+            let timed_passed = speed
+                .clone()
+                .filter(|c| speed_status(c) == Status::Passed)
+                .count();
+            let untimed = speed
+                .clone()
+                .filter(|c| speed_status(c) == Status::Skipped)
+                .count();
+            [
+                (*scene).to_owned(),
+                format!("{passed} of {}", images.count()),
+                format!("{timed_passed} of {}", speed.count()),
+                untimed.to_string(),
+            ]
+        })
+        .collect();
+    let _ = writeln!(out, "\n<details><summary>Passed, per scene</summary>\n");
+    table(
+        out,
+        &["scene", "image checks", "speed checks", "untimed"],
+        &rows,
+    );
+    let _ = writeln!(out, "\n</details>");
+}
