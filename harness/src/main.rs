@@ -121,6 +121,12 @@ enum Command {
         /// Bless the images only, not the timing goldens.
         #[arg(long)]
         no_speed: bool,
+        /// Instead of blessing, remove what nothing produces or records any more: folders of
+        /// scenes gone from scenes/, goldens of passes gone, goldens blessed.toml does not
+        /// record, records without a golden, stray files (every scene's, or the --scene ones';
+        /// with --dry-run, only list them).
+        #[arg(long, conflicts_with_all = ["speed_only", "every_pass", "passes"])]
+        prune: bool,
     },
     /// Render a scene on one backend and write pass outputs (`.png`, or `.exr` for float passes).
     Render {
@@ -319,6 +325,12 @@ fn main() -> ExitCode {
         } => cli::noise::command(&sources, &scenes, write, margin, json, timing),
         Command::Bless {
             scenes,
+            dry_run,
+            prune: true,
+            ..
+        } => cli::bless::prune(&scenes, dry_run),
+        Command::Bless {
+            scenes,
             passes,
             backend,
             all,
@@ -326,6 +338,7 @@ fn main() -> ExitCode {
             dry_run,
             speed_only,
             no_speed,
+            prune: false,
         } => cli::bless::run(
             &scenes,
             &passes,

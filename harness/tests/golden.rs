@@ -173,8 +173,15 @@ impl Suite {
                 let driver = backend::create(kind)
                     .map(|b| golden::fingerprint(b.info()))
                     .unwrap_or_default();
+                // Trials of one scene run in parallel: each holds the scene's lock while it
+                // writes its golden and blessed.toml.
+                let lock = self
+                    .store
+                    .lock_scene(case.name(), |_| {})
+                    .map_err(|e| Failed::from(e.to_string()))?;
                 let blessed = bless_pass(
                     &self.store,
+                    &lock,
                     case,
                     pass,
                     actual,
@@ -351,6 +358,7 @@ fn write_failure_report(suite: &Suite) {
         driver_notes: vec![],
         speed: Default::default(),
         diagnoses: vec![],
+        orphans: vec![],
     };
     let html = harness::report::html(&run, &outputs, &suite.store, None, &[]);
     match harness::images::write_atomically(&report_path(), html.as_bytes()) {

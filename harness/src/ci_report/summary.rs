@@ -79,6 +79,16 @@ pub fn summary(run: &CheckRun, report: &Path) -> String {
             let _ = writeln!(out, "```");
         }
     }
+    if !run.orphans.is_empty() {
+        let _ = writeln!(
+            out,
+            "\n### Orphans in golden/\n\nNothing produces or records these any more \
+             (`harness bless --prune --dry-run` lists what it would remove):\n"
+        );
+        for orphan in &run.orphans {
+            let _ = writeln!(out, "- {}", cell(&orphan.to_string()));
+        }
+    }
     passing(&mut out, run);
     out
 }

@@ -36,8 +36,23 @@ pub(crate) fn run(
     }
     let cases = load_cases(scenes)?;
     let store = harness::golden::GoldenStore::workspace();
+    // Every scene's folder held for the whole run, images and timing goldens, taken in name
+    // order (two runs over overlapping scenes cannot each wait for the other).
+    let mut names: Vec<&str> = cases.iter().map(|c| c.name()).collect();
+    names.sort_unstable();
+    names.dedup();
+    let mut locks = std::collections::BTreeMap::new();
+    for name in names {
+        let lock = store.lock_scene(name, |path| {
+            eprintln!(
+                "waiting for another `harness bless` of {name} to finish (it holds {})",
+                path.display()
+            );
+        })?;
+        locks.insert(name.to_owned(), lock);
+    }
     if options.images {
-        bless_images(&cases, &store, passes, kind, &options)?;
+        bless_images(&cases, &store, &locks, passes, kind, &options)?;
     }
     if options.speed {
         bless_speed(&cases, &store, &options)?;
@@ -87,6 +102,7 @@ fn bless_speed(
 fn bless_images(
     cases: &[harness::golden::suite::Case],
     store: &harness::golden::GoldenStore,
+    locks: &std::collections::BTreeMap<String, harness::golden::SceneLock>,
     passes: &[String],
     kind: BackendKind,
     options: &Options,
@@ -129,6 +145,7 @@ fn bless_images(
         for pass in wanted {
             let blessed = bless_pass(
                 store,
+                &locks[case.name()],
                 case,
                 pass,
                 &frame.outputs[&pass],
@@ -148,4 +165,32 @@ fn bless_images(
         }
     }
     Ok(())
+}
+
+/// `harness bless --prune`: lists the orphans in golden/ (every scene's and golden/'s own, or
+/// those of the scenes named) and removes them unless `dry_run`.
+pub(crate) fn prune(scenes: &[String], dry_run: bool) -> anyhow::Result<ExitCode> {
+    let cases = load_cases(scenes)?;
+    let store = harness::golden::GoldenStore::workspace();
+    let canonical = scenes
+        .is_empty()
+        .then(|| engine::scene_file::canonical_scenes(&harness::scenes_dir()));
+    let orphans = harness::golden::orphans::find(&store, &cases, canonical.as_deref())?;
+    if orphans.is_empty() {
+        println!("no orphans in {}", store.root().display());
+        return Ok(ExitCode::SUCCESS);
+    }
+    for orphan in &orphans {
+        println!("orphan: {orphan}");
+    }
+    let lines = harness::golden::orphans::prune(&store, &orphans, dry_run, |path| {
+        eprintln!(
+            "waiting for a `harness bless` to finish (it holds {})",
+            path.display()
+        );
+    })?;
+    for line in lines {
+        println!("{line}");
+    }
+    Ok(ExitCode::SUCCESS)
 }

@@ -82,6 +82,17 @@ pub(crate) fn run(
     }
     bar.finish_and_clear();
     run.load_errors = broken;
+    // With every scene checked, golden/'s folders too; otherwise the checked scenes' folders.
+    let canonical = scenes
+        .is_empty()
+        .then(|| engine::scene_file::canonical_scenes(&harness::scenes_dir()));
+    match harness::golden::orphans::find(&store, &cases, canonical.as_deref()) {
+        Ok(orphans) => run.orphans = orphans,
+        Err(e) => eprintln!("note: cannot look for orphans in golden/: {e}"),
+    }
+    for orphan in &run.orphans {
+        eprintln!("note: orphan: {orphan} (`harness bless --prune` removes it)");
+    }
     for b in &run.backends {
         if let Some(reason) = &b.unavailable {
             eprintln!("note: {} unavailable: {reason}", b.backend);

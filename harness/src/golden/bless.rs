@@ -11,7 +11,7 @@ use engine::plan::TargetId;
 use engine::Image;
 
 use super::suite::{bless_change, Case};
-use super::{GoldenError, GoldenStore};
+use super::{GoldenError, GoldenStore, SceneLock};
 
 /// Which of a case's golden passes to rewrite beyond those that changed.
 #[derive(Clone, Copy, Debug, Default)]
@@ -61,15 +61,22 @@ impl fmt::Display for BlessedPass {
 }
 
 /// Blesses `image`, the fresh output of `case`'s `pass` rendered on `backend` (whose driver
-/// fingerprint is `driver`), as `request` asks.
+/// fingerprint is `driver`), as `request` asks, holding the scene's `lock`.
 pub fn bless_pass(
     store: &GoldenStore,
+    lock: &SceneLock,
     case: &Case,
     pass: TargetId,
     image: &Image,
     (backend, driver): (BackendKind, &str),
     request: BlessRequest<'_>,
 ) -> Result<BlessedPass, GoldenError> {
+    if lock.scene() != case.name() {
+        return Err(GoldenError::Record {
+            path: store.root().join(case.name()),
+            message: format!("blessing it while holding {}'s lock", lock.scene()),
+        });
+    }
     let change = bless_change(store, case, pass, image);
     let write = change.changed || request.every_pass || request.named.contains(&pass);
     let outcome = if !write {
@@ -77,14 +84,7 @@ pub fn bless_pass(
     } else if request.dry_run {
         BlessOutcome::WouldWrite
     } else {
-        BlessOutcome::Written(store.bless(
-            case.name(),
-            pass,
-            image,
-            backend,
-            driver,
-            &change.previous,
-        )?)
+        BlessOutcome::Written(store.bless(lock, pass, image, backend, driver, &change.previous)?)
     };
     Ok(BlessedPass {
         scene: case.name().to_owned(),

@@ -88,6 +88,10 @@ pub struct CheckRun {
     /// moved alike, what to do.
     #[serde(default)]
     pub diagnoses: Vec<crate::golden::diagnosis::Diagnosis>,
+    /// Files in golden/ that nothing produces or records any more (notes, not failures;
+    /// `harness bless --prune` removes them).
+    #[serde(default)]
+    pub orphans: Vec<crate::golden::orphans::Orphan>,
 }
 
 impl CheckRun {
@@ -341,6 +345,7 @@ pub fn run_with(
     (
         CheckRun {
             diagnoses,
+            orphans: Vec::new(),
             driver_notes,
             backends,
             results,

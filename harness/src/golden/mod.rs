@@ -8,6 +8,7 @@ pub mod check;
 pub mod diagnosis;
 pub mod metrics;
 pub mod noise;
+pub mod orphans;
 pub mod pass_kind;
 pub mod portability;
 pub mod selftest;

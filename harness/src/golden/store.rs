@@ -34,6 +34,14 @@ pub enum GoldenError {
         /// How many.
         count: usize,
     },
+    /// The scene's bless lock could not be taken.
+    #[error("cannot lock {path} for blessing: {error}")]
+    Lock {
+        /// The lock file.
+        path: PathBuf,
+        /// Why.
+        error: std::io::Error,
+    },
     /// blessed.toml could not be read or written.
     #[error("{path}: {message}")]
     Record {
@@ -43,6 +51,28 @@ pub enum GoldenError {
         message: String,
     },
 }
+
+/// One bless holding a scene's golden folder, from before its goldens and records are written
+/// until they are: two blesses of one scene (two processes, or two threads of the golden
+/// suite's `UPDATE_GOLDENS` run) never interleave, and blessed.toml always names the backend of
+/// the image beside it. An advisory lock on `golden/<scene>/.bless.lock` (ignored by git),
+/// released when dropped or when its process dies. Writing a golden takes one
+/// ([`GoldenStore::bless`]).
+#[derive(Debug)]
+pub struct SceneLock {
+    scene: String,
+    _file: std::fs::File,
+}
+
+impl SceneLock {
+    /// The scene whose folder is held.
+    pub fn scene(&self) -> &str {
+        &self.scene
+    }
+}
+
+/// The name of a scene folder's lock file.
+pub const LOCK_FILE: &str = ".bless.lock";
 
 /// The golden folder.
 #[derive(Clone, Debug)]
@@ -155,16 +185,52 @@ impl GoldenStore {
         Ok(file.passes)
     }
 
-    /// Writes `image` as the golden of `scene`/`pass` and records the bless. Refuses NaN/Inf.
-    pub fn bless(
+    /// Takes `scene`'s bless lock, waiting while another bless holds it (`on_wait` is called
+    /// once, first, with the lock file's path, to say so).
+    pub fn lock_scene(
         &self,
         scene: &str,
+        on_wait: impl FnOnce(&Path),
+    ) -> Result<SceneLock, GoldenError> {
+        let dir = self.root.join(scene);
+        let path = dir.join(LOCK_FILE);
+        let lock_error = |error| GoldenError::Lock {
+            path: path.clone(),
+            error,
+        };
+        std::fs::create_dir_all(&dir).map_err(lock_error)?;
+        let file = std::fs::OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)
+            .map_err(lock_error)?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                on_wait(&path);
+                file.lock().map_err(lock_error)?;
+            }
+            Err(std::fs::TryLockError::Error(error)) => return Err(lock_error(error)),
+        }
+        Ok(SceneLock {
+            scene: scene.to_owned(),
+            _file: file,
+        })
+    }
+
+    /// Writes `image` as the golden of the locked scene's `pass` and records the bless. Refuses
+    /// NaN/Inf.
+    pub fn bless(
+        &self,
+        lock: &SceneLock,
         pass: TargetId,
         image: &Image,
         backend: BackendKind,
         driver: &str,
         previous: &str,
     ) -> Result<PathBuf, GoldenError> {
+        let scene = lock.scene();
         if let Some(values) = image.as_f32() {
             let count = values.iter().filter(|v| !v.is_finite()).count();
             if count > 0 {
@@ -194,19 +260,37 @@ impl GoldenStore {
                 previous: previous.to_owned(),
             },
         );
+        self.write_records(lock, records)?;
+        Ok(path)
+    }
+
+    /// Drops the record of `pass` (a name as blessed.toml has it) from the locked scene's
+    /// blessed.toml: a record whose golden is gone (`harness bless --prune`).
+    pub fn forget(&self, lock: &SceneLock, pass: &str) -> Result<(), GoldenError> {
+        let mut records = self.records(lock.scene())?;
+        if records.remove(pass).is_some() {
+            self.write_records(lock, records)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the locked scene's blessed.toml, atomically.
+    fn write_records(
+        &self,
+        lock: &SceneLock,
+        records: BTreeMap<String, BlessRecord>,
+    ) -> Result<(), GoldenError> {
+        let path = self.record_path(lock.scene());
         let text = toml::to_string_pretty(&BlessFile { passes: records }).map_err(|e| {
             GoldenError::Record {
-                path: self.record_path(scene),
+                path: path.clone(),
                 message: e.to_string(),
             }
         })?;
         let header = "# Written by `harness bless`: when each golden was blessed, from which \
                       backend and driver,\n# and how it differed from the golden it replaced.\n\n";
-        images::write_atomically(
-            &self.record_path(scene),
-            format!("{header}{text}").as_bytes(),
-        )?;
-        Ok(path)
+        images::write_atomically(&path, format!("{header}{text}").as_bytes())?;
+        Ok(())
     }
 }
 
@@ -301,9 +385,10 @@ mod tests {
             format: TextureFormat::Rgba16Float,
             data: ImageData::F32(vec![1.0, 2.0, 3.0, 1.0]),
         };
+        let lock = store.lock_scene("s", |_| {}).unwrap();
         let path = store
             .bless(
-                "s",
+                &lock,
                 TargetId::Light,
                 &image,
                 BackendKind::Gl,
@@ -328,7 +413,7 @@ mod tests {
         };
         let err = store
             .bless(
-                "s",
+                &lock,
                 TargetId::Light,
                 &bad,
                 BackendKind::Gl,

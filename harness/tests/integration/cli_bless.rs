@@ -10,6 +10,9 @@ fn snapshot(dir: &Path) -> std::collections::BTreeMap<PathBuf, (Vec<u8>, std::ti
         let entry = entry.unwrap();
         if entry.file_type().unwrap().is_dir() {
             out.extend(snapshot(&entry.path()));
+        } else if entry.file_name() == harness::golden::LOCK_FILE {
+            // The bless lock (see below): a lock, not a golden.
+            continue;
         } else {
             let meta = entry.metadata().unwrap();
             out.insert(
@@ -243,4 +246,202 @@ fn an_extracted_sun_gets_its_shadow_goldens() {
             "check did not check {pass}:\n{stdout}"
         );
     }
+}
+
+/// A bless waits while another holds the scene's folder (here, this test holds its lock), says
+/// so, and writes once the other is done: two blesses of one scene never interleave.
+#[test]
+fn a_bless_waits_for_another_bless_of_the_same_scene() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    let store = harness::golden::GoldenStore::new(root.path().join("golden"));
+    let lock = store
+        .lock_scene("chess", |_| panic!("nobody else holds it"))
+        .unwrap();
+    let before = std::fs::read(root.path().join("golden/chess/blessed.toml")).unwrap();
+    let mut child = common::harness_command()
+        .args(["bless", "--scene", "chess", "--pass", "final", "--no-speed"])
+        .env("HARNESS_ROOT", root.path())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Its stderr, line by line, until it says it waits (however long loading takes here).
+    let stderr = child.stderr.take().unwrap();
+    let (lines, received) = std::sync::mpsc::channel();
+    let reader = std::thread::spawn(move || {
+        use std::io::BufRead;
+        for line in std::io::BufReader::new(stderr)
+            .lines()
+            .map_while(Result::ok)
+        {
+            let _ = lines.send(line);
+        }
+    });
+    let mut seen = Vec::new();
+    while !seen
+        .iter()
+        .any(|l: &String| l.contains("waiting for another `harness bless` of chess to finish"))
+    {
+        match received.recv_timeout(std::time::Duration::from_secs(120)) {
+            Ok(line) => seen.push(line),
+            Err(e) => panic!("no waiting message ({e}): {seen:?}"),
+        }
+    }
+    // Waiting, it has written nothing; a moment later still nothing.
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    assert_eq!(
+        std::fs::read(root.path().join("golden/chess/blessed.toml")).unwrap(),
+        before,
+        "the bless wrote while another held the scene"
+    );
+    drop(lock);
+    let status = child.wait().unwrap();
+    reader.join().unwrap();
+    seen.extend(received.try_iter());
+    assert!(status.success(), "{seen:?}");
+    let records = store.records("chess").unwrap();
+    assert_eq!(records["final"].backend, engine::backend::BackendKind::Gl);
+    assert_ne!(
+        std::fs::read(root.path().join("golden/chess/blessed.toml")).unwrap(),
+        before
+    );
+}
+
+/// Orphans: `check` lists what in a checked scene's folder nothing produces or records (a
+/// golden of a pass gone, a leftover temporary, a golden blessed.toml does not record), as notes
+/// that do not fail it; `bless --prune --dry-run` lists every orphan in golden/ (also a gone
+/// scene's folder and a record without its golden) and removes nothing; `bless --prune` removes
+/// them and nothing else.
+#[test]
+fn orphans_are_listed_by_check_and_removed_by_prune() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    let golden = root.path().join("golden");
+    std::fs::create_dir_all(golden.join("gone")).unwrap();
+    std::fs::copy(
+        golden.join("arrow/final.png"),
+        golden.join("gone/final.png"),
+    )
+    .unwrap();
+    std::fs::copy(
+        golden.join("arrow/final.png"),
+        golden.join("arrow/final_old.png"),
+    )
+    .unwrap();
+    std::fs::write(golden.join("arrow/.final.png.tmp1.0"), b"half").unwrap();
+    let records = std::fs::read_to_string(golden.join("arrow/blessed.toml")).unwrap();
+    let start = records.find("[passes.mask]").unwrap();
+    let end = records[start + 1..]
+        .find("[passes.")
+        .map_or(records.len(), |i| start + 1 + i);
+    std::fs::write(
+        golden.join("arrow/blessed.toml"),
+        format!("{}{}", &records[..start], &records[end..]),
+    )
+    .unwrap();
+    std::fs::remove_file(golden.join("corner/mask.png")).unwrap();
+    let before = snapshot(&golden);
+
+    let output = common::harness_command()
+        .args([
+            "check",
+            "--scene",
+            "arrow",
+            "--backend",
+            "gl",
+            "--no-speed",
+            "--json",
+        ])
+        .args(["--out", root.path().join("out").to_str().unwrap()])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let listed: Vec<(String, String)> = json["orphans"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| {
+            let name = std::path::Path::new(o["path"].as_str().unwrap())
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .into_owned();
+            (name, o["kind"].to_string())
+        })
+        .collect();
+    assert_eq!(
+        listed,
+        [
+            (".final.png.tmp1.0".to_owned(), "\"stray\"".to_owned()),
+            ("final_old.png".to_owned(), "\"pass_gone\"".to_owned()),
+            ("mask.png".to_owned(), "\"unrecorded\"".to_owned()),
+        ],
+        "{stderr}"
+    );
+    assert!(stderr.contains("note: orphan: "), "{stderr}");
+
+    let prune = |dry_run: bool| {
+        let mut command = common::harness_command();
+        command.args(["bless", "--prune"]);
+        if dry_run {
+            command.arg("--dry-run");
+        }
+        let output = command.env("HARNESS_ROOT", root.path()).output().unwrap();
+        let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+        assert!(
+            output.status.success(),
+            "{stdout}{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        stdout
+    };
+    let listing = prune(true);
+    for expected in [
+        "gone: no scene in scenes/ is named gone",
+        "final_old.png: no golden pass of arrow",
+        ".final.png.tmp1.0: not a golden",
+        "arrow/mask.png: arrow/blessed.toml does not record it",
+        "corner/blessed.toml: records `mask`, which has no golden in corner",
+    ] {
+        assert!(listing.contains(expected), "no `{expected}` in:\n{listing}");
+    }
+    assert_eq!(
+        snapshot(&golden).keys().collect::<Vec<_>>(),
+        before.keys().collect::<Vec<_>>()
+    );
+
+    let removed = prune(false);
+    let after = snapshot(&golden);
+    let gone: Vec<String> = before
+        .keys()
+        .filter(|p| !after.contains_key(*p))
+        .map(|p| p.strip_prefix(&golden).unwrap().display().to_string())
+        .collect();
+    assert_eq!(
+        gone,
+        [
+            "arrow/.final.png.tmp1.0",
+            "arrow/final_old.png",
+            "arrow/mask.png",
+            "gone/final.png"
+        ],
+        "{removed}"
+    );
+    assert!(!golden.join("gone").exists());
+    let corner = harness::golden::GoldenStore::new(&golden)
+        .records("corner")
+        .unwrap();
+    assert!(
+        !corner.contains_key("mask") && corner.contains_key("final"),
+        "{corner:?}"
+    );
+    assert!(prune(false).contains("no orphans"));
 }

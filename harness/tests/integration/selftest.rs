@@ -120,10 +120,12 @@ fn a_mutation_of_an_extracted_suns_shadow_fails_in_its_shadow_term() {
     );
     let store = GoldenStore::new(dir.path().join("golden"));
     let frame = case.render(BackendKind::Gl).unwrap();
+    let lock = store.lock_scene(case.name(), |_| {}).unwrap();
     for &pass in &case.passes {
         let request = BlessRequest::default();
         let blessed = bless_pass(
             &store,
+            &lock,
             &case,
             pass,
             &frame.outputs[&pass],
