@@ -127,6 +127,14 @@ enum Command {
         /// with --dry-run, only list them).
         #[arg(long, conflicts_with_all = ["speed_only", "every_pass", "passes"])]
         prune: bool,
+        /// Instead of rendering, accept what the last `check` rendered: the outputs of its
+        /// failing passes on --backend (of --scene and --pass, or all), kept under
+        /// --out/failures/, blessed as a fresh render would be.
+        #[arg(long, conflicts_with_all = ["speed_only", "every_pass", "prune", "all"])]
+        from_last_check: bool,
+        /// With --from-last-check: the folder `check --out` wrote to.
+        #[arg(long, default_value_os_t = default_out_dir())]
+        out: PathBuf,
     },
     /// Render a scene on one backend and write pass outputs (`.png`, or `.exr` for float passes).
     Render {
@@ -333,12 +341,22 @@ fn main() -> ExitCode {
             scenes,
             passes,
             backend,
+            dry_run,
+            from_last_check: true,
+            out,
+            ..
+        } => cli::bless::from_last_check(&out, &scenes, &passes, backend, dry_run),
+        Command::Bless {
+            scenes,
+            passes,
+            backend,
             all,
             every_pass,
             dry_run,
             speed_only,
             no_speed,
             prune: false,
+            ..
         } => cli::bless::run(
             &scenes,
             &passes,

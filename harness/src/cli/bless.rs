@@ -194,3 +194,61 @@ pub(crate) fn prune(scenes: &[String], dry_run: bool) -> anyhow::Result<ExitCode
     }
     Ok(ExitCode::SUCCESS)
 }
+
+/// `harness bless --from-last-check`: blesses the outputs the last `check` (under `out`) kept of
+/// its failing passes on `backend`, of `scenes` and `passes` (all when empty), without rendering.
+/// Exits 1 when a pass was refused.
+pub(crate) fn from_last_check(
+    out: &std::path::Path,
+    scenes: &[String],
+    passes: &[String],
+    backend: BackendKind,
+    dry_run: bool,
+) -> anyhow::Result<ExitCode> {
+    use harness::golden::accept;
+    let candidates = accept::candidates(out, backend, scenes, passes)?;
+    if candidates.is_empty() {
+        println!(
+            "nothing to accept: the last check ({}) has no failing pass on {backend}{}",
+            out.join(accept::LAST_CHECK).display(),
+            if scenes.is_empty() && passes.is_empty() {
+                ""
+            } else {
+                " among those named"
+            }
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mut arguments: Vec<String> = Vec::new();
+    for c in &candidates {
+        if !arguments.contains(&c.check.scene_argument) {
+            arguments.push(c.check.scene_argument.clone());
+        }
+    }
+    let cases = load_cases(&arguments)?;
+    let store = harness::golden::GoldenStore::workspace();
+    let mut refused = 0;
+    for case in &cases {
+        let lock = store.lock_scene(case.name(), |path| {
+            eprintln!(
+                "waiting for another `harness bless` of {} to finish (it holds {})",
+                case.name(),
+                path.display()
+            );
+        })?;
+        for candidate in candidates.iter().filter(|c| c.check.scene == case.name()) {
+            match accept::accept(&store, &lock, case, candidate, dry_run) {
+                Ok(blessed) => println!("{blessed}"),
+                Err(why) => {
+                    refused += 1;
+                    println!("REFUSED {why}");
+                }
+            }
+        }
+    }
+    Ok(if refused == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}

@@ -114,6 +114,10 @@ pub(crate) fn run(
     );
     let report = out.join("report.html");
     harness::images::write_atomically(&report, html.as_bytes())?;
+    // What `bless --from-last-check` accepts from: this run's results, beside the failure images
+    // they point at.
+    let record = serde_json::to_vec(&run)?;
+    harness::images::write_atomically(&out.join(harness::golden::accept::LAST_CHECK), &record)?;
     if let Some(path) = &options.junit {
         let xml = harness::ci_report::junit(&run)
             .map_err(|e| anyhow::anyhow!("cannot write JUnit XML for {}: {e}", path.display()))?;

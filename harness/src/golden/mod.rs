@@ -3,6 +3,7 @@
 //! compares, the `check` run, the noise model the limits are derived from, and the mutation
 //! self-test that proves the limits catch real changes.
 
+pub mod accept;
 pub mod bless;
 pub mod check;
 pub mod diagnosis;

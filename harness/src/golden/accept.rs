@@ -1,0 +1,135 @@
+//! Accepting what `check` rendered, without rendering again (`harness bless --from-last-check`):
+//! `check` keeps its results in `<out>/last-check.json` and the outputs of its failing passes
+//! under `<out>/failures/` (written losslessly, as a bless writes them); accepting reads those and
+//! blesses them through the same path as `harness bless` ([`super::bless::bless_pass`]), so
+//! blessed.toml gets the same record: the check's backend and driver fingerprint and the
+//! metrics against the golden it replaces. A golden rewritten after the check is not
+//! overwritten: that pass is refused, with the reason.
+
+use std::path::{Path, PathBuf};
+use std::time::SystemTime;
+
+use engine::backend::BackendKind;
+
+use super::bless::{bless_pass, BlessRequest, BlessedPass};
+use super::check::CheckRun;
+use super::suite::{Case, PassCheck};
+use super::{GoldenStore, SceneLock};
+
+/// The file `check` keeps its results in, under its output folder.
+pub const LAST_CHECK: &str = "last-check.json";
+
+/// Why a pass of the last check cannot be accepted.
+#[derive(Debug, thiserror::Error)]
+pub enum AcceptError {
+    /// No last check, or one that does not parse.
+    #[error("cannot read the last check at {path}: {message} (run `harness check` first)")]
+    LastCheck {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+/// One failing pass of the last check, to accept.
+#[derive(Clone, Debug)]
+pub struct Candidate {
+    /// The check's result.
+    pub check: PassCheck,
+    /// The driver fingerprint the check rendered it with.
+    pub driver: String,
+    /// When the last check was written.
+    pub checked_at: SystemTime,
+}
+
+/// The last check's failing passes on `backend`, of `scenes` and `passes` (all when empty).
+pub fn candidates(
+    out: &Path,
+    backend: BackendKind,
+    scenes: &[String],
+    passes: &[String],
+) -> Result<Vec<Candidate>, AcceptError> {
+    let path = out.join(LAST_CHECK);
+    let error = |message: String| AcceptError::LastCheck {
+        path: path.clone(),
+        message,
+    };
+    let bytes = std::fs::read(&path).map_err(|e| error(e.to_string()))?;
+    let checked_at = std::fs::metadata(&path)
+        .and_then(|m| m.modified())
+        .map_err(|e| error(e.to_string()))?;
+    let run: CheckRun = serde_json::from_slice(&bytes).map_err(|e| error(e.to_string()))?;
+    let driver = run
+        .backends
+        .iter()
+        .find(|b| b.backend == backend)
+        .and_then(|b| b.fingerprint.clone())
+        .unwrap_or_default();
+    Ok(run
+        .results
+        .into_iter()
+        .filter(|r| r.backend == backend && !r.outcome.passed())
+        .filter(|r| {
+            scenes.is_empty() || scenes.contains(&r.scene) || scenes.contains(&r.scene_argument)
+        })
+        .filter(|r| passes.is_empty() || passes.contains(&r.pass.to_string()))
+        .map(|check| Candidate {
+            check,
+            driver: driver.clone(),
+            checked_at,
+        })
+        .collect())
+}
+
+/// Accepts `candidate`, a failing pass of `case` from the last check, holding the scene's
+/// `lock`: its kept output blessed as `harness bless` would bless a fresh render. Refused (an
+/// error line) when the output was not kept or the golden changed after the check.
+pub fn accept(
+    store: &GoldenStore,
+    lock: &SceneLock,
+    case: &Case,
+    candidate: &Candidate,
+    dry_run: bool,
+) -> Result<BlessedPass, String> {
+    let check = &candidate.check;
+    let name = format!("{}/{} ({})", check.scene, check.pass, check.backend);
+    let Some(actual) = &check.artifacts.actual else {
+        return Err(format!("{name}: the check kept no output to accept"));
+    };
+    let golden_changed = std::fs::metadata(&check.golden_path)
+        .and_then(|m| m.modified())
+        .is_ok_and(|modified| modified > candidate.checked_at);
+    if golden_changed {
+        return Err(format!(
+            "{name}: {} changed after the last check; run `harness check` again",
+            check.golden_path.display()
+        ));
+    }
+    let image = read_output(actual).map_err(|e| format!("{name}: {e}"))?;
+    let named = [check.pass];
+    bless_pass(
+        store,
+        lock,
+        case,
+        check.pass,
+        &image,
+        (check.backend, &candidate.driver),
+        BlessRequest {
+            // Failed in the check: written even where it would now be within tolerance.
+            named: &named,
+            every_pass: false,
+            dry_run,
+        },
+    )
+    .map_err(|e| format!("{name}: {e}"))
+}
+
+/// A kept output, as `check` wrote it (PNG for 8-bit passes, EXR for float ones).
+fn read_output(path: &Path) -> Result<engine::Image, crate::images::ImageFileError> {
+    if path.extension().is_some_and(|x| x == "png") {
+        crate::images::read_png(path)
+    } else {
+        crate::images::read_exr(path)
+    }
+}
