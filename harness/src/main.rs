@@ -96,46 +96,7 @@ enum Command {
     /// its golden, and rewrites only the passes that changed (outside tolerance) or have no
     /// golden, atomically, recording the driver and date in golden/<scene>/blessed.toml. Passes
     /// within tolerance and their records are left alone.
-    Bless {
-        /// Only this scene: a name in scenes/ or a path to a scene file (repeatable).
-        #[arg(long = "scene")]
-        scenes: Vec<String>,
-        /// Only this pass (repeatable); a pass named here is rewritten even within tolerance.
-        #[arg(long = "pass")]
-        passes: Vec<String>,
-        /// Rewrite every pass considered, also those within tolerance (after a driver change).
-        #[arg(long)]
-        every_pass: bool,
-        /// Backend to render the goldens with.
-        #[arg(long, default_value = "gl")]
-        backend: BackendKind,
-        /// Bless every pass of every canonical scene (required when no --scene is given).
-        #[arg(long)]
-        all: bool,
-        /// Show what would change without writing anything.
-        #[arg(long)]
-        dry_run: bool,
-        /// Bless the timing goldens only (a deliberate slowdown or speed-up), not the images.
-        #[arg(long, conflicts_with = "no_speed")]
-        speed_only: bool,
-        /// Bless the images only, not the timing goldens.
-        #[arg(long)]
-        no_speed: bool,
-        /// Instead of blessing, remove what nothing produces or records any more: folders of
-        /// scenes gone from scenes/, goldens of passes gone, goldens blessed.toml does not
-        /// record, records without a golden, stray files (every scene's, or the --scene ones';
-        /// with --dry-run, only list them).
-        #[arg(long, conflicts_with_all = ["speed_only", "every_pass", "passes"])]
-        prune: bool,
-        /// Instead of rendering, accept what the last `check` rendered: the outputs of its
-        /// failing passes on --backend (of --scene and --pass, or all), kept under
-        /// --out/failures/, blessed as a fresh render would be.
-        #[arg(long, conflicts_with_all = ["speed_only", "every_pass", "prune", "all"])]
-        from_last_check: bool,
-        /// With --from-last-check: the folder `check --out` wrote to.
-        #[arg(long, default_value_os_t = default_out_dir())]
-        out: PathBuf,
-    },
+    Bless(cli::bless::BlessArgs),
     /// Render a scene on one backend and write pass outputs (`.png`, or `.exr` for float passes).
     Render {
         /// Canonical scene name (`chess`) or path to a scene file.
@@ -331,44 +292,7 @@ fn main() -> ExitCode {
             json,
             timing,
         } => cli::noise::command(&sources, &scenes, write, margin, json, timing),
-        Command::Bless {
-            scenes,
-            dry_run,
-            prune: true,
-            ..
-        } => cli::bless::prune(&scenes, dry_run),
-        Command::Bless {
-            scenes,
-            passes,
-            backend,
-            dry_run,
-            from_last_check: true,
-            out,
-            ..
-        } => cli::bless::from_last_check(&out, &scenes, &passes, backend, dry_run),
-        Command::Bless {
-            scenes,
-            passes,
-            backend,
-            all,
-            every_pass,
-            dry_run,
-            speed_only,
-            no_speed,
-            prune: false,
-            ..
-        } => cli::bless::run(
-            &scenes,
-            &passes,
-            backend,
-            all,
-            cli::bless::Options {
-                every_pass,
-                dry_run,
-                images: !speed_only,
-                speed: !no_speed,
-            },
-        ),
+        Command::Bless(args) => cli::bless::command(args),
         Command::Render {
             scene,
             backend,

@@ -1,5 +1,6 @@
 //! `harness bless`: rewrites the goldens that changed (or were named) after an intended change.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use engine::backend::BackendKind;
@@ -8,6 +9,77 @@ use engine::renderer::Readback;
 use harness::golden::bless::{bless_pass, BlessOutcome, BlessRequest};
 
 use super::load_cases;
+
+/// The command line of `harness bless`.
+#[derive(clap::Args)]
+pub(crate) struct BlessArgs {
+    /// Only this scene: a name in scenes/ or a path to a scene file (repeatable).
+    #[arg(long = "scene")]
+    scenes: Vec<String>,
+    /// Only this pass (repeatable); a pass named here is rewritten even within tolerance.
+    #[arg(long = "pass")]
+    passes: Vec<String>,
+    /// Rewrite every pass considered, also those within tolerance (after a driver change).
+    #[arg(long)]
+    every_pass: bool,
+    /// Backend to render the goldens with.
+    #[arg(long, default_value = "gl")]
+    backend: BackendKind,
+    /// Bless every pass of every canonical scene (required when no --scene is given).
+    #[arg(long)]
+    all: bool,
+    /// Show what would change without writing anything.
+    #[arg(long)]
+    dry_run: bool,
+    /// Bless the timing goldens only (a deliberate slowdown or speed-up), not the images.
+    #[arg(long, conflicts_with = "no_speed")]
+    speed_only: bool,
+    /// Bless the images only, not the timing goldens.
+    #[arg(long)]
+    no_speed: bool,
+    /// Instead of blessing, remove what nothing produces or records any more: folders of
+    /// scenes gone from scenes/, goldens of passes gone, goldens blessed.toml does not
+    /// record, records without a golden, stray files (every scene's, or the --scene ones';
+    /// with --dry-run, only list them).
+    #[arg(long, conflicts_with_all = ["speed_only", "every_pass", "passes"])]
+    prune: bool,
+    /// Instead of rendering, accept what the last `check` rendered: the outputs of its
+    /// failing passes on --backend (of --scene and --pass, or all), kept under
+    /// --out/failures/, blessed as a fresh render would be.
+    #[arg(long, conflicts_with_all = ["speed_only", "every_pass", "prune", "all"])]
+    from_last_check: bool,
+    /// With --from-last-check: the folder `check --out` wrote to.
+    #[arg(long, default_value_os_t = crate::default_out_dir())]
+    out: PathBuf,
+}
+
+/// `harness bless`, by mode: prune, accept from the last check, or render and bless.
+pub(crate) fn command(args: BlessArgs) -> anyhow::Result<ExitCode> {
+    if args.prune {
+        return prune(&args.scenes, args.dry_run);
+    }
+    if args.from_last_check {
+        return from_last_check(
+            &args.out,
+            &args.scenes,
+            &args.passes,
+            args.backend,
+            args.dry_run,
+        );
+    }
+    run(
+        &args.scenes,
+        &args.passes,
+        args.backend,
+        args.all,
+        Options {
+            every_pass: args.every_pass,
+            dry_run: args.dry_run,
+            images: !args.speed_only,
+            speed: !args.no_speed,
+        },
+    )
+}
 
 /// What `bless` rewrites, beyond the scenes and passes named.
 pub(crate) struct Options {
