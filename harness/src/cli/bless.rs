@@ -51,6 +51,10 @@ pub(crate) struct BlessArgs {
     /// With --from-last-check: the folder `check --out` wrote to.
     #[arg(long, default_value_os_t = crate::default_out_dir())]
     out: PathBuf,
+    /// Write new image goldens without rendering them again on every backend and CPU code path
+    /// first (the default refuses one that does not reproduce); blessed.toml records it.
+    #[arg(long)]
+    unverified: bool,
 }
 
 /// `harness bless`, by mode: prune, accept from the last check, or render and bless.
@@ -65,6 +69,7 @@ pub(crate) fn command(args: BlessArgs) -> anyhow::Result<ExitCode> {
             &args.passes,
             args.backend,
             args.dry_run,
+            args.unverified,
         );
     }
     run(
@@ -77,6 +82,7 @@ pub(crate) fn command(args: BlessArgs) -> anyhow::Result<ExitCode> {
             dry_run: args.dry_run,
             images: !args.speed_only,
             speed: !args.no_speed,
+            unverified: args.unverified,
         },
     )
 }
@@ -91,6 +97,8 @@ pub(crate) struct Options {
     pub images: bool,
     /// Bless the timing goldens (on every available backend).
     pub speed: bool,
+    /// Write new image goldens without verifying that they reproduce.
+    pub unverified: bool,
 }
 
 /// Renders each scene asked for on `kind` and rewrites the passes outside tolerance, without a
@@ -123,13 +131,18 @@ pub(crate) fn run(
         })?;
         locks.insert(name.to_owned(), lock);
     }
+    let mut refused = 0;
     if options.images {
-        bless_images(&cases, &store, &locks, passes, kind, &options)?;
+        refused = bless_images(&cases, &store, &locks, passes, kind, &options)?;
     }
     if options.speed {
         bless_speed(&cases, &store, &options)?;
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(if refused == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
 }
 
 /// Probes every available backend and rewrites the timing goldens that moved.
@@ -170,7 +183,35 @@ fn bless_speed(
     Ok(())
 }
 
-/// Renders each scene on `kind` and rewrites its image goldens as asked.
+/// Whether `candidates`, the new goldens of `case`, reproduce under every verification source
+/// (see [`harness::golden::verify`]); prints each disagreement as a refusal.
+fn verified(
+    store: &harness::golden::GoldenStore,
+    case: &harness::golden::suite::Case,
+    candidates: &[(TargetId, engine::Image)],
+) -> anyhow::Result<bool> {
+    let exe = std::env::current_exe()?;
+    let disagreements = harness::golden::verify::verify(&exe, store, case, candidates, |source| {
+        eprintln!("verifying {}'s new goldens under {source} ...", case.name());
+    })
+    .map_err(anyhow::Error::msg)?;
+    for d in &disagreements {
+        println!("REFUSED {}/{d}", case.name());
+    }
+    if !disagreements.is_empty() {
+        println!(
+            "{}: nothing written; the new goldens must reproduce on every backend and CPU code \
+             path ({}); look at the disagreeing render, or bless with --unverified to record \
+             them anyway",
+            case.name(),
+            harness::golden::verify::SOURCES.join(", ")
+        );
+    }
+    Ok(disagreements.is_empty())
+}
+
+/// Renders each scene on `kind` and rewrites its image goldens as asked, once they are
+/// verified (unless `--unverified`); the number of scenes refused.
 fn bless_images(
     cases: &[harness::golden::suite::Case],
     store: &harness::golden::GoldenStore,
@@ -178,7 +219,8 @@ fn bless_images(
     passes: &[String],
     kind: BackendKind,
     options: &Options,
-) -> anyhow::Result<()> {
+) -> anyhow::Result<usize> {
+    let mut refused = 0;
     let (every_pass, dry_run) = (options.every_pass, options.dry_run);
     let mut backend = engine::backend::create(kind)?;
     let driver = harness::golden::fingerprint(backend.info());
@@ -212,12 +254,33 @@ fn bless_images(
             named: &named,
             every_pass,
             dry_run,
+            unverified: options.unverified,
         };
+        let lock = &locks[case.name()];
+        if !dry_run && !options.unverified {
+            let mut candidates = Vec::new();
+            for &pass in &wanted {
+                let image = &frame.outputs[&pass];
+                let decision = BlessRequest {
+                    dry_run: true,
+                    ..request
+                };
+                let blessed =
+                    bless_pass(store, lock, case, pass, image, (kind, &driver), decision)?;
+                if blessed.outcome == BlessOutcome::WouldWrite {
+                    candidates.push((pass, image.clone()));
+                }
+            }
+            if !candidates.is_empty() && !verified(store, case, &candidates)? {
+                refused += 1;
+                continue;
+            }
+        }
         let mut kept = 0;
         for pass in wanted {
             let blessed = bless_pass(
                 store,
-                &locks[case.name()],
+                lock,
                 case,
                 pass,
                 &frame.outputs[&pass],
@@ -236,7 +299,7 @@ fn bless_images(
             );
         }
     }
-    Ok(())
+    Ok(refused)
 }
 
 /// `harness bless --prune`: lists the orphans in golden/ (every scene's and golden/'s own, or
@@ -276,6 +339,7 @@ pub(crate) fn from_last_check(
     passes: &[String],
     backend: BackendKind,
     dry_run: bool,
+    unverified: bool,
 ) -> anyhow::Result<ExitCode> {
     use harness::golden::accept;
     let candidates = accept::candidates(out, backend, scenes, passes)?;
@@ -308,8 +372,28 @@ pub(crate) fn from_last_check(
                 path.display()
             );
         })?;
+        let mut accepted = Vec::new();
         for candidate in candidates.iter().filter(|c| c.check.scene == case.name()) {
-            match accept::accept(&store, &lock, case, candidate, dry_run) {
+            match accept::kept_output(candidate) {
+                Ok(image) => accepted.push((candidate, image)),
+                Err(why) => {
+                    refused += 1;
+                    println!("REFUSED {why}");
+                }
+            }
+        }
+        if !dry_run && !unverified && !accepted.is_empty() {
+            let images: Vec<(TargetId, engine::Image)> = accepted
+                .iter()
+                .map(|(c, image)| (c.check.pass, image.clone()))
+                .collect();
+            if !verified(&store, case, &images)? {
+                refused += accepted.len();
+                continue;
+            }
+        }
+        for (candidate, image) in &accepted {
+            match accept::accept(&store, &lock, case, candidate, image, dry_run, unverified) {
                 Ok(blessed) => println!("{blessed}"),
                 Err(why) => {
                     refused += 1;

@@ -82,16 +82,9 @@ pub fn candidates(
         .collect())
 }
 
-/// Accepts `candidate`, a failing pass of `case` from the last check, holding the scene's
-/// `lock`: its kept output blessed as `harness bless` would bless a fresh render. Refused (an
-/// error line) when the output was not kept or the golden changed after the check.
-pub fn accept(
-    store: &GoldenStore,
-    lock: &SceneLock,
-    case: &Case,
-    candidate: &Candidate,
-    dry_run: bool,
-) -> Result<BlessedPass, String> {
+/// The output the check kept of `candidate`'s pass, refused (an error line) when the check kept
+/// none or its golden changed after the check.
+pub fn kept_output(candidate: &Candidate) -> Result<engine::Image, String> {
     let check = &candidate.check;
     let name = format!("{}/{} ({})", check.scene, check.pass, check.backend);
     let Some(actual) = &check.artifacts.actual else {
@@ -106,23 +99,39 @@ pub fn accept(
             check.golden_path.display()
         ));
     }
-    let image = read_output(actual).map_err(|e| format!("{name}: {e}"))?;
+    read_output(actual).map_err(|e| format!("{name}: {e}"))
+}
+
+/// Accepts `image`, the output the last check kept of `candidate`'s pass of `case`
+/// ([`kept_output`]), holding the scene's `lock`: blessed as `harness bless` would bless a fresh
+/// render.
+pub fn accept(
+    store: &GoldenStore,
+    lock: &SceneLock,
+    case: &Case,
+    candidate: &Candidate,
+    image: &engine::Image,
+    dry_run: bool,
+    unverified: bool,
+) -> Result<BlessedPass, String> {
+    let check = &candidate.check;
     let named = [check.pass];
     bless_pass(
         store,
         lock,
         case,
         check.pass,
-        &image,
+        image,
         (check.backend, &candidate.driver),
         BlessRequest {
             // Failed in the check: written even where it would now be within tolerance.
             named: &named,
             every_pass: false,
             dry_run,
+            unverified,
         },
     )
-    .map_err(|e| format!("{name}: {e}"))
+    .map_err(|e| format!("{}/{} ({}): {e}", check.scene, check.pass, check.backend))
 }
 
 /// A kept output, as `check` wrote it (PNG for 8-bit passes, EXR for float ones).

@@ -22,6 +22,8 @@ pub struct BlessRequest<'a> {
     pub every_pass: bool,
     /// Decide, print, and write nothing.
     pub dry_run: bool,
+    /// Written without verification (recorded in blessed.toml; see [`super::verify`]).
+    pub unverified: bool,
 }
 
 /// What blessing did to one pass.
@@ -84,7 +86,17 @@ pub fn bless_pass(
     } else if request.dry_run {
         BlessOutcome::WouldWrite
     } else {
-        BlessOutcome::Written(store.bless(lock, pass, image, backend, driver, &change.previous)?)
+        BlessOutcome::Written(store.bless(
+            lock,
+            pass,
+            image,
+            super::Provenance {
+                backend,
+                driver,
+                previous: &change.previous,
+                unverified: request.unverified,
+            },
+        )?)
     };
     Ok(BlessedPass {
         scene: case.name().to_owned(),

@@ -17,5 +17,6 @@ pub mod speed;
 mod store;
 pub mod suite;
 pub mod tolerance;
+pub mod verify;
 
 pub use store::*;

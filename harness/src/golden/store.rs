@@ -71,6 +71,19 @@ impl SceneLock {
     }
 }
 
+/// Where a golden being blessed comes from: what its blessed.toml record says.
+#[derive(Clone, Copy, Debug)]
+pub struct Provenance<'a> {
+    /// The backend that rendered it.
+    pub backend: BackendKind,
+    /// That backend's driver fingerprint.
+    pub driver: &'a str,
+    /// The metrics against the golden it replaces, or "new".
+    pub previous: &'a str,
+    /// Written without verification.
+    pub unverified: bool,
+}
+
 /// The name of a scene folder's lock file.
 pub const LOCK_FILE: &str = ".bless.lock";
 
@@ -91,6 +104,10 @@ pub struct BlessRecord {
     pub driver: String,
     /// Metrics against the golden it replaced, or "new".
     pub previous: String,
+    /// Written without checking that it reproduces on every backend and CPU code path
+    /// (`harness bless --unverified`; see [`crate::golden::verify`]).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub unverified: bool,
 }
 
 #[derive(Debug, Default, serde::Serialize, serde::Deserialize)]
@@ -219,17 +236,21 @@ impl GoldenStore {
         })
     }
 
-    /// Writes `image` as the golden of the locked scene's `pass` and records the bless. Refuses
-    /// NaN/Inf.
+    /// Writes `image` as the golden of the locked scene's `pass` and records the bless with
+    /// `provenance`. Refuses NaN/Inf.
     pub fn bless(
         &self,
         lock: &SceneLock,
         pass: TargetId,
         image: &Image,
-        backend: BackendKind,
-        driver: &str,
-        previous: &str,
+        provenance: Provenance<'_>,
     ) -> Result<PathBuf, GoldenError> {
+        let Provenance {
+            backend,
+            driver,
+            previous,
+            unverified,
+        } = provenance;
         let scene = lock.scene();
         if let Some(values) = image.as_f32() {
             let count = values.iter().filter(|v| !v.is_finite()).count();
@@ -258,6 +279,7 @@ impl GoldenStore {
                 backend,
                 driver: driver.to_owned(),
                 previous: previous.to_owned(),
+                unverified,
             },
         );
         self.write_records(lock, records)?;
@@ -391,9 +413,12 @@ mod tests {
                 &lock,
                 TargetId::Light,
                 &image,
-                BackendKind::Gl,
-                "llvmpipe",
-                "new",
+                Provenance {
+                    backend: BackendKind::Gl,
+                    driver: "llvmpipe",
+                    previous: "new",
+                    unverified: false,
+                },
             )
             .unwrap();
         assert!(path.ends_with("s/light.exr"));
@@ -416,9 +441,12 @@ mod tests {
                 &lock,
                 TargetId::Light,
                 &bad,
-                BackendKind::Gl,
-                "llvmpipe",
-                "new",
+                Provenance {
+                    backend: BackendKind::Gl,
+                    driver: "llvmpipe",
+                    previous: "new",
+                    unverified: false,
+                },
             )
             .unwrap_err();
         assert!(err.to_string().contains("NaN/Inf"), "{err}");

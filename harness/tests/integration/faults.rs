@@ -259,7 +259,15 @@ fn a_full_disk_while_blessing_keeps_the_old_golden_and_names_the_file() {
     let before = std::fs::read(golden.join("final.png")).unwrap();
     let record = std::fs::read(golden.join("blessed.toml")).unwrap();
     let output = with_full_disk(
-        &["bless", "--scene", "chess", "--pass", "final"],
+        &[
+            "bless",
+            "--scene",
+            "chess",
+            "--pass",
+            "final",
+            "--no-speed",
+            "--unverified",
+        ],
         Some(root.path()),
     );
     let stderr = String::from_utf8_lossy(&output.stderr);
@@ -313,7 +321,15 @@ fn killing_a_bless_mid_write_leaves_the_old_golden_intact() {
     let before = std::fs::read(golden.join("final.png")).unwrap();
     let record = std::fs::read(golden.join("blessed.toml")).unwrap();
     let mut child = harness_bin()
-        .args(["bless", "--scene", "chess", "--pass", "final", "--no-speed"])
+        .args([
+            "bless",
+            "--scene",
+            "chess",
+            "--pass",
+            "final",
+            "--no-speed",
+            "--unverified",
+        ])
         .env("HARNESS_ROOT", root.path())
         .env(harness::images::WRITE_DELAY_ENV, "60000")
         .stdout(std::process::Stdio::null())
@@ -335,7 +351,15 @@ fn killing_a_bless_mid_write_leaves_the_old_golden_intact() {
     assert_eq!(std::fs::read(golden.join("blessed.toml")).unwrap(), record);
 
     let status = harness_bin()
-        .args(["bless", "--scene", "chess", "--pass", "final", "--no-speed"])
+        .args([
+            "bless",
+            "--scene",
+            "chess",
+            "--pass",
+            "final",
+            "--no-speed",
+            "--unverified",
+        ])
         .env("HARNESS_ROOT", root.path())
         .output()
         .unwrap();

@@ -13,6 +13,7 @@ mod common;
 
 mod ambient_occlusion;
 mod backends;
+mod cli_accept;
 mod cli_bless;
 mod cli_check;
 mod cli_inspect;

@@ -1,0 +1,157 @@
+//! Verified bless: before a new golden is written, by `harness bless` or `bless
+//! --from-last-check`, it must reproduce. The scene is rendered again on every available
+//! backend, as the drivers are and under llvmpipe's and lavapipe's other CPU code paths (the
+//! cheap environment sources of the noise model: `drivers`, `cpu-sse4.1`, `cpu-avx`), each in a
+//! child `harness check` against a temporary golden folder that holds the candidates; every
+//! candidate pass must pass its own limits there. A golden that only one backend or one code
+//! path can produce, or an output kept by a check of a scene that has changed since, is refused
+//! with the source that disagreed. `--unverified` skips this and blessed.toml records it.
+
+use std::path::Path;
+use std::process::Command;
+
+use engine::backend::BackendKind;
+use engine::plan::TargetId;
+use engine::Image;
+
+use super::check::CheckRun;
+use super::portability::{sources, SourceKind};
+use super::suite::Case;
+use super::GoldenStore;
+
+/// The noise sources a candidate golden must reproduce under.
+pub const SOURCES: [&str; 3] = ["drivers", "cpu-sse4.1", "cpu-avx"];
+
+/// A source under which a candidate did not reproduce within its limits.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Disagreement {
+    /// The source (`drivers`, `cpu-sse4.1`, ...).
+    pub source: String,
+    /// The backend that rendered it (None when the render itself failed for every backend).
+    pub backend: Option<BackendKind>,
+    /// The pass.
+    pub pass: Option<TargetId>,
+    /// What the check said.
+    pub detail: String,
+}
+
+impl std::fmt::Display for Disagreement {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let pass = self.pass.map_or("-".to_owned(), |p| p.to_string());
+        let backend = self.backend.map_or("-", BackendKind::name);
+        write!(
+            f,
+            "{pass} does not reproduce under {} on {backend}: {}",
+            self.source, self.detail
+        )
+    }
+}
+
+/// Renders `case` under each of [`SOURCES`] (children of `exe`, the harness binary) against a
+/// temporary copy of its golden folder holding `candidates`, and returns where a candidate pass
+/// fails its limits under the first source where one does (empty: verified). `progress` is told
+/// each source.
+pub fn verify(
+    exe: &Path,
+    store: &GoldenStore,
+    case: &Case,
+    candidates: &[(TargetId, Image)],
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<Disagreement>, String> {
+    let temp = tempfile::tempdir().map_err(|e| format!("cannot make a temporary folder: {e}"))?;
+    let golden = temp.path().join("golden");
+    let scene_dir = golden.join(case.name());
+    copy_folder(&store.root().join(case.name()), &scene_dir)?;
+    // The limits come from the noise model.
+    let noise = store.root().join("noise.toml");
+    if noise.exists() {
+        std::fs::copy(&noise, golden.join("noise.toml"))
+            .map_err(|e| format!("cannot copy {}: {e}", noise.display()))?;
+    }
+    let candidate_store = GoldenStore::new(&golden);
+    for (pass, image) in candidates {
+        let path = candidate_store.path(case.name(), *pass, super::is_eight_bit(image));
+        crate::images::write_image(image, &path, crate::images::PngCompression::Fast)
+            .map_err(|e| e.to_string())?;
+    }
+    let (all, _) = sources(store);
+    let mut disagreements = Vec::new();
+    for source in all.iter().filter(|s| SOURCES.contains(&s.name.as_str())) {
+        let SourceKind::Environment(vars) = &source.kind else {
+            continue;
+        };
+        progress(&source.name);
+        let out = temp.path().join(format!("out-{}", source.name));
+        let output = Command::new(exe)
+            .args(["check", "--json", "--no-speed", "--scene"])
+            .arg(&case.loaded.path)
+            .arg("--out")
+            .arg(&out)
+            .env("HARNESS_ROOT", temp.path())
+            // The maps of this workspace's cache (the temporary root has none).
+            .env(
+                "HARNESS_IBL_CACHE",
+                crate::ibl_cache_dir().unwrap_or_default(),
+            )
+            .envs(vars.iter().map(|(k, v)| (k, v)))
+            .output()
+            .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
+        let run: CheckRun = match serde_json::from_slice(&output.stdout) {
+            Ok(run) => run,
+            Err(_) => {
+                disagreements.push(Disagreement {
+                    source: source.name.clone(),
+                    backend: None,
+                    pass: None,
+                    detail: format!(
+                        "the check did not run ({}): {}",
+                        output.status,
+                        String::from_utf8_lossy(&output.stderr)
+                            .lines()
+                            .last()
+                            .unwrap_or_default()
+                    ),
+                });
+                continue;
+            }
+        };
+        for r in &run.results {
+            if candidates.iter().any(|(p, _)| *p == r.pass) && !r.outcome.passed() {
+                disagreements.push(Disagreement {
+                    source: source.name.clone(),
+                    backend: Some(r.backend),
+                    pass: Some(r.pass),
+                    detail: r.worst(),
+                });
+            }
+        }
+        for (_, backend, error) in &run.render_errors {
+            disagreements.push(Disagreement {
+                source: source.name.clone(),
+                backend: Some(*backend),
+                pass: None,
+                detail: format!("render failed: {error}"),
+            });
+        }
+        // Refused already: the sources after this one would only say more of the same.
+        if !disagreements.is_empty() {
+            break;
+        }
+    }
+    Ok(disagreements)
+}
+
+/// Copies the files of `from` (not its folders: a scene's golden folder has none) into `to`.
+fn copy_folder(from: &Path, to: &Path) -> Result<(), String> {
+    std::fs::create_dir_all(to).map_err(|e| format!("cannot create {}: {e}", to.display()))?;
+    let Ok(entries) = std::fs::read_dir(from) else {
+        return Ok(());
+    };
+    for entry in entries.flatten() {
+        if entry.file_type().is_ok_and(|t| t.is_file()) {
+            std::fs::copy(entry.path(), to.join(entry.file_name()))
+                .map_err(|e| format!("cannot copy {}: {e}", entry.path().display()))?;
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,157 @@
+//! `harness bless --from-last-check`: accepting what `check` rendered and kept, and the
+//! verification every new golden goes through first.
+
+use super::cli_bless::{changed_files, snapshot};
+use crate::common;
+
+/// `bless --from-last-check` accepts what `check` rendered without rendering again: after a
+/// light change, accepting arrow's light pass (`--unverified`, with no driver to be found, so a
+/// render would fail) writes that golden and its record (the check's backend and driver, the
+/// metrics against the old golden, unverified) and nothing else; the next check passes it and
+/// still fails the final image, until it is accepted too. Verification (the default; a verified
+/// bless that writes is in `bless_after_a_light_change_rewrites_only_the_changed_passes`) refuses
+/// a kept output that no longer reproduces (the scene changed back after the check), naming the
+/// source and backend, and a golden rewritten after the check is refused too.
+#[test]
+fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    let scene = root.path().join("scenes/arrow.toml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let with_intensity = |value: &str| {
+        std::fs::write(
+            &scene,
+            text.replace("intensity = 2.5", &format!("intensity = {value}")),
+        )
+        .unwrap();
+    };
+    with_intensity("3.0");
+    let out = root.path().join("out");
+    let check = || {
+        let output = common::harness_command()
+            .args([
+                "check",
+                "--scene",
+                "arrow",
+                "--backend",
+                "gl",
+                "--no-speed",
+                "--json",
+            ])
+            .args(["--out", out.to_str().unwrap()])
+            .env("HARNESS_ROOT", root.path())
+            .output()
+            .unwrap();
+        let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+        let failing: Vec<String> = json["results"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|r| r["outcome"].get("Passed").is_none())
+            .map(|r| r["pass"].as_str().unwrap().to_owned())
+            .collect();
+        (output.status.code(), failing)
+    };
+    let accept = |pass: &str, drivers: bool, verify: bool| {
+        let mut command = common::harness_command();
+        command
+            .args([
+                "bless",
+                "--from-last-check",
+                "--scene",
+                "arrow",
+                "--pass",
+                pass,
+            ])
+            .args(["--out", out.to_str().unwrap()])
+            .env("HARNESS_ROOT", root.path());
+        if !verify {
+            command.arg("--unverified");
+        }
+        if !drivers {
+            command
+                .env("LIBGL_DRIVERS_PATH", "/nonexistent")
+                .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+                .env("VK_ICD_FILENAMES", "/nonexistent/icd.json");
+        }
+        let output = command.output().unwrap();
+        let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+        (output.status.code(), stdout)
+    };
+    let light_final = vec!["light".to_owned(), "final".to_owned()];
+    assert_eq!(check(), (Some(1), light_final.clone()));
+    let golden = root.path().join("golden");
+    let before = snapshot(&golden);
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    let (code, stdout) = accept("light", false, false);
+    assert_eq!(code, Some(0), "{stdout}");
+    assert!(
+        stdout.contains("arrow/light: CHANGED vs old golden") && stdout.contains("wrote "),
+        "{stdout}"
+    );
+    let after = snapshot(&golden);
+    assert_eq!(
+        changed_files(&golden, &before, &after),
+        ["arrow/blessed.toml", "arrow/light.exr"]
+    );
+    // The golden holds exactly the pixels the check kept (the files' compression may differ).
+    let kept = harness::images::read_exr(&out.join("failures/arrow/gl/light_actual.exr")).unwrap();
+    let blessed = harness::images::read_exr(&golden.join("arrow/light.exr")).unwrap();
+    assert!(
+        kept.data == blessed.data && (kept.width, kept.height) == (blessed.width, blessed.height),
+        "the blessed light buffer is not the one the check kept"
+    );
+    let records = || {
+        harness::golden::GoldenStore::new(&golden)
+            .records("arrow")
+            .unwrap()
+    };
+    let light = &records()["light"];
+    assert_eq!(light.backend, engine::backend::BackendKind::Gl);
+    assert!(light.driver.contains("llvmpipe"), "{}", light.driver);
+    assert!(
+        light
+            .previous
+            .starts_with("CHANGED vs old golden: fraction_over"),
+        "{}",
+        light.previous
+    );
+    assert!(light.unverified);
+
+    assert_eq!(check(), (Some(1), vec!["final".to_owned()]));
+    let (code, stdout) = accept("final", true, false);
+    assert_eq!(code, Some(0), "{stdout}");
+    assert_eq!(check(), (Some(0), vec![]));
+
+    // Checked at 3.5, accepted after the scene went back to 3.0: the kept light buffer does not
+    // reproduce, and nothing is written.
+    with_intensity("3.5");
+    assert_eq!(check(), (Some(1), light_final));
+    with_intensity("3.0");
+    let before = snapshot(&golden);
+    let (code, stdout) = accept("light", true, true);
+    assert_eq!(code, Some(1), "{stdout}");
+    assert!(
+        stdout.contains("REFUSED arrow/light does not reproduce under drivers on gl"),
+        "{stdout}"
+    );
+    assert_eq!(snapshot(&golden), before);
+
+    // The final golden rewritten after that check: accepting the check's final is refused.
+    let future = std::time::SystemTime::now() + std::time::Duration::from_secs(60);
+    std::fs::File::options()
+        .write(true)
+        .open(golden.join("arrow/final.png"))
+        .unwrap()
+        .set_modified(future)
+        .unwrap();
+    let (code, stdout) = accept("final", true, false);
+    assert_eq!(code, Some(1), "{stdout}");
+    assert!(
+        stdout.contains("REFUSED arrow/final (gl)")
+            && stdout.contains("changed after the last check"),
+        "{stdout}"
+    );
+}
