@@ -16,6 +16,7 @@ pub mod inspect;
 pub mod measure;
 pub mod reference;
 pub mod report;
+pub mod review;
 pub mod test_scenes;
 
 /// Order statistics (one nearest-rank rule), shared with the engine's tests.

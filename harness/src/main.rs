@@ -97,6 +97,18 @@ enum Command {
     /// golden, atomically, recording the driver and date in golden/<scene>/blessed.toml. Passes
     /// within tolerance and their records are left alone.
     Bless(cli::bless::BlessArgs),
+    /// Serve the last check's review page on 127.0.0.1 with Accept buttons on each failing pass,
+    /// scene and the whole run: accepting blesses the outputs the check kept (verified, never
+    /// rendered again). Prints the page's address (with its token) and opens nothing; Ctrl-C
+    /// stops it.
+    Review {
+        /// The folder `check --out` wrote to.
+        #[arg(long, default_value_os_t = default_out_dir())]
+        out: PathBuf,
+        /// Port to listen on (0: any free one).
+        #[arg(long, default_value_t = 0)]
+        port: u16,
+    },
     /// Render a scene on one backend and write pass outputs (`.png`, or `.exr` for float passes).
     Render {
         /// Canonical scene name (`chess`) or path to a scene file.
@@ -293,6 +305,7 @@ fn main() -> ExitCode {
             timing,
         } => cli::noise::command(&sources, &scenes, write, margin, json, timing),
         Command::Bless(args) => cli::bless::command(args),
+        Command::Review { out, port } => cli::review::run(&out, port),
         Command::Render {
             scene,
             backend,

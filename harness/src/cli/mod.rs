@@ -10,6 +10,7 @@ pub(super) mod hard;
 pub(super) mod info;
 pub(super) mod noise;
 pub(super) mod render;
+pub(super) mod review;
 pub(super) mod selftest;
 pub(super) mod sweep;
 

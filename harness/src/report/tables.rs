@@ -34,8 +34,11 @@ pub(super) fn summary(out: &mut String, run: &CheckRun) {
             .unwrap_or_default();
         let _ = write!(
             out,
-            "<tr class=\"{class}\"><td>{}</td><td><a href=\"#{}\">{}</a></td><td>{}</td>\
-             <td>{}</td><td>{verdict}<code>{}</code></td></tr>",
+            "<tr class=\"{class}\" data-scene=\"{}\" data-pass=\"{}\" data-backend=\"{}\"><td>{}</td>\
+             <td><a href=\"#{}\">{}</a></td><td>{}</td><td class=\"result\">{}</td><td>{verdict}<code>{}</code></td></tr>",
+            escape(&r.scene),
+            r.pass,
+            r.backend,
             escape(&r.scene),
             case_id(&r.scene, r.pass),
             r.pass,

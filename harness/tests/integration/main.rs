@@ -31,6 +31,7 @@ mod noise;
 mod plans;
 mod renderer;
 mod report;
+mod review;
 mod selftest;
 mod shadows;
 mod speed;

@@ -18,7 +18,7 @@ use serde_json::{json, Value};
 use tungstenite::stream::MaybeTlsStream;
 use tungstenite::{Message, WebSocket};
 
-fn chromium() -> Option<&'static str> {
+pub(crate) fn chromium() -> Option<&'static str> {
     [
         "/usr/bin/chromium",
         "/usr/bin/chromium-browser",
@@ -30,7 +30,7 @@ fn chromium() -> Option<&'static str> {
 
 /// A headless Chromium and one page of it, driven over the DevTools Protocol (JSON messages on
 /// a WebSocket; the few commands the test needs).
-struct Browser {
+pub(crate) struct Browser {
     child: Child,
     socket: WebSocket<MaybeTlsStream<TcpStream>>,
     next_id: u64,
@@ -41,7 +41,7 @@ struct Browser {
 }
 
 impl Browser {
-    fn launch(executable: &str) -> Browser {
+    pub(crate) fn launch(executable: &str) -> Browser {
         let profile = tempfile::tempdir().unwrap();
         let child = Command::new(executable)
             .args([
@@ -134,7 +134,7 @@ impl Browser {
     }
 
     /// Opens `url` in a new page of 1600x1200 CSS pixels and talks to that page from now on.
-    fn open(&mut self, url: &str) {
+    pub(crate) fn open(&mut self, url: &str) {
         let target = self.call("Target.createTarget", json!({ "url": "about:blank" }));
         let attached = self.call(
             "Target.attachToTarget",
@@ -152,7 +152,7 @@ impl Browser {
     }
 
     /// Evaluates JavaScript in the page (awaiting a promise) and returns its value.
-    fn eval(&mut self, expression: &str) -> Value {
+    pub(crate) fn eval(&mut self, expression: &str) -> Value {
         let result = self.call(
             "Runtime.evaluate",
             json!({ "expression": expression, "awaitPromise": true, "returnByValue": true }),
@@ -197,7 +197,7 @@ impl Browser {
     }
 
     /// Clicks the middle of the element found by `selector`.
-    fn click_on(&mut self, selector: &str) {
+    pub(crate) fn click_on(&mut self, selector: &str) {
         let [x, y, w, h] = self.rect(selector);
         self.click(x + w / 2.0, y + h / 2.0);
     }
@@ -275,7 +275,7 @@ fn exr(path: &Path) -> engine::Image {
 /// Brightens the arrow scene's light in a temporary workspace (its light buffer and final image
 /// change, nothing else) and runs `harness check` on it, which must fail. Returns the workspace
 /// and the `--out` folder holding report.html and the failure images.
-fn check_after_a_light_change() -> (tempfile::TempDir, PathBuf) {
+pub(crate) fn check_after_a_light_change() -> (tempfile::TempDir, PathBuf) {
     let root = common::temp_workspace();
     let scene = root.path().join("scenes/arrow.toml");
     let text = std::fs::read_to_string(&scene).unwrap();

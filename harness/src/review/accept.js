@@ -1,0 +1,92 @@
+// The Accept buttons of `harness review` (served pages only; the page written by `check` has
+// none). Each failing row, each scene and the whole run get one; a click posts to /accept with
+// the run's token, and the rows of what was accepted are marked.
+(function () {
+  const review = window.HARNESS_REVIEW;
+  if (!review) return;
+  const style = document.createElement('style');
+  style.textContent =
+    'button.accept{margin-right:.5em} tr.accepted td{background:#e3f4e3}' +
+    ' .accept-bar{margin:.5em 0} .accept-bar button{margin-right:.4em}';
+  document.head.appendChild(style);
+
+  function mark(accepted) {
+    for (const [scene, pass] of accepted) {
+      const rows = document.querySelectorAll('tr[data-scene][data-pass]');
+      for (const row of rows) {
+        if (row.dataset.scene !== scene || row.dataset.pass !== pass) continue;
+        row.classList.add('accepted');
+        const result = row.querySelector('td.result');
+        if (result) result.textContent = 'ACCEPTED';
+        const button = row.querySelector('button.accept');
+        if (button) {
+          button.disabled = true;
+          button.textContent = 'accepted';
+        }
+      }
+    }
+  }
+
+  function accept(filter, button) {
+    button.disabled = true;
+    button.textContent = 'accepting…';
+    fetch('/accept', {
+      method: 'POST',
+      headers: { 'Content-Type': 'application/json', 'X-Harness-Token': review.token },
+      body: JSON.stringify(filter),
+    })
+      .then((response) => response.json())
+      .then((answer) => {
+        mark(answer.accepted.map(([scene, pass]) => [scene, pass]));
+        if (answer.refused.length) {
+          button.disabled = false;
+          button.textContent = 'refused';
+          button.title = answer.refused.map((r) => r.join(' ')).join('\n');
+        } else {
+          button.textContent = 'accepted';
+        }
+      })
+      .catch((error) => {
+        button.disabled = false;
+        button.textContent = 'error';
+        button.title = String(error);
+      });
+  }
+
+  const failing = document.querySelectorAll('table.summary tr.failed[data-scene]');
+  const scenes = [];
+  for (const row of failing) {
+    if (!scenes.includes(row.dataset.scene)) scenes.push(row.dataset.scene);
+    const button = document.createElement('button');
+    button.className = 'accept';
+    button.textContent = 'Accept';
+    button.title = 'bless this output of ' + row.dataset.backend + ' as the golden';
+    button.onclick = () =>
+      accept(
+        { scene: row.dataset.scene, pass: row.dataset.pass, backend: row.dataset.backend },
+        button
+      );
+    row.lastElementChild.prepend(button);
+  }
+  if (scenes.length) {
+    const bar = document.createElement('div');
+    bar.className = 'accept-bar';
+    bar.append('Accept every failing pass of: ');
+    for (const scene of scenes) {
+      const button = document.createElement('button');
+      button.className = 'accept-scene';
+      button.dataset.scene = scene;
+      button.textContent = scene;
+      button.onclick = () => accept({ scene }, button);
+      bar.append(button);
+    }
+    const all = document.createElement('button');
+    all.className = 'accept-run';
+    all.textContent = 'the whole run';
+    all.onclick = () => accept({}, all);
+    bar.append(all);
+    const summary = document.getElementById('summary');
+    summary.parentNode.insertBefore(bar, summary.nextSibling);
+  }
+  mark(review.accepted);
+})();

@@ -1,0 +1,309 @@
+//! `harness review`: the last check's review page served on 127.0.0.1, with Accept buttons on
+//! each failing pass, each scene and the whole run. Accepting blesses exactly the outputs that
+//! `check` rendered and kept ([`crate::golden::accept`]), verified and recorded as any bless
+//! ([`crate::golden::verify`]); it never renders the check again. The page marks what was
+//! accepted; a later `check` shows it passing.
+//!
+//! The server answers only its own page: every request must name it in its Host header
+//! (`127.0.0.1:<port>` or `localhost:<port>`: a page elsewhere that makes the browser call it, or
+//! a DNS name rebound to 127.0.0.1, names another), and every accept must carry the run's
+//! random token (printed in the URL, sent back in a header) and, when the browser says where it
+//! comes from, an Origin of the same host.
+
+use std::collections::BTreeSet;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use engine::backend::BackendKind;
+
+use crate::golden::accept::{self, Candidate};
+use crate::golden::suite::{self, Case};
+use crate::golden::GoldenStore;
+
+/// The script the served page gets: the Accept buttons and what they do.
+const SCRIPT: &str = include_str!("accept.js");
+
+/// Why the review server could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum ReviewError {
+    /// No page to serve.
+    #[error("no review page at {0}: run `harness check` first")]
+    NoPage(PathBuf),
+    /// The address could not be bound.
+    #[error("cannot listen on 127.0.0.1:{port}: {message}")]
+    Bind {
+        /// The port asked for.
+        port: u16,
+        /// Why.
+        message: String,
+    },
+    /// No random token could be made.
+    #[error("cannot read random bytes for the page's token: {0}")]
+    Token(std::io::Error),
+}
+
+/// What one accept request asks for: a pass on a backend, a scene, or (all empty) the run.
+#[derive(Clone, Debug, Default, serde::Deserialize)]
+pub struct AcceptRequest {
+    /// Only this scene.
+    pub scene: Option<String>,
+    /// Only this pass (with a scene).
+    pub pass: Option<String>,
+    /// The backend whose outputs to accept (the reference backend by default).
+    pub backend: Option<BackendKind>,
+}
+
+/// The answer to an accept request.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct AcceptAnswer {
+    /// `(scene, pass, backend)` accepted and written.
+    pub accepted: Vec<(String, String, BackendKind)>,
+    /// Those refused, with why.
+    pub refused: Vec<(String, String, String)>,
+}
+
+/// The server of one review.
+pub struct Review {
+    server: tiny_http::Server,
+    port: u16,
+    token: String,
+    out: PathBuf,
+    accepted: BTreeSet<(String, String)>,
+}
+
+impl Review {
+    /// Binds 127.0.0.1:`port` (0: any free port) for the check kept under `out`.
+    pub fn bind(out: &Path, port: u16) -> Result<Self, ReviewError> {
+        if !out.join("report.html").exists() || !out.join(accept::LAST_CHECK).exists() {
+            return Err(ReviewError::NoPage(out.join("report.html")));
+        }
+        let server =
+            tiny_http::Server::http(("127.0.0.1", port)).map_err(|e| ReviewError::Bind {
+                port,
+                message: e.to_string(),
+            })?;
+        let port = server
+            .server_addr()
+            .to_ip()
+            .map(|a| a.port())
+            .unwrap_or(port);
+        Ok(Self {
+            server,
+            port,
+            token: token().map_err(ReviewError::Token)?,
+            out: out.to_owned(),
+            accepted: BTreeSet::new(),
+        })
+    }
+
+    /// The page's address, token included.
+    pub fn url(&self) -> String {
+        format!("http://127.0.0.1:{}/?token={}", self.port, self.token)
+    }
+
+    /// Answers requests until the process ends.
+    pub fn serve(mut self, store: &GoldenStore) {
+        while let Ok(request) = self.server.recv() {
+            self.answer(request, store);
+        }
+    }
+
+    fn answer(&mut self, mut request: tiny_http::Request, store: &GoldenStore) {
+        let header = |name: &str| {
+            request
+                .headers()
+                .iter()
+                .find(|h| h.field.as_str().as_str().eq_ignore_ascii_case(name))
+                .map(|h| h.value.as_str().to_owned())
+        };
+        let host_ok = header("Host").is_some_and(|host| {
+            host == format!("127.0.0.1:{}", self.port) || host == format!("localhost:{}", self.port)
+        });
+        let origin_ok = header("Origin").is_none_or(|origin| {
+            origin == format!("http://127.0.0.1:{}", self.port)
+                || origin == format!("http://localhost:{}", self.port)
+        });
+        let url = request.url().to_owned();
+        let (path, query) = url.split_once('?').unwrap_or((&url, ""));
+        let forbidden = |why: &str| {
+            tiny_http::Response::from_string(format!("refused: {why}\n")).with_status_code(403)
+        };
+        if !host_ok || !origin_ok {
+            let _ = request.respond(forbidden("this server answers only its own page"));
+            return;
+        }
+        let method = request.method().clone();
+        let response = match (method, path) {
+            (tiny_http::Method::Get, "/") => {
+                let token_ok = query
+                    .split('&')
+                    .any(|kv| kv == format!("token={}", self.token));
+                if token_ok {
+                    self.page()
+                } else {
+                    forbidden("no or wrong token (use the URL `harness review` printed)").boxed()
+                }
+            }
+            (tiny_http::Method::Post, "/accept") => {
+                if header("X-Harness-Token").as_deref() != Some(self.token.as_str()) {
+                    forbidden("no or wrong token").boxed()
+                } else {
+                    let mut body = String::new();
+                    let _ = request
+                        .as_reader()
+                        .take(64 * 1024)
+                        .read_to_string(&mut body);
+                    match serde_json::from_str::<AcceptRequest>(&body) {
+                        Ok(ask) => {
+                            let answer = self.accept(&ask, store);
+                            json(&answer)
+                        }
+                        Err(e) => tiny_http::Response::from_string(format!("bad request: {e}\n"))
+                            .with_status_code(400)
+                            .boxed(),
+                    }
+                }
+            }
+            _ => tiny_http::Response::from_string("not found\n")
+                .with_status_code(404)
+                .boxed(),
+        };
+        let _ = request.respond(response);
+    }
+
+    /// The review page with the token, what was accepted, and the Accept script.
+    fn page(&self) -> tiny_http::ResponseBox {
+        let html = match std::fs::read_to_string(self.out.join("report.html")) {
+            Ok(html) => html,
+            Err(e) => {
+                return tiny_http::Response::from_string(format!("cannot read the page: {e}\n"))
+                    .with_status_code(500)
+                    .boxed()
+            }
+        };
+        let state = serde_json::json!({
+            "token": self.token,
+            "accepted": self.accepted.iter().collect::<Vec<_>>(),
+        });
+        let inject = format!("<script>window.HARNESS_REVIEW = {state};\n{SCRIPT}</script></body>");
+        let page = html.replacen("</body>", &inject, 1);
+        let mut response = tiny_http::Response::from_string(page);
+        if let Ok(header) =
+            tiny_http::Header::from_bytes("Content-Type", "text/html; charset=utf-8")
+        {
+            response.add_header(header);
+        }
+        response.boxed()
+    }
+
+    /// Accepts what `ask` names from the last check: verified, then blessed, scene by scene.
+    fn accept(&mut self, ask: &AcceptRequest, store: &GoldenStore) -> AcceptAnswer {
+        let mut answer = AcceptAnswer::default();
+        let backend = ask.backend.unwrap_or(suite::REFERENCE_BACKEND);
+        let scenes: Vec<String> = ask.scene.iter().cloned().collect();
+        let passes: Vec<String> = ask.pass.iter().cloned().collect();
+        let candidates = match accept::candidates(&self.out, backend, &scenes, &passes) {
+            Ok(candidates) => candidates,
+            Err(e) => {
+                answer.refused.push(("-".into(), "-".into(), e.to_string()));
+                return answer;
+            }
+        };
+        let mut arguments: Vec<String> = Vec::new();
+        for c in &candidates {
+            if !arguments.contains(&c.check.scene_argument) {
+                arguments.push(c.check.scene_argument.clone());
+            }
+        }
+        for argument in arguments {
+            let mine: Vec<&Candidate> = candidates
+                .iter()
+                .filter(|c| c.check.scene_argument == argument)
+                .collect();
+            let refuse = |answer: &mut AcceptAnswer, why: String| {
+                for c in &mine {
+                    let (scene, pass) = (c.check.scene.clone(), c.check.pass.to_string());
+                    answer.refused.push((scene, pass, why.clone()));
+                }
+            };
+            let case = match Case::load(&argument) {
+                Ok(case) => case,
+                Err(e) => {
+                    refuse(&mut answer, e.to_string());
+                    continue;
+                }
+            };
+            match accept_scene(store, &case, &mine) {
+                Ok((accepted, refused)) => {
+                    for (pass, backend) in accepted {
+                        self.accepted.insert((case.name().to_owned(), pass.clone()));
+                        answer
+                            .accepted
+                            .push((case.name().to_owned(), pass, backend));
+                    }
+                    answer.refused.extend(refused);
+                }
+                Err(why) => refuse(&mut answer, why),
+            }
+        }
+        answer
+    }
+}
+
+/// Accepts `candidates` of `case`: the kept outputs, verified together, then blessed under the
+/// scene's lock. The passes accepted (with their backend) and those refused (with why), or why
+/// the whole scene was refused.
+#[allow(clippy::type_complexity)]
+fn accept_scene(
+    store: &GoldenStore,
+    case: &Case,
+    candidates: &[&Candidate],
+) -> Result<(Vec<(String, BackendKind)>, Vec<(String, String, String)>), String> {
+    let lock = store
+        .lock_scene(case.name(), |_| {})
+        .map_err(|e| e.to_string())?;
+    let mut refused = Vec::new();
+    let mut kept = Vec::new();
+    for c in candidates {
+        match accept::kept_output(c) {
+            Ok(image) => kept.push((*c, image)),
+            Err(why) => refused.push((c.check.scene.clone(), c.check.pass.to_string(), why)),
+        }
+    }
+    let images: Vec<_> = kept
+        .iter()
+        .map(|(c, i)| (c.check.pass, i.clone()))
+        .collect();
+    if !images.is_empty() {
+        let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+        let disagreements = crate::golden::verify::verify(&exe, store, case, &images, |_| {})?;
+        if let Some(first) = disagreements.first() {
+            return Err(format!("not verified: {first}"));
+        }
+    }
+    let mut accepted = Vec::new();
+    for (c, image) in &kept {
+        match accept::accept(store, &lock, case, c, image, false, false) {
+            Ok(_) => accepted.push((c.check.pass.to_string(), c.check.backend)),
+            Err(why) => refused.push((c.check.scene.clone(), c.check.pass.to_string(), why)),
+        }
+    }
+    Ok((accepted, refused))
+}
+
+/// `value` as a JSON response.
+fn json(value: &impl serde::Serialize) -> tiny_http::ResponseBox {
+    let text = serde_json::to_string(value).unwrap_or_else(|_| "{}".to_owned());
+    let mut response = tiny_http::Response::from_string(text);
+    if let Ok(header) = tiny_http::Header::from_bytes("Content-Type", "application/json") {
+        response.add_header(header);
+    }
+    response.boxed()
+}
+
+/// 128 random bits as hex, from the operating system.
+fn token() -> std::io::Result<String> {
+    let mut bytes = [0u8; 16];
+    std::fs::File::open("/dev/urandom")?.read_exact(&mut bytes)?;
+    Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())
+}

@@ -1,0 +1,155 @@
+//! `harness review` in a real browser: after a change to the arrow scene's light and a failing
+//! check, the served page's Accept button on the light buffer (gl) blesses what the check kept,
+//! the page marks that row accepted, and the next check passes the light buffer and still fails
+//! the final image. Requests without the page's token, or naming another host, are refused.
+//!
+//! Needs Chromium, like `report` (skipped with a note without it, unless REQUIRE_CHROMIUM=1).
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+
+use serde_json::json;
+
+use super::report::{check_after_a_light_change, chromium, Browser};
+use crate::common;
+
+/// Sends a raw HTTP request to 127.0.0.1:`port` and returns its status code.
+fn status(port: u16, request: &str) -> u16 {
+    let mut stream = TcpStream::connect(("127.0.0.1", port)).unwrap();
+    stream.write_all(request.as_bytes()).unwrap();
+    let mut answer = String::new();
+    let _ = stream.read_to_string(&mut answer);
+    answer
+        .split_whitespace()
+        .nth(1)
+        .and_then(|code| code.parse().ok())
+        .unwrap_or_else(|| panic!("no status in {answer:?}"))
+}
+
+/// Kills the review server when the test ends, however it ends; holds its stdout open until
+/// then (a closed pipe would end it at its next line).
+struct Server {
+    child: std::process::Child,
+    _stdout: BufReader<std::process::ChildStdout>,
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+#[test]
+fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
+    let Some(executable) = chromium() else {
+        if std::env::var("REQUIRE_CHROMIUM").as_deref() == Ok("1") {
+            panic!("REQUIRE_CHROMIUM=1 but no Chromium found (apt-get install -y chromium)");
+        }
+        eprintln!("note: no Chromium; review server test skipped (apt-get install -y chromium)");
+        return;
+    };
+    if !common::gl_available() {
+        return;
+    }
+    let (root, out) = check_after_a_light_change();
+    let mut child = common::harness_command()
+        .args(["review", "--out"])
+        .arg(&out)
+        .env("HARNESS_ROOT", root.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    let mut stdout = BufReader::new(child.stdout.take().unwrap());
+    stdout.read_line(&mut first).unwrap();
+    let server = Server {
+        child,
+        _stdout: stdout,
+    };
+    let url = first
+        .split_whitespace()
+        .find(|w| w.starts_with("http://127.0.0.1:"))
+        .unwrap_or_else(|| panic!("no address in {first:?}"))
+        .to_owned();
+    let port: u16 = url["http://127.0.0.1:".len()..]
+        .split('/')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let token = url.split("token=").nth(1).unwrap().to_owned();
+    let host = format!("Host: 127.0.0.1:{port}\r\n");
+    let post = |headers: &str| {
+        format!(
+            "POST /accept HTTP/1.1\r\n{headers}Content-Type: application/json\r\n\
+             Content-Length: 2\r\nConnection: close\r\n\r\n{{}}"
+        )
+    };
+
+    // Refused: no token, a wrong one, another host, another origin, the page without its token.
+    assert_eq!(status(port, &post(&host)), 403);
+    assert_eq!(
+        status(port, &post(&format!("{host}X-Harness-Token: 00\r\n"))),
+        403
+    );
+    let token_header = format!("X-Harness-Token: {token}\r\n");
+    let elsewhere = format!("Host: attacker.example:{port}\r\n{token_header}");
+    assert_eq!(status(port, &post(&elsewhere)), 403);
+    let origin = format!("{host}{token_header}Origin: http://attacker.example\r\n");
+    assert_eq!(status(port, &post(&origin)), 403);
+    let page = format!("GET / HTTP/1.1\r\n{host}Connection: close\r\n\r\n");
+    assert_eq!(status(port, &page), 403);
+
+    let mut browser = Browser::launch(executable);
+    browser.open(&url);
+    let row = "table.summary tr.failed[data-scene=arrow][data-pass=light][data-backend=gl]";
+    assert_eq!(
+        browser.eval(&format!(
+            "document.querySelectorAll('{row} button.accept').length"
+        )),
+        json!(1)
+    );
+    browser.click_on(&format!("{row} button.accept"));
+    // Accepting verifies (renders again in child checks): wait for the row to be marked.
+    let marked = browser.eval(&format!(
+        "new Promise((resolve) => {{ const start = Date.now(); const poll = () => {{ \
+         const r = document.querySelector('{row}'); \
+         if (r.classList.contains('accepted')) resolve(r.querySelector('td.result').textContent); \
+         else if (Date.now() - start > 120000) resolve('timed out: ' + \
+           r.querySelector('button.accept').textContent + ' ' + r.querySelector('button.accept').title); \
+         else setTimeout(poll, 100); }}; poll(); }})"
+    ));
+    assert_eq!(marked, json!("ACCEPTED"));
+    drop(server);
+
+    let output = common::harness_command()
+        .args([
+            "check",
+            "--no-speed",
+            "--scene",
+            "arrow",
+            "--backend",
+            "gl",
+            "--json",
+            "--out",
+        ])
+        .arg(&out)
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let run: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let failing: Vec<&str> = run["results"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| r["outcome"].get("Passed").is_none())
+        .map(|r| r["pass"].as_str().unwrap())
+        .collect();
+    assert_eq!(failing, ["final"]);
+    let record = &harness::golden::GoldenStore::new(root.path().join("golden"))
+        .records("arrow")
+        .unwrap()["light"];
+    assert!(!record.unverified && record.previous.starts_with("CHANGED vs old golden"));
+}
