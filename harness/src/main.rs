@@ -109,6 +109,26 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         port: u16,
     },
+    /// Join sharded checks (`check --scene S --out DIR` on several jobs) into one run: one review
+    /// page and last-check.json under --out, and one JUnit file and summary if asked. Exits 1 if
+    /// the joined run failed.
+    Report {
+        /// The shards' `--out` folders (each with its last-check.json and failures/).
+        #[arg(long = "merge", required = true, num_args = 1..)]
+        shards: Vec<PathBuf>,
+        /// Where to write the joined page and last-check.json.
+        #[arg(long, default_value_os_t = default_out_dir())]
+        out: PathBuf,
+        /// Also write the joined results as JUnit XML.
+        #[arg(long, value_name = "FILE")]
+        junit: Option<PathBuf>,
+        /// Also write the joined Markdown summary.
+        #[arg(long, value_name = "FILE")]
+        summary: Option<PathBuf>,
+        /// Print the joined results as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Render a scene on one backend and write pass outputs (`.png`, or `.exr` for float passes).
     Render {
         /// Canonical scene name (`chess`) or path to a scene file.
@@ -306,6 +326,23 @@ fn main() -> ExitCode {
         } => cli::noise::command(&sources, &scenes, write, margin, json, timing),
         Command::Bless(args) => cli::bless::command(args),
         Command::Review { out, port } => cli::review::run(&out, port),
+        Command::Report {
+            shards,
+            out,
+            junit,
+            summary,
+            json,
+        } => cli::check::merge(
+            &shards,
+            &out,
+            &cli::check::Options {
+                json,
+                speed: false,
+                unspecialised_lighting: false,
+                junit,
+                summary,
+            },
+        ),
         Command::Render {
             scene,
             backend,

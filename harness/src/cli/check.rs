@@ -33,7 +33,6 @@ pub(crate) fn run(
     backends: &[BackendKind],
     options: Options,
 ) -> anyhow::Result<ExitCode> {
-    let json = options.json;
     let (mut cases, broken) = load_cases_isolated(scenes)?;
     let variations = engine::renderer::Variations {
         unspecialised_lighting: options.unspecialised_lighting,
@@ -105,38 +104,72 @@ pub(crate) fn run(
         eprintln!("note: {note}");
     }
     note_borrowed_limits(&cases);
-    let html = harness::report::html(
+    finish(
         &run,
         &outputs,
         &store,
+        out,
+        &failures.display().to_string(),
+        &options,
+    )
+}
+
+/// Writes what a run leaves under `out` (the review page, last-check.json) and where `options`
+/// asks (JUnit, summary), prints the table or the JSON, and says how the run went: `check`'s
+/// last step, and `report --merge`'s.
+pub(crate) fn finish(
+    run: &CheckRun,
+    outputs: &harness::golden::check::Outputs,
+    store: &harness::golden::GoldenStore,
+    out: &Path,
+    failures: &str,
+    options: &Options,
+) -> anyhow::Result<ExitCode> {
+    let html = harness::report::html(
+        run,
+        outputs,
+        store,
         Some(out),
         &harness::measure::report_sections(),
     );
     let report = out.join("report.html");
     harness::images::write_atomically(&report, html.as_bytes())?;
-    // What `bless --from-last-check` accepts from: this run's results, beside the failure images
-    // they point at.
-    let record = serde_json::to_vec(&run)?;
+    // What `bless --from-last-check` and `harness review` accept from: this run's results,
+    // beside the failure images they point at.
+    let record = serde_json::to_vec(run)?;
     harness::images::write_atomically(&out.join(harness::golden::accept::LAST_CHECK), &record)?;
     if let Some(path) = &options.junit {
-        let xml = harness::ci_report::junit(&run)
+        let xml = harness::ci_report::junit(run)
             .map_err(|e| anyhow::anyhow!("cannot write JUnit XML for {}: {e}", path.display()))?;
         harness::images::write_atomically(path, xml.as_bytes())?;
     }
     if let Some(path) = &options.summary {
-        let markdown = harness::ci_report::summary(&run, &report);
+        let markdown = harness::ci_report::summary(run, &report);
         harness::images::write_atomically(path, markdown.as_bytes())?;
     }
-    if json {
-        println!("{}", serde_json::to_string_pretty(&run)?);
+    if options.json {
+        println!("{}", serde_json::to_string_pretty(run)?);
     } else {
-        print_table(&run, &report, &failures);
+        print_table(run, &report, failures);
     }
     Ok(if run.passed() {
         ExitCode::SUCCESS
     } else {
         ExitCode::FAILURE
     })
+}
+
+/// `harness report --merge DIR...`: the shards' runs joined into one, written under `out` like a
+/// check's (page, last-check.json, and the JUnit and summary `options` asks for).
+pub(crate) fn merge(shards: &[PathBuf], out: &Path, options: &Options) -> anyhow::Result<ExitCode> {
+    let (run, outputs) = harness::golden::merge::merge(shards)?;
+    let store = harness::golden::GoldenStore::workspace();
+    // The failure images stay in the shards' folders.
+    let failures: Vec<String> = shards
+        .iter()
+        .map(|s| s.join("failures").display().to_string())
+        .collect();
+    finish(&run, &outputs, &store, out, &failures.join(", "), options)
 }
 
 /// Notes on stderr each scene whose limits are borrowed from the canonical scenes (or a
@@ -164,7 +197,7 @@ fn note_borrowed_limits(cases: &[Case]) {
 /// The results table on stdout: a line per scene, pass and backend, then the renders and
 /// scenes that failed, the backends that disagree, a summary line, and on a failure where the
 /// images are and the bless commands.
-fn print_table(run: &CheckRun, report: &Path, failures: &Path) {
+fn print_table(run: &CheckRun, report: &Path, failures: &str) {
     println!(
         "{:<8} {:<17} {:<12} {:<12} worst metric",
         "scene", "pass", "backend", "result"
@@ -220,7 +253,7 @@ fn print_table(run: &CheckRun, report: &Path, failures: &Path) {
         report.display()
     );
     if failed > 0 {
-        println!("failure images: {}", failures.display());
+        println!("failure images: {failures}");
         println!(
             "after reviewing the report, bless what changed on purpose (one command per \
              scene; it rewrites only the passes outside tolerance or without a golden):"

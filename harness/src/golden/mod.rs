@@ -7,6 +7,7 @@ pub mod accept;
 pub mod bless;
 pub mod check;
 pub mod diagnosis;
+pub mod merge;
 pub mod metrics;
 pub mod noise;
 pub mod orphans;

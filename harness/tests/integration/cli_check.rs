@@ -350,3 +350,99 @@ fn check_notes_a_driver_other_than_the_blessing_one() {
         "the report does not say it"
     );
 }
+
+/// Shards: `check --scene` on two "jobs" (arrow after a light change, corner), each with its own
+/// `--out`, joined by `report --merge` into one run: one JUnit file with both scenes' cases, one
+/// page, a last-check.json whose failure images resolve into the shards (accepting from it
+/// works); a scene checked in two shards, or a shard given twice, is refused.
+#[test]
+fn sharded_checks_merge_into_one_report() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    let scene = root.path().join("scenes/arrow.toml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(&scene, text.replace("intensity = 2.5", "intensity = 3.0")).unwrap();
+    let run = |args: &[&str]| {
+        let output = common::harness_command()
+            .args(args)
+            .env("HARNESS_ROOT", root.path())
+            .output()
+            .unwrap();
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&output.stdout),
+            String::from_utf8_lossy(&output.stderr)
+        );
+        (output.status.code(), text)
+    };
+    let shard = |scene: &str, name: &str| {
+        let out = root.path().join(name);
+        let args = [
+            "check",
+            "--no-speed",
+            "--backend",
+            "gl",
+            "--scene",
+            scene,
+            "--out",
+        ];
+        let (code, text) = run(&[&args[..], &[out.to_str().unwrap()]].concat());
+        (code, text, out)
+    };
+    let (code, _, arrow) = shard("arrow", "shard-arrow");
+    assert_eq!(code, Some(1));
+    let (code, _, corner) = shard("corner", "shard-corner");
+    assert_eq!(code, Some(0));
+    let merged = root.path().join("merged");
+    let junit = merged.join("junit.xml");
+    let (code, text) = run(&[
+        "report",
+        "--merge",
+        arrow.to_str().unwrap(),
+        corner.to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+        "--junit",
+        junit.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(1), "{text}");
+    let report =
+        quick_junit::Report::deserialize_from_str(&std::fs::read_to_string(&junit).unwrap())
+            .unwrap();
+    let suites: Vec<&str> = report.test_suites.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(suites, ["arrow", "corner"]);
+    let lines = text
+        .lines()
+        .filter(|l| l.starts_with("arrow ") || l.starts_with("corner "));
+    assert_eq!(report.tests, lines.count(), "{text}");
+    assert_eq!(report.failures, 2, "{text}");
+    let page = std::fs::read_to_string(merged.join("report.html")).unwrap();
+    assert!(page.contains("data-scene=\"corner\"") && page.contains("id=\"case-arrow-light\""));
+    let (code, text) = run(&[
+        "bless",
+        "--from-last-check",
+        "--unverified",
+        "--scene",
+        "arrow",
+        "--pass",
+        "light",
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0), "{text}");
+    assert!(
+        text.contains("arrow/light: CHANGED vs old golden"),
+        "{text}"
+    );
+
+    let (_, _, again) = shard("arrow", "shard-arrow-again");
+    let twice = [arrow.to_str().unwrap(), again.to_str().unwrap()];
+    let (code, text) = run(&[&["report", "--merge"][..], &twice].concat());
+    assert_eq!(code, Some(1), "{text}");
+    assert!(text.contains("in two shards"), "{text}");
+    let (code, text) = run(&["report", "--merge", twice[0], twice[0]]);
+    assert_eq!(code, Some(1), "{text}");
+    assert!(text.contains("given twice"), "{text}");
+}

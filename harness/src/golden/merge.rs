@@ -1,0 +1,152 @@
+//! Sharded checks joined: `harness check --scene S --out DIR` on several CI jobs, each leaving its
+//! `last-check.json` and `failures/` in its DIR; `harness report --merge DIR... --out OUT` joins
+//! them into one run (one page, one JUnit file, one summary, and a `last-check.json` that
+//! `bless --from-last-check` and `harness review` accept from). The failure images stay in the
+//! shards' folders: a path recorded on the job that wrote it is looked up again under the
+//! folder it was downloaded to (`<DIR>/failures/<scene>/<backend>/<file>`).
+
+use std::path::{Path, PathBuf};
+
+use super::accept::LAST_CHECK;
+use super::check::{CheckRun, Outputs};
+use super::suite::Artifacts;
+
+/// Why shards could not be joined.
+#[derive(Debug, thiserror::Error)]
+pub enum MergeError {
+    /// A shard's results could not be read.
+    #[error("{path}: {message}")]
+    Shard {
+        /// The shard's last-check.json.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// Two shards checked the same scene on the same backend.
+    #[error("{scene} on {backend} is in two shards ({first} and {second}): shard by scene")]
+    Overlap {
+        /// Scene.
+        scene: String,
+        /// Backend.
+        backend: String,
+        /// One shard.
+        first: PathBuf,
+        /// The other.
+        second: PathBuf,
+    },
+}
+
+/// The runs under `shards` as one, with the outputs of its failing passes read back from the
+/// shards' failure images (for the page's viewers).
+pub fn merge(shards: &[PathBuf]) -> Result<(CheckRun, Outputs), MergeError> {
+    let mut merged = CheckRun {
+        backends: vec![],
+        results: vec![],
+        render_errors: vec![],
+        load_errors: vec![],
+        cross: vec![],
+        timings: vec![],
+        driver_notes: vec![],
+        speed: Default::default(),
+        diagnoses: vec![],
+        orphans: vec![],
+    };
+    let mut owner: Vec<(String, String, PathBuf)> = Vec::new();
+    for (i, dir) in shards.iter().enumerate() {
+        if shards[..i].contains(dir) {
+            return Err(MergeError::Shard {
+                path: dir.clone(),
+                message: "given twice".to_owned(),
+            });
+        }
+        let path = dir.join(LAST_CHECK);
+        let error = |message: String| MergeError::Shard {
+            path: path.clone(),
+            message,
+        };
+        let bytes = std::fs::read(&path).map_err(|e| error(e.to_string()))?;
+        let mut run: CheckRun = serde_json::from_slice(&bytes).map_err(|e| error(e.to_string()))?;
+        for r in &mut run.results {
+            let key = (r.scene.clone(), r.backend.name().to_owned());
+            match owner.iter().find(|(s, b, _)| (s, b) == (&key.0, &key.1)) {
+                Some((_, _, first)) if first != dir => {
+                    return Err(MergeError::Overlap {
+                        scene: key.0,
+                        backend: key.1,
+                        first: first.clone(),
+                        second: dir.clone(),
+                    })
+                }
+                Some(_) => {}
+                None => owner.push((key.0, key.1, dir.clone())),
+            }
+            rebase(&mut r.artifacts, dir);
+        }
+        for b in run.backends {
+            match merged.backends.iter_mut().find(|m| m.backend == b.backend) {
+                // Available in any shard is available; the first fingerprint seen is kept.
+                Some(m) if m.unavailable.is_some() && b.unavailable.is_none() => *m = b,
+                Some(_) => {}
+                None => merged.backends.push(b),
+            }
+        }
+        merged.results.extend(run.results);
+        merged.render_errors.extend(run.render_errors);
+        merged.load_errors.extend(run.load_errors);
+        merged.cross.extend(run.cross);
+        merged.timings.extend(run.timings);
+        for note in run.driver_notes {
+            if !merged.driver_notes.contains(&note) {
+                merged.driver_notes.push(note);
+            }
+        }
+        merged.speed.checks.extend(run.speed.checks);
+        merged.speed.errors.extend(run.speed.errors);
+        merged.diagnoses.extend(run.diagnoses);
+        for orphan in run.orphans {
+            if !merged.orphans.contains(&orphan) {
+                merged.orphans.push(orphan);
+            }
+        }
+    }
+    let mut outputs = Outputs::new();
+    for r in merged.results.iter().filter(|r| !r.outcome.passed()) {
+        let Some(actual) = &r.artifacts.actual else {
+            continue;
+        };
+        let image = if actual.extension().is_some_and(|x| x == "png") {
+            crate::images::read_png(actual)
+        } else {
+            crate::images::read_exr(actual)
+        };
+        if let Ok(image) = image {
+            outputs.insert((r.scene.clone(), r.pass, r.backend), image);
+        }
+    }
+    Ok((merged, outputs))
+}
+
+/// Points `artifacts` recorded on another machine at the copies under `dir`: a path that does
+/// not exist is looked up as `<dir>/failures/<scene>/<backend>/<file>` (its last three parts).
+fn rebase(artifacts: &mut Artifacts, dir: &Path) {
+    for path in [
+        &mut artifacts.actual,
+        &mut artifacts.golden,
+        &mut artifacts.diff,
+    ]
+    .into_iter()
+    .flatten()
+    {
+        if path.exists() {
+            continue;
+        }
+        let parts: Vec<_> = path.iter().collect();
+        if parts.len() >= 3 {
+            let tail: PathBuf = parts[parts.len() - 3..].iter().collect();
+            let moved = dir.join("failures").join(tail);
+            if moved.exists() {
+                *path = moved;
+            }
+        }
+    }
+}
