@@ -45,8 +45,10 @@ pub(crate) struct BlessArgs {
     prune: bool,
     /// Instead of rendering, accept what the last `check` rendered: the outputs of its
     /// failing passes on --backend (of --scene and --pass, or all), kept under
-    /// --out/failures/, blessed as a fresh render would be.
-    #[arg(long, conflicts_with_all = ["speed_only", "every_pass", "prune", "all"])]
+    /// --out/failures/, blessed as a fresh render would be; and its speed checks that moved
+    /// beyond their limits, as the timing goldens (--no-speed: images only; --speed-only:
+    /// timings only).
+    #[arg(long, conflicts_with_all = ["every_pass", "prune", "all"])]
     from_last_check: bool,
     /// With --from-last-check: the folder `check --out` wrote to.
     #[arg(long, default_value_os_t = crate::default_out_dir())]
@@ -68,8 +70,13 @@ pub(crate) fn command(args: BlessArgs) -> anyhow::Result<ExitCode> {
             &args.scenes,
             &args.passes,
             args.backend,
-            args.dry_run,
-            args.unverified,
+            &Options {
+                every_pass: false,
+                dry_run: args.dry_run,
+                images: !args.speed_only,
+                speed: !args.no_speed,
+                unverified: args.unverified,
+            },
         );
     }
     run(
@@ -338,14 +345,24 @@ pub(crate) fn from_last_check(
     scenes: &[String],
     passes: &[String],
     backend: BackendKind,
-    dry_run: bool,
-    unverified: bool,
+    options: &Options,
 ) -> anyhow::Result<ExitCode> {
     use harness::golden::accept;
-    let candidates = accept::candidates(out, backend, scenes, passes)?;
-    if candidates.is_empty() {
+    let (dry_run, unverified) = (options.dry_run, options.unverified);
+    let candidates = if options.images {
+        accept::candidates(out, backend, scenes, passes)?
+    } else {
+        Vec::new()
+    };
+    let timings = if options.speed {
+        accept::speed_candidates(out, scenes, passes)?
+    } else {
+        Vec::new()
+    };
+    if candidates.is_empty() && timings.is_empty() {
         println!(
-            "nothing to accept: the last check ({}) has no failing pass on {backend}{}",
+            "nothing to accept: the last check ({}) has no failing pass on {backend} and no \
+             speed check beyond its limit{}",
             out.join(accept::LAST_CHECK).display(),
             if scenes.is_empty() && passes.is_empty() {
                 ""
@@ -361,7 +378,15 @@ pub(crate) fn from_last_check(
             arguments.push(c.check.scene_argument.clone());
         }
     }
-    let cases = load_cases(&arguments)?;
+    // No images to accept: no scene to load (an empty list would load them all).
+    let cases = if arguments.is_empty() {
+        Vec::new()
+    } else {
+        load_cases(&arguments)?
+    };
+    let mut timed: Vec<&str> = timings.iter().map(|c| c.scene.as_str()).collect();
+    timed.sort_unstable();
+    timed.dedup();
     let store = harness::golden::GoldenStore::workspace();
     let mut refused = 0;
     for case in &cases {
@@ -400,6 +425,20 @@ pub(crate) fn from_last_check(
                     println!("REFUSED {why}");
                 }
             }
+        }
+    }
+    // The timing goldens, as the check measured them (a probe again would be a new measurement).
+    for scene in timed {
+        let lock = store.lock_scene(scene, |path| {
+            eprintln!(
+                "waiting for another `harness bless` of {scene} to finish (it holds {})",
+                path.display()
+            );
+        })?;
+        for line in
+            accept::accept_timings(&store, &lock, &timings, dry_run).map_err(anyhow::Error::msg)?
+        {
+            println!("{line}");
         }
     }
     Ok(if refused == 0 {

@@ -142,3 +142,92 @@ fn read_output(path: &Path) -> Result<engine::Image, crate::images::ImageFileErr
         crate::images::read_exr(path)
     }
 }
+
+/// The last check's speed checks to accept: a pass slower or faster than its timing golden
+/// beyond the limit, or timed without one, of `scenes` and `passes` (plan passes, by name; all
+/// when empty).
+pub fn speed_candidates(
+    out: &Path,
+    scenes: &[String],
+    passes: &[String],
+) -> Result<Vec<crate::golden::speed::SpeedCheck>, AcceptError> {
+    use crate::golden::speed::SpeedOutcome;
+    let path = out.join(LAST_CHECK);
+    let error = |message: String| AcceptError::LastCheck {
+        path: path.clone(),
+        message,
+    };
+    let bytes = std::fs::read(&path).map_err(|e| error(e.to_string()))?;
+    let run: CheckRun = serde_json::from_slice(&bytes).map_err(|e| error(e.to_string()))?;
+    Ok(run
+        .speed
+        .checks
+        .into_iter()
+        .filter(|c| {
+            matches!(
+                c.outcome,
+                SpeedOutcome::Slower | SpeedOutcome::Faster | SpeedOutcome::MissingGolden
+            )
+        })
+        .filter(|c| scenes.is_empty() || scenes.contains(&c.scene))
+        .filter(|c| passes.is_empty() || passes.contains(&c.pass.to_string()))
+        .collect())
+}
+
+/// Records `checks` (all of the locked scene) as its timing goldens: each pass's ratio as the
+/// check measured it (its fastest time and its floor's), the host being this one. Lines saying
+/// what was (or, with `dry_run`, would be) written.
+pub fn accept_timings(
+    store: &GoldenStore,
+    lock: &SceneLock,
+    checks: &[crate::golden::speed::SpeedCheck],
+    dry_run: bool,
+) -> Result<Vec<String>, String> {
+    use crate::golden::speed::TimingGoldens;
+    use crate::measure::speed::{PassSpeed, SceneSpeed};
+    let scene = lock.scene();
+    let mut goldens = TimingGoldens::load(store.root(), scene).map_err(|e| e.to_string())?;
+    let blessed = humantime::format_rfc3339_seconds(SystemTime::now()).to_string();
+    let mut lines = Vec::new();
+    for c in checks.iter().filter(|c| c.scene == scene) {
+        // The check's figures as a probe of one sample: its fastest time over its floor's.
+        let probe = SceneSpeed {
+            scene: scene.to_owned(),
+            backend: c.backend,
+            rounds: 1,
+            passes: vec![PassSpeed {
+                pass: c.pass,
+                pass_ms: vec![c.ms],
+                floor_ms: vec![c.ms / c.ratio],
+            }],
+        };
+        let driver = goldens
+            .backends
+            .get(&c.backend)
+            .map(|b| b.host.clone())
+            .unwrap_or_default();
+        let host = if driver.is_empty() {
+            crate::golden::speed::host_fingerprint(c.backend.name())
+        } else {
+            driver
+        };
+        goldens.record(&probe, &[c.pass], &host, &blessed);
+        lines.push(format!(
+            "{scene}/{} on {} (speed): ratio {:.3} as the check measured it; {}",
+            c.pass,
+            c.backend,
+            c.ratio,
+            if dry_run {
+                "would be written"
+            } else {
+                "written"
+            }
+        ));
+    }
+    if !dry_run && !lines.is_empty() {
+        goldens
+            .save(store.root(), scene)
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(lines)
+}

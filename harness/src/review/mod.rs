@@ -1,8 +1,9 @@
 //! `harness review`: the last check's review page served on 127.0.0.1, with Accept buttons on
 //! each failing pass, each scene and the whole run. Accepting blesses exactly the outputs that
 //! `check` rendered and kept ([`crate::golden::accept`]), verified and recorded as any bless
-//! ([`crate::golden::verify`]); it never renders the check again. The page marks what was
-//! accepted; a later `check` shows it passing.
+//! ([`crate::golden::verify`]); it never renders the check again. A scene's or the run's Accept
+//! also records the speed ratios the check measured beyond their limits as the timing goldens.
+//! The page marks what was accepted; a later `check` shows it passing.
 //!
 //! The server answers only its own page: every request must name it in its Host header
 //! (`127.0.0.1:<port>` or `localhost:<port>`: a page elsewhere that makes the browser call it, or
@@ -246,7 +247,40 @@ impl Review {
                 Err(why) => refuse(&mut answer, why),
             }
         }
+        // A scene's or the run's Accept takes its timing goldens too, as the check measured.
+        if ask.pass.is_none() {
+            self.accept_timings(&scenes, store, &mut answer);
+        }
         answer
+    }
+
+    /// Accepts the last check's speed checks beyond their limits of `scenes` (all when empty).
+    fn accept_timings(&self, scenes: &[String], store: &GoldenStore, answer: &mut AcceptAnswer) {
+        let checks = match accept::speed_candidates(&self.out, scenes, &[]) {
+            Ok(checks) => checks,
+            Err(e) => {
+                answer.refused.push(("-".into(), "speed".into(), e.to_string()));
+                return;
+            }
+        };
+        let mut timed: Vec<&str> = checks.iter().map(|c| c.scene.as_str()).collect();
+        timed.sort_unstable();
+        timed.dedup();
+        for scene in timed {
+            let result = store
+                .lock_scene(scene, |_| {})
+                .map_err(|e| e.to_string())
+                .and_then(|lock| accept::accept_timings(store, &lock, &checks, false));
+            match result {
+                Ok(_) => {
+                    for c in checks.iter().filter(|c| c.scene == scene) {
+                        let pass = format!("speed {}", c.pass);
+                        answer.accepted.push((scene.to_owned(), pass, c.backend));
+                    }
+                }
+                Err(why) => answer.refused.push((scene.to_owned(), "speed".into(), why)),
+            }
+        }
     }
 }
 

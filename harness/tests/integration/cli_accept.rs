@@ -155,3 +155,67 @@ fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
         "{stdout}"
     );
 }
+
+/// The timing goldens are accepted from the last check too: arrow's lighting golden on gl
+/// divided by 3 makes the check fail that pass's speed check (SLOWER); `bless --from-last-check
+/// --speed-only` records the ratio the check measured, without probing again, and the next
+/// check passes it.
+#[test]
+fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    let timing = root.path().join("golden/arrow/timing.toml");
+    let mut goldens: toml::Table = std::fs::read_to_string(&timing).unwrap().parse().unwrap();
+    let ratio = &mut goldens["gl"]["passes"]["lighting_pbr"]["ratio"];
+    *ratio = toml::Value::Float(ratio.as_float().unwrap() / 3.0);
+    std::fs::write(&timing, toml::to_string(&goldens).unwrap()).unwrap();
+    let out = root.path().join("out");
+    let check = || {
+        let output = common::harness_command()
+            .args([
+                "check",
+                "--scene",
+                "arrow",
+                "--backend",
+                "gl",
+                "--json",
+                "--out",
+            ])
+            .arg(&out)
+            .env("HARNESS_ROOT", root.path())
+            .output()
+            .unwrap();
+        let run: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+        let slower: Vec<String> = run["speed"]["checks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|c| c["outcome"]["verdict"] == "slower")
+            .map(|c| c["pass"].as_str().unwrap().to_owned())
+            .collect();
+        (output.status.code(), slower)
+    };
+    assert_eq!(check(), (Some(1), vec!["lighting_pbr".to_owned()]));
+    let output = common::harness_command()
+        .args([
+            "bless",
+            "--from-last-check",
+            "--speed-only",
+            "--scene",
+            "arrow",
+            "--out",
+        ])
+        .arg(&out)
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}");
+    assert!(
+        stdout.contains("arrow/lighting_pbr on gl (speed): ratio ") && stdout.contains("written"),
+        "{stdout}"
+    );
+    assert_eq!(check(), (Some(0), vec![]));
+}
