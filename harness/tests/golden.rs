@@ -186,7 +186,12 @@ impl Suite {
                     pass,
                     actual,
                     (kind, &driver),
-                    BlessRequest::default(),
+                    // The other backends are checked against this render below, the CPU code
+                    // paths not: recorded as unverified (`harness bless` verifies).
+                    BlessRequest {
+                        unverified: true,
+                        ..BlessRequest::default()
+                    },
                 )
                 .map_err(|e| Failed::from(e.to_string()))?;
                 eprintln!("{blessed}");
