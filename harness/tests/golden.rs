@@ -354,16 +354,8 @@ fn write_failure_report(suite: &Suite) {
         }
     }
     let run = harness::golden::check::CheckRun {
-        backends: vec![],
         results: failures.clone(),
-        render_errors: vec![],
-        load_errors: vec![],
-        cross: vec![],
-        timings: vec![],
-        driver_notes: vec![],
-        speed: Default::default(),
-        diagnoses: vec![],
-        orphans: vec![],
+        ..Default::default()
     };
     let html = harness::report::html(&run, &outputs, &suite.store, None, &[]);
     match harness::images::write_atomically(&report_path(), html.as_bytes()) {

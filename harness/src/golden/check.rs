@@ -62,7 +62,7 @@ pub struct Timing {
 }
 
 /// Everything a check run found.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct CheckRun {
     /// Backends, available or not.
     pub backends: Vec<BackendRun>,

@@ -39,18 +39,7 @@ pub enum MergeError {
 /// The runs under `shards` as one, with the outputs of its failing passes read back from the
 /// shards' failure images (for the page's viewers).
 pub fn merge(shards: &[PathBuf]) -> Result<(CheckRun, Outputs), MergeError> {
-    let mut merged = CheckRun {
-        backends: vec![],
-        results: vec![],
-        render_errors: vec![],
-        load_errors: vec![],
-        cross: vec![],
-        timings: vec![],
-        driver_notes: vec![],
-        speed: Default::default(),
-        diagnoses: vec![],
-        orphans: vec![],
-    };
+    let mut merged = CheckRun::default();
     let mut owner: Vec<(String, String, PathBuf)> = Vec::new();
     for (i, dir) in shards.iter().enumerate() {
         if shards[..i].contains(dir) {

@@ -259,7 +259,9 @@ impl Review {
         let checks = match accept::speed_candidates(&self.out, scenes, &[]) {
             Ok(checks) => checks,
             Err(e) => {
-                answer.refused.push(("-".into(), "speed".into(), e.to_string()));
+                answer
+                    .refused
+                    .push(("-".into(), "speed".into(), e.to_string()));
                 return;
             }
         };

@@ -33,3 +33,15 @@ pub fn darken(png: &Path, steps: u8) {
     }
     image.save(png).unwrap();
 }
+
+/// The passes whose image check did not pass in `harness check --json`'s output, in order.
+pub fn failing_passes(json: &[u8]) -> Vec<String> {
+    let run: serde_json::Value = serde_json::from_slice(json).unwrap();
+    run["results"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| r["outcome"].get("Passed").is_none())
+        .map(|r| r["pass"].as_str().unwrap().to_owned())
+        .collect()
+}

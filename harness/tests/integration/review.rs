@@ -139,15 +139,7 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
         .env("HARNESS_ROOT", root.path())
         .output()
         .unwrap();
-    let run: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
-    let failing: Vec<&str> = run["results"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter(|r| r["outcome"].get("Passed").is_none())
-        .map(|r| r["pass"].as_str().unwrap())
-        .collect();
-    assert_eq!(failing, ["final"]);
+    assert_eq!(common::cli::failing_passes(&output.stdout), ["final"]);
     let record = &harness::golden::GoldenStore::new(root.path().join("golden"))
         .records("arrow")
         .unwrap()["light"];
