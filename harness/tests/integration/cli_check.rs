@@ -94,15 +94,75 @@ fn a_broken_scene_is_one_failed_case_and_the_others_are_checked() {
     );
 }
 
+/// What a JUnit consumer (the Jenkins/GitLab schema) needs of `xml`, read with quick-xml apart
+/// from the crate that wrote it: a `testsuites` root whose `tests` and `failures` are the sums
+/// of its suites', each `testsuite` named with as many `testcase`s as its `tests` says, each
+/// `testcase` with a name and a class, each `failure` with a message. Returns (tests, failures).
+fn junit_structure(xml: &str) -> (usize, usize) {
+    use quick_xml::events::{BytesStart, Event};
+    let attribute = |element: &BytesStart, name: &str| -> Option<String> {
+        element.try_get_attribute(name).unwrap().map(|a| {
+            a.normalized_value(quick_xml::XmlVersion::Explicit1_0)
+                .unwrap()
+                .into_owned()
+        })
+    };
+    let count = |element: &BytesStart, name: &str| -> usize {
+        attribute(element, name)
+            .unwrap_or_else(|| panic!("no {name} on {element:?}"))
+            .parse()
+            .unwrap()
+    };
+    let mut reader = quick_xml::Reader::from_str(xml);
+    let (mut root, mut suite_tests, mut cases, mut failures) = (None, 0, 0, 0);
+    let (mut sum_tests, mut sum_failures) = (0, 0);
+    loop {
+        match reader.read_event().unwrap() {
+            Event::Start(e) | Event::Empty(e) => match e.name().as_ref() {
+                b"testsuites" => root = Some((count(&e, "tests"), count(&e, "failures"))),
+                b"testsuite" => {
+                    assert!(attribute(&e, "name").is_some_and(|n| !n.is_empty()));
+                    suite_tests = count(&e, "tests");
+                    sum_tests += suite_tests;
+                    sum_failures += count(&e, "failures");
+                    cases = 0;
+                }
+                b"testcase" => {
+                    assert!(
+                        attribute(&e, "name").is_some() && attribute(&e, "classname").is_some()
+                    );
+                    cases += 1;
+                }
+                b"failure" => {
+                    assert!(attribute(&e, "message").is_some_and(|m| !m.is_empty()));
+                    failures += 1;
+                }
+                _ => {}
+            },
+            Event::End(e) if e.name().as_ref() == b"testsuite" => {
+                assert_eq!(cases, suite_tests, "a suite's tests attribute");
+            }
+            Event::Eof => break,
+            _ => {}
+        }
+    }
+    let (tests, root_failures) = root.expect("a testsuites root");
+    assert_eq!((tests, root_failures), (sum_tests, sum_failures));
+    assert_eq!(failures, root_failures);
+    (tests, failures)
+}
+
 /// `--junit` and `--summary` of the run in `check_reports_failures_with_images_and_the_bless_command`
-/// (arrow's final golden darkened, its light golden removed): the JUnit XML parses (with
-/// quick-junit's reader) into a suite for arrow, a case per pass and backend, the two failures
+/// (arrow's final golden darkened, its light golden removed): the JUnit XML has what its
+/// consumers read ([`junit_structure`]) and parses with quick-junit's reader into a suite for arrow, a case per pass and backend, the two failures
 /// with their messages, the verdict and the images; the Markdown lists them first with the
 /// bless command.
 fn ci_formats_name_the_failures(out: &std::path::Path, stdout: &str) {
     use quick_junit::{NonSuccessKind, TestCaseStatus};
     let xml = std::fs::read_to_string(out.join("junit.xml")).unwrap();
+    let (tests, failed) = junit_structure(&xml);
     let report = quick_junit::Report::deserialize_from_str(&xml).unwrap();
+    assert_eq!((report.tests, report.failures), (tests, failed));
     let checks = stdout.lines().filter(|l| l.starts_with("arrow ")).count();
     assert_eq!(report.tests, checks, "{xml}");
     assert_eq!(report.test_suites.len(), 1);
