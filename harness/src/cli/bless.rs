@@ -202,7 +202,16 @@ fn verified(
         eprintln!("verifying {}'s new goldens under {source} ...", case.name());
     })
     .map_err(anyhow::Error::msg)?;
-    for d in &disagreements {
+    print_disagreements(case, &disagreements);
+    Ok(disagreements.is_empty())
+}
+
+/// Prints each place `case`'s new goldens did not reproduce as a refusal, and what to do.
+fn print_disagreements(
+    case: &harness::golden::suite::Case,
+    disagreements: &[harness::golden::verify::Disagreement],
+) {
+    for d in disagreements {
         println!("REFUSED {}/{d}", case.name());
     }
     if !disagreements.is_empty() {
@@ -214,7 +223,6 @@ fn verified(
             harness::golden::verify::SOURCES.join(", ")
         );
     }
-    Ok(disagreements.is_empty())
 }
 
 /// Renders each scene on `kind` and rewrites its image goldens as asked, once they are
@@ -384,60 +392,52 @@ pub(crate) fn from_last_check(
     } else {
         load_cases(&arguments)?
     };
-    let mut timed: Vec<&str> = timings.iter().map(|c| c.scene.as_str()).collect();
-    timed.sort_unstable();
-    timed.dedup();
     let store = harness::golden::GoldenStore::workspace();
+    let exe = std::env::current_exe()?;
+    let on_wait = |scene: &str, path: &std::path::Path| {
+        eprintln!(
+            "waiting for another `harness bless` of {scene} to finish (it holds {})",
+            path.display()
+        );
+    };
     let mut refused = 0;
     for case in &cases {
-        let lock = store.lock_scene(case.name(), |path| {
-            eprintln!(
-                "waiting for another `harness bless` of {} to finish (it holds {})",
-                case.name(),
-                path.display()
-            );
-        })?;
-        let mut accepted = Vec::new();
-        for candidate in candidates.iter().filter(|c| c.check.scene == case.name()) {
-            match accept::kept_output(candidate) {
-                Ok(image) => accepted.push((candidate, image)),
-                Err(why) => {
-                    refused += 1;
-                    println!("REFUSED {why}");
-                }
-            }
+        let lock = store.lock_scene(case.name(), |path| on_wait(case.name(), path))?;
+        let mine: Vec<&accept::Candidate> = candidates
+            .iter()
+            .filter(|c| c.check.scene == case.name())
+            .collect();
+        let done = accept::accept_scene(
+            &exe,
+            &store,
+            &lock,
+            case,
+            &mine,
+            (dry_run, unverified),
+            |source| eprintln!("verifying {}'s new goldens under {source} ...", case.name()),
+        )
+        .map_err(anyhow::Error::msg)?;
+        print_disagreements(case, &done.disagreements);
+        if !done.disagreements.is_empty() {
+            refused += mine.len();
         }
-        if !dry_run && !unverified && !accepted.is_empty() {
-            let images: Vec<(TargetId, engine::Image)> = accepted
-                .iter()
-                .map(|(c, image)| (c.check.pass, image.clone()))
-                .collect();
-            if !verified(&store, case, &images)? {
-                refused += accepted.len();
-                continue;
-            }
+        for (_, why) in &done.refused {
+            refused += 1;
+            println!("REFUSED {why}");
         }
-        for (candidate, image) in &accepted {
-            match accept::accept(&store, &lock, case, candidate, image, dry_run, unverified) {
-                Ok(blessed) => println!("{blessed}"),
-                Err(why) => {
-                    refused += 1;
-                    println!("REFUSED {why}");
-                }
-            }
+        for blessed in &done.accepted {
+            println!("{blessed}");
         }
     }
     // The timing goldens, as the check measured them (a probe again would be a new measurement).
-    for scene in timed {
-        let lock = store.lock_scene(scene, |path| {
-            eprintln!(
-                "waiting for another `harness bless` of {scene} to finish (it holds {})",
-                path.display()
-            );
-        })?;
-        for line in
-            accept::accept_timings(&store, &lock, &timings, dry_run).map_err(anyhow::Error::msg)?
-        {
+    let timed = accept::accept_all_timings(&store, &timings, dry_run, |path| {
+        eprintln!(
+            "waiting for another `harness bless` to finish (it holds {})",
+            path.display()
+        );
+    });
+    for (_, lines) in timed {
+        for line in lines.map_err(anyhow::Error::msg)? {
             println!("{line}");
         }
     }

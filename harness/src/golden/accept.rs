@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
 use engine::backend::BackendKind;
+use engine::plan::TargetId;
 
 use super::bless::{bless_pass, BlessRequest, BlessedPass};
 use super::check::CheckRun;
@@ -43,13 +44,8 @@ pub struct Candidate {
     pub checked_at: SystemTime,
 }
 
-/// The last check's failing passes on `backend`, of `scenes` and `passes` (all when empty).
-pub fn candidates(
-    out: &Path,
-    backend: BackendKind,
-    scenes: &[String],
-    passes: &[String],
-) -> Result<Vec<Candidate>, AcceptError> {
+/// The last check under `out` and when it was written.
+fn last_check(out: &Path) -> Result<(CheckRun, SystemTime), AcceptError> {
     let path = out.join(LAST_CHECK);
     let error = |message: String| AcceptError::LastCheck {
         path: path.clone(),
@@ -59,7 +55,18 @@ pub fn candidates(
     let checked_at = std::fs::metadata(&path)
         .and_then(|m| m.modified())
         .map_err(|e| error(e.to_string()))?;
-    let run: CheckRun = serde_json::from_slice(&bytes).map_err(|e| error(e.to_string()))?;
+    let run = serde_json::from_slice(&bytes).map_err(|e| error(e.to_string()))?;
+    Ok((run, checked_at))
+}
+
+/// The last check's failing passes on `backend`, of `scenes` and `passes` (all when empty).
+pub fn candidates(
+    out: &Path,
+    backend: BackendKind,
+    scenes: &[String],
+    passes: &[String],
+) -> Result<Vec<Candidate>, AcceptError> {
+    let (run, checked_at) = last_check(out)?;
     let driver = run
         .backends
         .iter()
@@ -152,13 +159,7 @@ pub fn speed_candidates(
     passes: &[String],
 ) -> Result<Vec<crate::golden::speed::SpeedCheck>, AcceptError> {
     use crate::golden::speed::SpeedOutcome;
-    let path = out.join(LAST_CHECK);
-    let error = |message: String| AcceptError::LastCheck {
-        path: path.clone(),
-        message,
-    };
-    let bytes = std::fs::read(&path).map_err(|e| error(e.to_string()))?;
-    let run: CheckRun = serde_json::from_slice(&bytes).map_err(|e| error(e.to_string()))?;
+    let (run, _) = last_check(out)?;
     Ok(run
         .speed
         .checks
@@ -230,4 +231,79 @@ pub fn accept_timings(
             .map_err(|e| e.to_string())?;
     }
     Ok(lines)
+}
+
+/// What accepting one scene's candidates did ([`accept_scene`]).
+#[derive(Debug, Default)]
+pub struct SceneAcceptance {
+    /// The passes blessed (with `dry_run`, that would be).
+    pub accepted: Vec<BlessedPass>,
+    /// Passes refused one by one (no kept output, golden changed since the check), with why.
+    pub refused: Vec<(TargetId, String)>,
+    /// Where verification disagreed: then nothing of the scene was written.
+    pub disagreements: Vec<crate::golden::verify::Disagreement>,
+}
+
+/// Accepts `candidates`, failing passes of `case` from the last check, holding the scene's
+/// `lock`: their kept outputs, verified together (unless `unverified` or `dry_run`; `exe` is the
+/// harness binary the verification runs, `progress` is told each source), then blessed. The one
+/// flow of `bless --from-last-check` and `harness review`.
+pub fn accept_scene(
+    exe: &Path,
+    store: &GoldenStore,
+    lock: &SceneLock,
+    case: &Case,
+    candidates: &[&Candidate],
+    (dry_run, unverified): (bool, bool),
+    progress: impl FnMut(&str),
+) -> Result<SceneAcceptance, String> {
+    let mut done = SceneAcceptance::default();
+    let mut kept = Vec::new();
+    for &candidate in candidates {
+        match kept_output(candidate) {
+            Ok(image) => kept.push((candidate, image)),
+            Err(why) => done.refused.push((candidate.check.pass, why)),
+        }
+    }
+    if !dry_run && !unverified && !kept.is_empty() {
+        let images: Vec<_> = kept
+            .iter()
+            .map(|(c, i)| (c.check.pass, i.clone()))
+            .collect();
+        done.disagreements = crate::golden::verify::verify(exe, store, case, &images, progress)?;
+        if !done.disagreements.is_empty() {
+            return Ok(done);
+        }
+    }
+    for (candidate, image) in &kept {
+        match accept(store, lock, case, candidate, image, dry_run, unverified) {
+            Ok(blessed) => done.accepted.push(blessed),
+            Err(why) => done.refused.push((candidate.check.pass, why)),
+        }
+    }
+    Ok(done)
+}
+
+/// Accepts `checks` (speed checks of the last check, [`speed_candidates`]) as the timing
+/// goldens, scene by scene under each scene's lock (`on_wait` as for
+/// [`GoldenStore::lock_scene`]): per scene, the lines [`accept_timings`] says, or why not.
+pub fn accept_all_timings(
+    store: &GoldenStore,
+    checks: &[crate::golden::speed::SpeedCheck],
+    dry_run: bool,
+    on_wait: impl Fn(&Path),
+) -> Vec<(String, Result<Vec<String>, String>)> {
+    let mut scenes: Vec<&str> = checks.iter().map(|c| c.scene.as_str()).collect();
+    scenes.sort_unstable();
+    scenes.dedup();
+    scenes
+        .into_iter()
+        .map(|scene| {
+            let result = store
+                .lock_scene(scene, &on_wait)
+                .map_err(|e| e.to_string())
+                .and_then(|lock| accept_timings(store, &lock, checks, dry_run));
+            (scene.to_owned(), result)
+        })
+        .collect()
 }

@@ -234,15 +234,37 @@ impl Review {
                     continue;
                 }
             };
-            match accept_scene(store, &case, &mine) {
-                Ok((accepted, refused)) => {
-                    for (pass, backend) in accepted {
+            let lock = match store.lock_scene(case.name(), |_| {}) {
+                Ok(lock) => lock,
+                Err(e) => {
+                    refuse(&mut answer, e.to_string());
+                    continue;
+                }
+            };
+            let exe = std::env::current_exe().map_err(|e| e.to_string());
+            let done = exe.and_then(|exe| {
+                accept::accept_scene(&exe, store, &lock, &case, &mine, (false, false), |_| {})
+            });
+            match done {
+                Ok(done) if !done.disagreements.is_empty() => {
+                    refuse(
+                        &mut answer,
+                        format!("not verified: {}", done.disagreements[0]),
+                    );
+                }
+                Ok(done) => {
+                    for blessed in done.accepted {
+                        let pass = blessed.pass.to_string();
                         self.accepted.insert((case.name().to_owned(), pass.clone()));
                         answer
                             .accepted
                             .push((case.name().to_owned(), pass, backend));
                     }
-                    answer.refused.extend(refused);
+                    for (pass, why) in done.refused {
+                        answer
+                            .refused
+                            .push((case.name().to_owned(), pass.to_string(), why));
+                    }
                 }
                 Err(why) => refuse(&mut answer, why),
             }
@@ -265,66 +287,18 @@ impl Review {
                 return;
             }
         };
-        let mut timed: Vec<&str> = checks.iter().map(|c| c.scene.as_str()).collect();
-        timed.sort_unstable();
-        timed.dedup();
-        for scene in timed {
-            let result = store
-                .lock_scene(scene, |_| {})
-                .map_err(|e| e.to_string())
-                .and_then(|lock| accept::accept_timings(store, &lock, &checks, false));
+        for (scene, result) in accept::accept_all_timings(store, &checks, false, |_| {}) {
             match result {
                 Ok(_) => {
                     for c in checks.iter().filter(|c| c.scene == scene) {
                         let pass = format!("speed {}", c.pass);
-                        answer.accepted.push((scene.to_owned(), pass, c.backend));
+                        answer.accepted.push((scene.clone(), pass, c.backend));
                     }
                 }
-                Err(why) => answer.refused.push((scene.to_owned(), "speed".into(), why)),
+                Err(why) => answer.refused.push((scene, "speed".into(), why)),
             }
         }
     }
-}
-
-/// Accepts `candidates` of `case`: the kept outputs, verified together, then blessed under the
-/// scene's lock. The passes accepted (with their backend) and those refused (with why), or why
-/// the whole scene was refused.
-#[allow(clippy::type_complexity)]
-fn accept_scene(
-    store: &GoldenStore,
-    case: &Case,
-    candidates: &[&Candidate],
-) -> Result<(Vec<(String, BackendKind)>, Vec<(String, String, String)>), String> {
-    let lock = store
-        .lock_scene(case.name(), |_| {})
-        .map_err(|e| e.to_string())?;
-    let mut refused = Vec::new();
-    let mut kept = Vec::new();
-    for c in candidates {
-        match accept::kept_output(c) {
-            Ok(image) => kept.push((*c, image)),
-            Err(why) => refused.push((c.check.scene.clone(), c.check.pass.to_string(), why)),
-        }
-    }
-    let images: Vec<_> = kept
-        .iter()
-        .map(|(c, i)| (c.check.pass, i.clone()))
-        .collect();
-    if !images.is_empty() {
-        let exe = std::env::current_exe().map_err(|e| e.to_string())?;
-        let disagreements = crate::golden::verify::verify(&exe, store, case, &images, |_| {})?;
-        if let Some(first) = disagreements.first() {
-            return Err(format!("not verified: {first}"));
-        }
-    }
-    let mut accepted = Vec::new();
-    for (c, image) in &kept {
-        match accept::accept(store, &lock, case, c, image, false, false) {
-            Ok(_) => accepted.push((c.check.pass.to_string(), c.check.backend)),
-            Err(why) => refused.push((c.check.scene.clone(), c.check.pass.to_string(), why)),
-        }
-    }
-    Ok((accepted, refused))
 }
 
 /// `value` as a JSON response.
