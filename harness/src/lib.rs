@@ -8,6 +8,7 @@
 //! [`images`], [`stats`]) and the scenes built in code ([`test_scenes`], [`first_scene`]).
 
 pub mod ci_report;
+pub mod faults;
 pub mod first_scene;
 pub mod golden;
 pub mod html;

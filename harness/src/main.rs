@@ -48,6 +48,11 @@ enum Command {
         /// Skip the speed checks (each pass's speed ratio against its timing golden).
         #[arg(long)]
         no_speed: bool,
+        /// Do not verify the outputs kept of failing passes (`check` otherwise renders them
+        /// again under the cheap noise sources, so that accepting them later renders nothing;
+        /// without it, the accept verifies).
+        #[arg(long)]
+        no_verify: bool,
         /// Also write the results as JUnit XML (a test case per scene, pass and backend), for
         /// CI test-report actions.
         #[arg(long, value_name = "FILE")]
@@ -288,6 +293,7 @@ fn main() -> ExitCode {
         backends: vec![],
         json: false,
         no_speed: false,
+        no_verify: false,
         junit: None,
         summary: None,
         debug_unspecialised_lighting: false,
@@ -300,6 +306,7 @@ fn main() -> ExitCode {
             backends,
             json,
             no_speed,
+            no_verify,
             junit,
             summary,
             debug_unspecialised_lighting,
@@ -310,6 +317,7 @@ fn main() -> ExitCode {
             cli::check::Options {
                 json,
                 speed: !no_speed,
+                verify: !no_verify,
                 unspecialised_lighting: debug_unspecialised_lighting,
                 junit,
                 summary,
@@ -338,6 +346,7 @@ fn main() -> ExitCode {
             &cli::check::Options {
                 json,
                 speed: false,
+                verify: false,
                 unspecialised_lighting: false,
                 junit,
                 summary,

@@ -237,7 +237,7 @@ fn bless_images(
 ) -> anyhow::Result<usize> {
     let mut refused = 0;
     let (every_pass, dry_run) = (options.every_pass, options.dry_run);
-    let mut backend = engine::backend::create(kind)?;
+    let mut backend = harness::faults::create_backend(kind)?;
     let driver = harness::golden::fingerprint(backend.info());
     for case in cases {
         // Names given on the command line (an edge), as the case's golden passes.
@@ -417,6 +417,12 @@ pub(crate) fn from_last_check(
             |source| eprintln!("verifying {}'s new goldens under {source} ...", case.name()),
         )
         .map_err(anyhow::Error::msg)?;
+        if done.verified_by_check {
+            eprintln!(
+                "{}: verified by the last check (its inputs are unchanged); nothing rendered",
+                case.name()
+            );
+        }
         print_disagreements(case, &done.disagreements);
         if !done.disagreements.is_empty() {
             refused += mine.len();

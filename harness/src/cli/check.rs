@@ -17,6 +17,8 @@ pub(crate) struct Options {
     pub json: bool,
     /// Run the speed checks.
     pub speed: bool,
+    /// Verify the outputs kept of failing passes (for accepting them without rendering).
+    pub verify: bool,
     /// Debug: the lighting passes unspecialised, in the renders and the speed probes.
     pub unspecialised_lighting: bool,
     /// Where to write the results as JUnit XML.
@@ -56,8 +58,14 @@ pub(crate) fn run(
             bar.set_message(what.to_owned());
         });
     let mut run = run;
+    let exe = std::env::current_exe()?;
+    if options.verify {
+        run.verifications =
+            harness::golden::verify::verify_failing(&exe, &store, &cases, &run, &outputs, |what| {
+                bar.set_message(what.to_owned())
+            });
+    }
     if options.speed {
-        let exe = std::env::current_exe()?;
         let scenes: Vec<(String, String)> = cases
             .iter()
             .map(|c| (c.name().to_owned(), c.argument()))

@@ -42,6 +42,8 @@ pub struct Candidate {
     pub driver: String,
     /// When the last check was written.
     pub checked_at: SystemTime,
+    /// The check's verification of this output, if it verified it.
+    pub verification: Option<crate::golden::verify::Verification>,
 }
 
 /// The last check under `out` and when it was written.
@@ -73,6 +75,7 @@ pub fn candidates(
         .find(|b| b.backend == backend)
         .and_then(|b| b.fingerprint.clone())
         .unwrap_or_default();
+    let verifications = run.verifications;
     Ok(run
         .results
         .into_iter()
@@ -82,6 +85,12 @@ pub fn candidates(
         })
         .filter(|r| passes.is_empty() || passes.contains(&r.pass.to_string()))
         .map(|check| Candidate {
+            verification: verifications
+                .iter()
+                .find(|v| {
+                    v.scene == check.scene && v.backend == backend && v.passes.contains(&check.pass)
+                })
+                .cloned(),
             check,
             driver: driver.clone(),
             checked_at,
@@ -242,12 +251,16 @@ pub struct SceneAcceptance {
     pub refused: Vec<(TargetId, String)>,
     /// Where verification disagreed: then nothing of the scene was written.
     pub disagreements: Vec<crate::golden::verify::Disagreement>,
+    /// Whether the check's own verification was used (nothing was rendered), rather than a
+    /// verification run by the accept.
+    pub verified_by_check: bool,
 }
 
 /// Accepts `candidates`, failing passes of `case` from the last check, holding the scene's
-/// `lock`: their kept outputs, verified together (unless `unverified` or `dry_run`; `exe` is the
-/// harness binary the verification runs, `progress` is told each source), then blessed. The one
-/// flow of `bless --from-last-check` and `harness review`.
+/// `lock`: their kept outputs, verified together (unless `unverified` or `dry_run`: by the
+/// check's own verification when it covers them and the scene's inputs are unchanged, which
+/// renders nothing; otherwise now, running `exe`, the harness binary, with `progress` told each
+/// source), then blessed. The one flow of `bless --from-last-check` and `harness review`.
 pub fn accept_scene(
     exe: &Path,
     store: &GoldenStore,
@@ -266,11 +279,17 @@ pub fn accept_scene(
         }
     }
     if !dry_run && !unverified && !kept.is_empty() {
-        let images: Vec<_> = kept
-            .iter()
-            .map(|(c, i)| (c.check.pass, i.clone()))
-            .collect();
-        done.disagreements = crate::golden::verify::verify(exe, store, case, &images, progress)?;
+        if let Some(recorded) = recorded_verification(case, &kept) {
+            done.verified_by_check = true;
+            done.disagreements = recorded.disagreements.clone();
+        } else {
+            let images: Vec<_> = kept
+                .iter()
+                .map(|(c, i)| (c.check.pass, i.clone()))
+                .collect();
+            done.disagreements =
+                crate::golden::verify::verify(exe, store, case, &images, progress)?;
+        }
         if !done.disagreements.is_empty() {
             return Ok(done);
         }
@@ -282,6 +301,19 @@ pub fn accept_scene(
         }
     }
     Ok(done)
+}
+
+/// The check's verification that covers every one of `kept`, while the scene's inputs are as
+/// they were when the check verified it (otherwise the accept must verify again).
+fn recorded_verification<'a>(
+    case: &Case,
+    kept: &[(&'a Candidate, engine::Image)],
+) -> Option<&'a crate::golden::verify::Verification> {
+    let first = kept.first()?.0.verification.as_ref()?;
+    let all_covered = kept
+        .iter()
+        .all(|(c, _)| c.verification.as_ref() == Some(first));
+    (all_covered && first.inputs == crate::golden::verify::inputs_digest(case)).then_some(first)
 }
 
 /// Accepts `checks` (speed checks of the last check, [`speed_candidates`]) as the timing

@@ -92,6 +92,10 @@ pub struct CheckRun {
     /// `harness bless --prune` removes them).
     #[serde(default)]
     pub orphans: Vec<crate::golden::orphans::Orphan>,
+    /// The kept outputs of failing passes verified as the check went (what accepting them
+    /// relies on instead of rendering again).
+    #[serde(default)]
+    pub verifications: Vec<crate::golden::verify::Verification>,
 }
 
 impl CheckRun {
@@ -232,7 +236,7 @@ pub fn run(
         store,
         only,
         failures,
-        &|kind| backend::create(kind),
+        &crate::faults::create_backend,
         progress,
     )
 }
@@ -346,6 +350,7 @@ pub fn run_with(
         CheckRun {
             diagnoses,
             orphans: Vec::new(),
+            verifications: Vec::new(),
             driver_notes,
             backends,
             results,

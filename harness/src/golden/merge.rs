@@ -92,6 +92,7 @@ pub fn merge(shards: &[PathBuf]) -> Result<(CheckRun, Outputs), MergeError> {
         merged.speed.checks.extend(run.speed.checks);
         merged.speed.errors.extend(run.speed.errors);
         merged.diagnoses.extend(run.diagnoses);
+        merged.verifications.extend(run.verifications);
         for orphan in run.orphans {
             if !merged.orphans.contains(&orphan) {
                 merged.orphans.push(orphan);

@@ -206,10 +206,11 @@ impl Case {
 
     /// Renders the golden passes on a new backend of this kind.
     pub fn render(&self, kind: BackendKind) -> Result<Frame, RenderError> {
-        let mut backend = backend::create(kind).map_err(|source| RenderError::Backend {
-            scene: self.name().to_owned(),
-            source,
-        })?;
+        let mut backend =
+            crate::faults::create_backend(kind).map_err(|source| RenderError::Backend {
+                scene: self.name().to_owned(),
+                source,
+            })?;
         self.render_on(backend.as_mut())
     }
 

@@ -6,6 +6,12 @@
 //! candidate pass must pass its own limits there. A golden that only one backend or one code
 //! path can produce, or an output kept by a check of a scene that has changed since, is refused
 //! with the source that disagreed. `--unverified` skips this and blessed.toml records it.
+//!
+//! `check` verifies the outputs it keeps of the reference backend's failing passes as it goes
+//! (unless `--no-verify`) and records a [`Verification`] in last-check.json, so that accepting
+//! them later (`harness review`, `bless --from-last-check`) renders nothing: the record is used
+//! while the scene's inputs ([`inputs_digest`]) are as they were; otherwise the accept verifies
+//! again.
 
 use std::path::Path;
 use std::process::Command;
@@ -23,7 +29,7 @@ use super::GoldenStore;
 pub const SOURCES: [&str; 3] = ["drivers", "cpu-sse4.1", "cpu-avx"];
 
 /// A source under which a candidate did not reproduce within its limits.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Disagreement {
     /// The source (`drivers`, `cpu-sse4.1`, ...).
     pub source: String,
@@ -44,6 +50,60 @@ impl std::fmt::Display for Disagreement {
             "{pass} does not reproduce under {} on {backend}: {}",
             self.source, self.detail
         )
+    }
+}
+
+/// What `check` found when it verified the outputs it kept of one scene's failing passes on
+/// one backend.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Verification {
+    /// The scene.
+    pub scene: String,
+    /// The backend whose outputs were verified.
+    pub backend: BackendKind,
+    /// The passes verified together.
+    pub passes: Vec<TargetId>,
+    /// The scene's inputs when it was verified ([`inputs_digest`]).
+    pub inputs: String,
+    /// Where they did not reproduce (empty: verified under every source).
+    pub disagreements: Vec<Disagreement>,
+}
+
+/// A digest of what a scene's render depends on that can change between a check and an
+/// accept: the scene file, every file its values name (assets beside it), and the harness
+/// executable that renders it. (Files an asset names in turn, such as an OBJ's material
+/// library, are not followed: check again after changing one.)
+pub fn inputs_digest(case: &Case) -> String {
+    use std::hash::{Hash, Hasher};
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    let path = &case.loaded.path;
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    text.hash(&mut hasher);
+    if let (Ok(table), Some(dir)) = (text.parse::<toml::Table>(), path.parent()) {
+        let mut named = Vec::new();
+        collect_strings(&toml::Value::Table(table), &mut named);
+        for name in named {
+            let file = dir.join(&name);
+            if file.is_file() {
+                name.hash(&mut hasher);
+                std::fs::read(&file).unwrap_or_default().hash(&mut hasher);
+            }
+        }
+    }
+    if let Ok(meta) = std::env::current_exe().and_then(std::fs::metadata) {
+        meta.len().hash(&mut hasher);
+        meta.modified().ok().hash(&mut hasher);
+    }
+    format!("{:016x}", hasher.finish())
+}
+
+/// Every string value in `value`, depth first.
+fn collect_strings(value: &toml::Value, into: &mut Vec<String>) {
+    match value {
+        toml::Value::String(s) => into.push(s.clone()),
+        toml::Value::Array(items) => items.iter().for_each(|v| collect_strings(v, into)),
+        toml::Value::Table(table) => table.values().for_each(|v| collect_strings(v, into)),
+        _ => {}
     }
 }
 
@@ -83,7 +143,7 @@ pub fn verify(
         progress(&source.name);
         let out = temp.path().join(format!("out-{}", source.name));
         let output = Command::new(exe)
-            .args(["check", "--json", "--no-speed", "--scene"])
+            .args(["check", "--json", "--no-speed", "--no-verify", "--scene"])
             .arg(&case.loaded.path)
             .arg("--out")
             .arg(&out)
@@ -139,6 +199,68 @@ pub fn verify(
         }
     }
     Ok(disagreements)
+}
+
+/// Verifies the outputs `run` kept of each scene's failing passes on one backend (the
+/// reference backend when it was checked, else the first available one), as `check` does
+/// before it writes last-check.json: one [`Verification`] per scene with failing passes.
+/// `progress` is told each scene and source.
+pub fn verify_failing(
+    exe: &Path,
+    store: &GoldenStore,
+    cases: &[Case],
+    run: &CheckRun,
+    outputs: &super::check::Outputs,
+    mut progress: impl FnMut(&str),
+) -> Vec<Verification> {
+    let available: Vec<BackendKind> = run
+        .backends
+        .iter()
+        .filter(|b| b.unavailable.is_none())
+        .map(|b| b.backend)
+        .collect();
+    let Some(&backend) = available
+        .iter()
+        .find(|&&b| b == super::suite::REFERENCE_BACKEND)
+        .or(available.first())
+    else {
+        return Vec::new();
+    };
+    let mut verifications = Vec::new();
+    for case in cases {
+        let candidates: Vec<(TargetId, Image)> = run
+            .results
+            .iter()
+            .filter(|r| r.scene == case.name() && r.backend == backend && !r.outcome.passed())
+            .filter_map(|r| {
+                let image = outputs.get(&(r.scene.clone(), r.pass, backend))?;
+                Some((r.pass, image.clone()))
+            })
+            .collect();
+        if candidates.is_empty() {
+            continue;
+        }
+        let scene = case.name();
+        let disagreements = verify(exe, store, case, &candidates, |source| {
+            progress(&format!("verifying {scene}'s new outputs under {source}"));
+        })
+        .unwrap_or_else(|e| {
+            vec![Disagreement {
+                source: "-".to_owned(),
+                backend: None,
+                pass: None,
+                detail: format!("could not verify: {e}"),
+            }]
+        });
+        verifications.push(Verification {
+            scene: scene.to_owned(),
+            backend,
+            passes: candidates.iter().map(|(p, _)| *p).collect(),
+            inputs: inputs_digest(case),
+            disagreements,
+        });
+    }
+    verifications
 }
 
 /// Copies the files of `from` (not its folders: a scene's golden folder has none) into `to`.

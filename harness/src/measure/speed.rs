@@ -106,7 +106,7 @@ pub fn probe(
         backend: kind,
         message: e.to_string(),
     };
-    let mut backend = backend::create(kind).map_err(backend_error)?;
+    let mut backend = crate::faults::create_backend(kind).map_err(backend_error)?;
     let prepared = PreparedFrame::new(scene)
         .map_err(render_error)?
         .with_variations(variations);

@@ -5,13 +5,13 @@ use super::cli_bless::{changed_files, snapshot};
 use crate::common;
 
 /// `bless --from-last-check` accepts what `check` rendered without rendering again: after a
-/// light change, accepting arrow's light pass (`--unverified`, with no driver to be found, so a
-/// render would fail) writes that golden and its record (the check's backend and driver, the
-/// metrics against the old golden, unverified) and nothing else; the next check passes it and
-/// still fails the final image, until it is accepted too. Verification (the default; a verified
-/// bless that writes is in `bless_after_a_light_change_rewrites_only_the_changed_passes`) refuses
-/// a kept output that no longer reproduces (the scene changed back after the check), naming the
-/// source and backend, and a golden rewritten after the check is refused too.
+/// light change, the check verifies the outputs it keeps, so accepting arrow's light pass with
+/// no driver to be found (a render would fail) writes that golden and its record (the check's
+/// backend and driver, the metrics against the old golden, verified) and nothing else; the next
+/// check (`--no-verify`) passes it and still fails the final image, until that is accepted
+/// `--unverified`, which the record says. A kept output whose scene changed after the check is
+/// verified again, and refused when it no longer reproduces (the scene changed back), naming the
+/// source and backend; a golden rewritten after the check is refused too.
 #[test]
 fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
     if !common::gl_available() {
@@ -29,7 +29,7 @@ fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
     };
     with_intensity("3.0");
     let out = root.path().join("out");
-    let check = || {
+    let check = |verify: bool| {
         let output = common::harness_command()
             .args([
                 "check",
@@ -41,6 +41,7 @@ fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
                 "--json",
             ])
             .args(["--out", out.to_str().unwrap()])
+            .args((!verify).then_some("--no-verify"))
             .env("HARNESS_ROOT", root.path())
             .output()
             .unwrap();
@@ -71,15 +72,17 @@ fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
         }
         let output = command.output().unwrap();
         let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
-        (output.status.code(), stdout)
+        let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+        (output.status.code(), stdout + &stderr)
     };
     let light_final = vec!["light".to_owned(), "final".to_owned()];
-    assert_eq!(check(), (Some(1), light_final.clone()));
+    assert_eq!(check(true), (Some(1), light_final.clone()));
     let golden = root.path().join("golden");
     let before = snapshot(&golden);
     std::thread::sleep(std::time::Duration::from_millis(20));
-    let (code, stdout) = accept("light", false, false);
+    let (code, stdout) = accept("light", false, true);
     assert_eq!(code, Some(0), "{stdout}");
+    assert!(stdout.contains("verified by the last check"), "{stdout}");
     assert!(
         stdout.contains("arrow/light: CHANGED vs old golden") && stdout.contains("wrote "),
         "{stdout}"
@@ -111,17 +114,19 @@ fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
         "{}",
         light.previous
     );
-    assert!(light.unverified);
+    assert!(!light.unverified);
 
-    assert_eq!(check(), (Some(1), vec!["final".to_owned()]));
-    let (code, stdout) = accept("final", true, false);
+    assert_eq!(check(false), (Some(1), vec!["final".to_owned()]));
+    let (code, stdout) = accept("final", false, false);
     assert_eq!(code, Some(0), "{stdout}");
-    assert_eq!(check(), (Some(0), vec![]));
+    assert!(records()["final"].unverified);
+    assert_eq!(check(false), (Some(0), vec![]));
 
-    // Checked at 3.5, accepted after the scene went back to 3.0: the kept light buffer does not
-    // reproduce, and nothing is written.
+    // Checked (and verified) at 3.5, accepted after the scene went back to 3.0: the check's
+    // verification is of other inputs, so the accept verifies again; the kept light buffer does
+    // not reproduce, and nothing is written.
     with_intensity("3.5");
-    assert_eq!(check(), (Some(1), light_final));
+    assert_eq!(check(true), (Some(1), light_final));
     with_intensity("3.0");
     let before = snapshot(&golden);
     let (code, stdout) = accept("light", true, true);

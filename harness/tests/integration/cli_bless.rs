@@ -186,6 +186,7 @@ fn bless_after_a_light_change_rewrites_only_the_changed_passes() {
     let output = common::harness_command()
         .args([
             "check",
+            "--no-verify",
             "--no-speed",
             "--backend",
             "gl",
@@ -230,6 +231,7 @@ fn an_extracted_sun_gets_its_shadow_goldens() {
     let output = common::harness_command()
         .args([
             "check",
+            "--no-verify",
             "--no-speed",
             "--scene",
             "ibl_sun",
@@ -367,6 +369,7 @@ fn orphans_are_listed_by_check_and_removed_by_prune() {
     let output = common::harness_command()
         .args([
             "check",
+            "--no-verify",
             "--scene",
             "arrow",
             "--backend",

@@ -25,6 +25,7 @@ fn a_broken_scene_is_one_failed_case_and_the_others_are_checked() {
     let output = common::harness_command()
         .args([
             "check",
+            "--no-verify",
             "--no-speed",
             "--backend",
             "gl",
@@ -246,6 +247,7 @@ fn check_reports_failures_with_images_and_the_bless_command() {
     let output = common::harness_command()
         .args([
             "check",
+            "--no-verify",
             "--no-speed",
             "--scene",
             "arrow",
@@ -385,6 +387,7 @@ fn check_notes_a_driver_other_than_the_blessing_one() {
     let output = common::harness_command()
         .args([
             "check",
+            "--no-verify",
             "--no-speed",
             "--scene",
             "arrow",
@@ -441,6 +444,7 @@ fn sharded_checks_merge_into_one_report() {
         let out = root.path().join(name);
         let args = [
             "check",
+            "--no-verify",
             "--no-speed",
             "--backend",
             "gl",

@@ -11,112 +11,14 @@ use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
-use engine::backend::*;
+use engine::backend::Backend;
 use engine::renderer::{self, Readback};
-use engine::{BackendKind, Image};
+use engine::BackendKind;
+use harness::faults::FaultyBackend;
 
-/// A backend that forwards to a real one, with faults injected on request.
-struct Faulty {
-    inner: Box<dyn Backend>,
-    /// This shader file is replaced by WGSL that does not compile.
-    break_shader: Option<&'static str>,
-    /// Every submit fails as if the device were lost.
-    lose_device: bool,
-    /// Every readback fails.
-    fail_readback: bool,
-}
-
-impl Faulty {
-    fn new(kind: BackendKind) -> Self {
-        Self {
-            inner: engine::backend::create(kind).unwrap(),
-            break_shader: None,
-            lose_device: false,
-            fail_readback: false,
-        }
-    }
-
-    fn injected(&self, context: &str, message: &str) -> BackendError {
-        BackendError::Driver {
-            backend: self.inner.kind().name(),
-            context: context.to_owned(),
-            message: format!("{message} (injected)"),
-        }
-    }
-}
-
-impl Backend for Faulty {
-    fn kind(&self) -> BackendKind {
-        self.inner.kind()
-    }
-    fn info(&self) -> &DriverInfo {
-        self.inner.info()
-    }
-    fn features(&self) -> Features {
-        self.inner.features()
-    }
-    fn create_texture(&mut self, desc: &TextureDesc) -> Result<Handle<Texture>> {
-        self.inner.create_texture(desc)
-    }
-    fn write_texture(&mut self, t: Handle<Texture>, at: Subresource, data: &[u8]) -> Result<()> {
-        self.inner.write_texture(t, at, data)
-    }
-    fn destroy_texture(&mut self, t: Handle<Texture>) -> Result<()> {
-        self.inner.destroy_texture(t)
-    }
-    fn create_buffer(&mut self, desc: &BufferDesc) -> Result<Handle<Buffer>> {
-        self.inner.create_buffer(desc)
-    }
-    fn write_buffer(&mut self, b: Handle<Buffer>, offset: u64, data: &[u8]) -> Result<()> {
-        self.inner.write_buffer(b, offset, data)
-    }
-    fn destroy_buffer(&mut self, b: Handle<Buffer>) -> Result<()> {
-        self.inner.destroy_buffer(b)
-    }
-    fn create_sampler(&mut self, desc: &SamplerDesc) -> Result<Handle<Sampler>> {
-        self.inner.create_sampler(desc)
-    }
-    fn destroy_sampler(&mut self, s: Handle<Sampler>) -> Result<()> {
-        self.inner.destroy_sampler(s)
-    }
-    fn create_shader(&mut self, desc: &ShaderDesc) -> Result<Handle<Shader>> {
-        if self.break_shader == Some(desc.name.as_str()) {
-            let broken = ShaderDesc {
-                name: desc.name.clone(),
-                wgsl: format!("{}\nfn broken( {{", desc.wgsl),
-            };
-            return self.inner.create_shader(&broken);
-        }
-        self.inner.create_shader(desc)
-    }
-    fn destroy_shader(&mut self, s: Handle<Shader>) -> Result<()> {
-        self.inner.destroy_shader(s)
-    }
-    fn create_pipeline(&mut self, desc: &PipelineDesc) -> Result<Handle<Pipeline>> {
-        self.inner.create_pipeline(desc)
-    }
-    fn destroy_pipeline(&mut self, p: Handle<Pipeline>) -> Result<()> {
-        self.inner.destroy_pipeline(p)
-    }
-    fn submit(&mut self, passes: &[RenderPass]) -> Result<Vec<PassTiming>> {
-        if self.lose_device {
-            let first = passes.first().map_or("submit", |p| p.name.as_str());
-            return Err(self.injected(first, "device lost"));
-        }
-        self.inner.submit(passes)
-    }
-    fn read_texture(&mut self, t: Handle<Texture>, at: Subresource) -> Result<Image> {
-        if self.fail_readback {
-            return Err(self.injected("read_texture", "readback failed"));
-        }
-        self.inner.read_texture(t, at)
-    }
-    fn live_resources(&self) -> usize {
-        self.inner.live_resources()
-    }
-    fn pipelines_compiled(&self) -> u64 {
-        self.inner.pipelines_compiled()
-    }
+/// A real backend of `kind` with no fault on yet.
+fn faulty(kind: BackendKind) -> FaultyBackend {
+    FaultyBackend::new(engine::backend::create(kind).unwrap())
 }
 
 fn chess() -> engine::scene::Scene {
@@ -127,8 +29,8 @@ fn chess() -> engine::scene::Scene {
 #[test]
 fn a_shader_that_fails_to_compile_names_the_scene_the_shader_and_the_backend() {
     for kind in common::available_backends() {
-        let mut backend = Faulty::new(kind);
-        backend.break_shader = Some("lighting.wgsl");
+        let mut backend = faulty(kind);
+        backend.break_shader = Some("lighting.wgsl".to_owned());
         let before = backend.live_resources();
         let error = renderer::render(&mut backend, &chess(), Readback::All)
             .err()
@@ -148,7 +50,7 @@ fn a_shader_that_fails_to_compile_names_the_scene_the_shader_and_the_backend() {
 #[test]
 fn a_failed_readback_names_the_scene_the_output_and_the_backend() {
     for kind in common::available_backends() {
-        let mut backend = Faulty::new(kind);
+        let mut backend = faulty(kind);
         backend.fail_readback = true;
         let error = renderer::render(&mut backend, &chess(), Readback::Only(&[TargetId::Light]))
             .err()
@@ -177,8 +79,8 @@ fn a_backend_lost_mid_run_fails_its_scene_and_the_run_goes_on() {
     let cases = harness::golden::suite::canonical_cases().unwrap();
     let store = harness::golden::GoldenStore::workspace();
     let created = AtomicUsize::new(0);
-    let create = |k: BackendKind| -> Result<Box<dyn Backend>> {
-        let mut backend = Faulty::new(k);
+    let create = |k: BackendKind| -> engine::backend::Result<Box<dyn Backend>> {
+        let mut backend = faulty(k);
         backend.lose_device = k == kind && created.fetch_add(1, Ordering::SeqCst) == 1;
         Ok(Box::new(backend))
     };
@@ -365,4 +267,92 @@ fn killing_a_bless_mid_write_leaves_the_old_golden_intact() {
         .unwrap();
     assert!(status.status.success());
     assert_eq!(temporaries(&golden), Vec::<PathBuf>::new());
+}
+
+/// The backends a one-backend fault needs: wgpu-vulkan to perturb and at least one other.
+fn perturbable() -> bool {
+    let available = common::available_backends();
+    available.contains(&BackendKind::WgpuVulkan) && available.len() >= 2
+}
+
+/// A real `check` with every output of wgpu-vulkan perturbed (`HARNESS_INJECT_FAULT`): only
+/// wgpu-vulkan's passes fail, and each verdict says it moved alone, the others held; the first
+/// passes in the plan are the origins, the rest moved because of them.
+#[test]
+fn a_fault_in_one_backend_gets_the_verdict_that_it_moved_alone() {
+    use harness::golden::diagnosis::{Agreement, Role};
+    if !perturbable() {
+        return;
+    }
+    let out = tempfile::tempdir().unwrap();
+    let output = harness_bin()
+        .args(["check", "--json", "--no-speed", "--no-verify"])
+        .args(["--scene", "arrow", "--out"])
+        .arg(out.path())
+        .env(harness::faults::INJECT_FAULT, "wgpu-vulkan:perturb-output")
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(1));
+    let run: harness::golden::check::CheckRun = serde_json::from_slice(&output.stdout).unwrap();
+    let failed: Vec<_> = run.results.iter().filter(|r| !r.outcome.passed()).collect();
+    assert!(!failed.is_empty());
+    assert!(failed.iter().all(|r| r.backend == BackendKind::WgpuVulkan));
+    assert_eq!(run.diagnoses.len(), failed.len());
+    let others: Vec<BackendKind> = common::available_backends()
+        .into_iter()
+        .filter(|&b| b != BackendKind::WgpuVulkan)
+        .collect();
+    for d in &run.diagnoses {
+        assert_eq!(
+            d.agreement,
+            Agreement::Only {
+                moved: vec![BackendKind::WgpuVulkan],
+                held: others.clone()
+            },
+            "{}: {}",
+            d.pass,
+            d.headline()
+        );
+        if matches!(d.role, Role::Origin { .. }) {
+            assert!(
+                d.headline().contains("wgpu-vulkan alone"),
+                "{}",
+                d.headline()
+            );
+        }
+    }
+    // The geometry pass's outputs are origins; the light buffer only followed them.
+    let role = |pass: TargetId| &run.diagnoses.iter().find(|d| d.pass == pass).unwrap().role;
+    assert!(matches!(role(TargetId::Depth), Role::Origin { .. }));
+    assert!(matches!(role(TargetId::Light), Role::Downstream { .. }));
+}
+
+/// A golden that no other backend reproduces: blessed from wgpu-vulkan with its outputs
+/// perturbed, it is refused by the verification, which names the source (`drivers`) and a
+/// backend that disagreed, and golden/ is left as it was.
+#[test]
+fn verified_bless_refuses_a_golden_only_one_backend_renders() {
+    if !perturbable() {
+        return;
+    }
+    let root = common::temp_workspace();
+    let golden = root.path().join("golden/arrow");
+    let before = crate::cli_bless::snapshot(&golden);
+    let output = harness_bin()
+        .args(["bless", "--scene", "arrow", "--pass", "final", "--no-speed"])
+        .args(["--backend", "wgpu-vulkan"])
+        .env("HARNESS_ROOT", root.path())
+        .env(harness::faults::INJECT_FAULT, "wgpu-vulkan:perturb-output")
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    eprintln!("{stdout}");
+    assert_eq!(output.status.code(), Some(1), "{stdout}");
+    let refusal = stdout
+        .lines()
+        .find(|l| l.starts_with("REFUSED arrow/final does not reproduce under drivers on "))
+        .unwrap_or_else(|| panic!("no refusal naming the source in:\n{stdout}"));
+    assert!(!refusal.contains("on wgpu-vulkan"), "{refusal}");
+    assert!(stdout.contains("nothing written"), "{stdout}");
+    assert_eq!(crate::cli_bless::snapshot(&golden), before);
 }

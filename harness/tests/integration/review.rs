@@ -1,7 +1,11 @@
 //! `harness review` in a real browser: after a change to the arrow scene's light and a failing
 //! check, the served page's Accept button on the light buffer (gl) blesses what the check kept,
 //! the page marks that row accepted, and the next check passes the light buffer and still fails
-//! the final image. Requests without the page's token, or naming another host, are refused.
+//! the final image; the scene's Accept then takes the rest, and golden/ ends exactly as
+//! `harness bless --scene arrow` leaves it from the same change (the blessing times aside). The
+//! server runs with rendering forbidden (`HARNESS_NO_RENDER`, which its children inherit): it
+//! accepts on the checks' own verification and renders nothing. Requests without the page's
+//! token, or naming another host, are refused.
 //!
 //! Needs Chromium, like `report` (skipped with a note without it, unless REQUIRE_CHROMIUM=1).
 
@@ -52,11 +56,20 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
     if !common::gl_available() {
         return;
     }
-    let (root, out) = check_after_a_light_change();
+    let (root, out) = check_after_a_light_change(true);
+    // The same change blessed the usual way, in a second workspace.
+    let (blessed_root, _) = check_after_a_light_change(false);
+    let output = common::harness_command()
+        .args(["bless", "--scene", "arrow", "--no-speed"])
+        .env("HARNESS_ROOT", blessed_root.path())
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{output:?}");
     let mut child = common::harness_command()
         .args(["review", "--out"])
         .arg(&out)
         .env("HARNESS_ROOT", root.path())
+        .env(harness::faults::NO_RENDER, "1")
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::null())
         .spawn()
@@ -112,36 +125,84 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
         json!(1)
     );
     browser.click_on(&format!("{row} button.accept"));
-    // Accepting verifies (renders again in child checks): wait for the row to be marked.
-    let marked = browser.eval(&format!(
-        "new Promise((resolve) => {{ const start = Date.now(); const poll = () => {{ \
-         const r = document.querySelector('{row}'); \
-         if (r.classList.contains('accepted')) resolve(r.querySelector('td.result').textContent); \
-         else if (Date.now() - start > 120000) resolve('timed out: ' + \
-           r.querySelector('button.accept').textContent + ' ' + r.querySelector('button.accept').title); \
-         else setTimeout(poll, 100); }}; poll(); }})"
+    let marked = browser.eval(&wait_for(
+        &format!("document.querySelector('{row}')"),
+        "r.classList.contains('accepted')",
+        "r.querySelector('td.result').textContent",
     ));
     assert_eq!(marked, json!("ACCEPTED"));
-    drop(server);
 
-    let output = common::harness_command()
-        .args([
-            "check",
-            "--no-speed",
-            "--scene",
-            "arrow",
-            "--backend",
-            "gl",
-            "--json",
-            "--out",
-        ])
-        .arg(&out)
-        .env("HARNESS_ROOT", root.path())
-        .output()
-        .unwrap();
-    assert_eq!(common::cli::failing_passes(&output.stdout), ["final"]);
-    let record = &harness::golden::GoldenStore::new(root.path().join("golden"))
+    let check = || {
+        let output = common::harness_command()
+            .args(["check", "--no-speed", "--scene", "arrow", "--backend", "gl"])
+            .args(["--json", "--out"])
+            .arg(&out)
+            .env("HARNESS_ROOT", root.path())
+            .output()
+            .unwrap();
+        common::cli::failing_passes(&output.stdout)
+    };
+    assert_eq!(check(), ["final"]);
+    let golden = root.path().join("golden");
+    let record = &harness::golden::GoldenStore::new(&golden)
         .records("arrow")
         .unwrap()["light"];
     assert!(!record.unverified && record.previous.starts_with("CHANGED vs old golden"));
+
+    // The scene's Accept (the page is the first check's; the server accepts from the last).
+    let scene = ".accept-bar button.accept-scene[data-scene=arrow]";
+    browser.click_on(scene);
+    let answer = browser.eval(&wait_for(
+        &format!("document.querySelector('{scene}')"),
+        "r.textContent !== 'accepting…'",
+        "r.textContent + ' ' + r.title",
+    ));
+    assert_eq!(answer, json!("accepted "));
+    drop(server);
+    assert!(check().is_empty());
+    let without_times = |root: &std::path::Path| {
+        let files = crate::cli_bless::snapshot(&root.join("golden/arrow"));
+        files
+            .into_iter()
+            .map(|(path, (bytes, _))| {
+                let name = path.file_name().unwrap().to_string_lossy().into_owned();
+                let bytes = if name == "blessed.toml" {
+                    String::from_utf8(bytes)
+                        .unwrap()
+                        .lines()
+                        .filter(|l| !l.starts_with("blessed = "))
+                        .collect::<Vec<_>>()
+                        .join("\n")
+                        .into_bytes()
+                } else {
+                    bytes
+                };
+                (name, bytes)
+            })
+            .collect::<std::collections::BTreeMap<_, _>>()
+    };
+    let accepted = without_times(root.path());
+    let blessed = without_times(blessed_root.path());
+    assert_eq!(
+        accepted.keys().collect::<Vec<_>>(),
+        blessed.keys().collect::<Vec<_>>()
+    );
+    for (name, bytes) in &accepted {
+        assert!(
+            *bytes == blessed[name],
+            "golden/arrow/{name} differs from what `bless --scene arrow` writes"
+        );
+    }
+}
+
+/// A CDP expression that waits (up to 2 minutes) until `done` holds of `r` (the element
+/// `element` finds), then gives `value` of it, or what the element shows if it never does.
+fn wait_for(element: &str, done: &str, value: &str) -> String {
+    format!(
+        "new Promise((resolve) => {{ const start = Date.now(); const poll = () => {{ \
+         const r = {element}; \
+         if ({done}) resolve({value}); \
+         else if (Date.now() - start > 120000) resolve('timed out: ' + r.outerHTML); \
+         else setTimeout(poll, 100); }}; poll(); }})"
+    )
 }
