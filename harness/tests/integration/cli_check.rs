@@ -414,10 +414,12 @@ fn check_notes_a_driver_other_than_the_blessing_one() {
     );
 }
 
-/// Shards: `check --scene` on two "jobs" (arrow after a light change, corner), each with its own
-/// `--out`, joined by `report --merge` into one run: one JUnit file with both scenes' cases, one
-/// page, a last-check.json whose failure images resolve into the shards (accepting from it
-/// works); a scene checked in two shards, or a shard given twice, is refused.
+/// Shards: `check --scene` on three "jobs" (arrow after a light change, corner, ibl), each with
+/// its own `--out`, joined by `report --merge` into one run that equals the unsharded check of
+/// the three scenes (its results, verdicts and cross-backend comparisons, its JUnit file and its
+/// summary, with the GPU times and the output folders' names aside); one page; a
+/// last-check.json whose failure images resolve into the shards (accepting from it works); a
+/// scene checked in two shards, or a shard given twice, is refused.
 #[test]
 fn sharded_checks_merge_into_one_report() {
     if !common::gl_available() {
@@ -459,6 +461,8 @@ fn sharded_checks_merge_into_one_report() {
     assert_eq!(code, Some(1));
     let (code, _, corner) = shard("corner", "shard-corner");
     assert_eq!(code, Some(0));
+    let (code, _, ibl) = shard("ibl", "shard-ibl");
+    assert_eq!(code, Some(0));
     let merged = root.path().join("merged");
     let junit = merged.join("junit.xml");
     let (code, text) = run(&[
@@ -466,20 +470,66 @@ fn sharded_checks_merge_into_one_report() {
         "--merge",
         arrow.to_str().unwrap(),
         corner.to_str().unwrap(),
+        ibl.to_str().unwrap(),
         "--out",
         merged.to_str().unwrap(),
         "--junit",
         junit.to_str().unwrap(),
+        "--summary",
+        merged.join("summary.md").to_str().unwrap(),
     ]);
     assert_eq!(code, Some(1), "{text}");
+    let whole = root.path().join("unsharded");
+    let (code, whole_text) = run(&[
+        "check",
+        "--no-verify",
+        "--no-speed",
+        "--backend",
+        "gl",
+        "--scene",
+        "arrow",
+        "--scene",
+        "corner",
+        "--scene",
+        "ibl",
+        "--out",
+        whole.to_str().unwrap(),
+        "--junit",
+        whole.join("junit.xml").to_str().unwrap(),
+        "--summary",
+        whole.join("summary.md").to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(1), "{whole_text}");
+    let shards = [&arrow, &corner, &ibl];
+    let comparable = |dir: &std::path::Path, file: &str| {
+        let mut text = std::fs::read_to_string(dir.join(file)).unwrap();
+        if file == "last-check.json" {
+            let mut run: serde_json::Value = serde_json::from_str(&text).unwrap();
+            run.as_object_mut().unwrap().remove("timings");
+            text = serde_json::to_string_pretty(&run).unwrap();
+        }
+        for out in shards.iter().copied().chain([&whole, &merged]) {
+            text = text.replace(out.to_str().unwrap(), "OUT");
+        }
+        without_attributes(&text, &["time", "timestamp"])
+    };
+    for file in ["last-check.json", "junit.xml", "summary.md"] {
+        assert_eq!(
+            comparable(&merged, file),
+            comparable(&whole, file),
+            "the merged {file} differs from the unsharded one"
+        );
+    }
     let report =
         quick_junit::Report::deserialize_from_str(&std::fs::read_to_string(&junit).unwrap())
             .unwrap();
     let suites: Vec<&str> = report.test_suites.iter().map(|s| s.name.as_str()).collect();
-    assert_eq!(suites, ["arrow", "corner"]);
-    let lines = text
-        .lines()
-        .filter(|l| l.starts_with("arrow ") || l.starts_with("corner "));
+    assert_eq!(suites, ["arrow", "corner", "ibl"]);
+    let lines = text.lines().filter(|l| {
+        ["arrow ", "corner ", "ibl "]
+            .iter()
+            .any(|s| l.starts_with(s))
+    });
     assert_eq!(report.tests, lines.count(), "{text}");
     assert_eq!(report.failures, 2, "{text}");
     let page = std::fs::read_to_string(merged.join("report.html")).unwrap();
@@ -509,4 +559,18 @@ fn sharded_checks_merge_into_one_report() {
     let (code, text) = run(&["report", "--merge", twice[0], twice[0]]);
     assert_eq!(code, Some(1), "{text}");
     assert!(text.contains("given twice"), "{text}");
+}
+
+/// `xml` without the attributes named (` name="..."`): JUnit's times, which no two runs share.
+fn without_attributes(xml: &str, names: &[&str]) -> String {
+    let mut out = xml.to_owned();
+    for name in names {
+        let marker = format!(" {name}=\"");
+        while let Some(start) = out.find(&marker) {
+            let value = start + marker.len();
+            let end = value + out[value..].find('"').unwrap() + 1;
+            out.replace_range(start..end, "");
+        }
+    }
+    out
 }
