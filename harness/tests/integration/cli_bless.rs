@@ -259,6 +259,75 @@ fn an_extracted_sun_gets_its_shadow_goldens() {
     }
 }
 
+/// Two blesses of one scene run at once, from two backends, each rewriting every pass: both
+/// succeed, one after the other, and the folder ends as the later one alone would leave it:
+/// every record names one backend, and every image is byte for byte what a bless from that
+/// backend alone writes (never one backend's image under the other's record).
+#[test]
+fn two_blesses_at_once_leave_a_consistent_golden_folder() {
+    use engine::backend::BackendKind;
+    let available = common::available_backends();
+    let pair = [BackendKind::Gl, BackendKind::WgpuVulkan];
+    if !pair.iter().all(|b| available.contains(b)) {
+        return;
+    }
+    let bless = |root: &Path, backend: BackendKind| {
+        common::harness_command()
+            .args(["bless", "--scene", "arrow", "--every-pass", "--no-speed"])
+            .args(["--unverified", "--backend", backend.name()])
+            .env("HARNESS_ROOT", root)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let root = common::temp_workspace();
+    let running: Vec<_> = pair.iter().map(|&b| bless(root.path(), b)).collect();
+    for child in running {
+        let output = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        eprintln!(
+            "{}",
+            stderr
+                .lines()
+                .filter(|l| l.contains("waiting"))
+                .collect::<String>()
+        );
+        assert!(output.status.success(), "{stderr}");
+    }
+    let store = harness::golden::GoldenStore::new(root.path().join("golden"));
+    let records = store.records("arrow").unwrap();
+    let last = records.values().next().unwrap().backend;
+    assert!(
+        records.values().all(|r| r.backend == last),
+        "blessed.toml mixes backends: {:?}",
+        records
+            .iter()
+            .map(|(p, r)| (p, r.backend))
+            .collect::<Vec<_>>()
+    );
+    // The later bless alone, in a second workspace.
+    let alone = common::temp_workspace();
+    assert!(bless(alone.path(), last).wait().unwrap().success());
+    let files = |root: &Path| {
+        let dir = root.join("golden/arrow");
+        snapshot(&dir)
+            .into_iter()
+            .filter(|(path, _)| path.file_name().unwrap() != "blessed.toml")
+            .map(|(path, (bytes, _))| (path.strip_prefix(&dir).unwrap().to_owned(), bytes))
+            .collect::<std::collections::BTreeMap<_, _>>()
+    };
+    let (together, by_itself) = (files(root.path()), files(alone.path()));
+    assert_eq!(together.len(), by_itself.len());
+    for (name, bytes) in &together {
+        assert!(
+            *bytes == by_itself[name],
+            "{} is not what a bless from {last} writes",
+            name.display()
+        );
+    }
+}
+
 /// A bless waits while another holds the scene's folder (here, this test holds its lock), says
 /// so, and writes once the other is done: two blesses of one scene never interleave.
 #[test]
