@@ -272,15 +272,21 @@ fn exr(path: &Path) -> engine::Image {
     harness::images::read_exr(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
+/// A temporary workspace whose arrow scene's light is brighter (2.5 -> 3.0).
+pub(crate) fn workspace_with_a_light_change() -> tempfile::TempDir {
+    let root = common::temp_workspace();
+    let scene = root.path().join("scenes/arrow.toml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(&scene, text.replace("intensity = 2.5", "intensity = 3.0")).unwrap();
+    root
+}
+
 /// Brightens the arrow scene's light in a temporary workspace (its light buffer and final image
 /// change, nothing else) and runs `harness check` on it (on gl; with `verify`, verifying the
 /// outputs it keeps), which must fail. Returns the workspace and the `--out` folder holding
 /// report.html, last-check.json and the failure images.
 pub(crate) fn check_after_a_light_change(verify: bool) -> (tempfile::TempDir, PathBuf) {
-    let root = common::temp_workspace();
-    let scene = root.path().join("scenes/arrow.toml");
-    let text = std::fs::read_to_string(&scene).unwrap();
-    std::fs::write(&scene, text.replace("intensity = 2.5", "intensity = 3.0")).unwrap();
+    let root = workspace_with_a_light_change();
     let out = root.path().join("out");
     let output = common::harness_command()
         .args([

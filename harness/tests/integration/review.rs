@@ -14,7 +14,7 @@ use std::net::TcpStream;
 
 use serde_json::json;
 
-use super::report::{check_after_a_light_change, chromium, Browser};
+use super::report::{check_after_a_light_change, chromium, workspace_with_a_light_change, Browser};
 use crate::common;
 
 /// Sends a raw HTTP request to 127.0.0.1:`port` and returns its status code.
@@ -58,7 +58,7 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
     }
     let (root, out) = check_after_a_light_change(true);
     // The same change blessed the usual way, in a second workspace.
-    let (blessed_root, _) = check_after_a_light_change(false);
+    let blessed_root = workspace_with_a_light_change();
     let output = common::harness_command()
         .args(["bless", "--scene", "arrow", "--no-speed"])
         .env("HARNESS_ROOT", blessed_root.path())
