@@ -42,6 +42,10 @@ enum Command {
         /// Only this backend (repeatable). Default: every available one.
         #[arg(long = "backend")]
         backends: Vec<BackendKind>,
+        /// Only these golden passes' image checks (repeatable; the renders run only what they
+        /// need). The speed checks are not narrowed (`--no-speed` skips them).
+        #[arg(long = "pass")]
+        passes: Vec<String>,
         /// Print the results as JSON on stdout.
         #[arg(long)]
         json: bool,
@@ -291,6 +295,7 @@ fn main() -> ExitCode {
         out: default_out_dir(),
         scenes: vec![],
         backends: vec![],
+        passes: vec![],
         json: false,
         no_speed: false,
         no_verify: false,
@@ -304,6 +309,7 @@ fn main() -> ExitCode {
             out,
             scenes,
             backends,
+            passes,
             json,
             no_speed,
             no_verify,
@@ -316,6 +322,7 @@ fn main() -> ExitCode {
             &backends,
             cli::check::Options {
                 json,
+                passes,
                 speed: !no_speed,
                 verify: !no_verify,
                 unspecialised_lighting: debug_unspecialised_lighting,
@@ -345,6 +352,7 @@ fn main() -> ExitCode {
             &out,
             &cli::check::Options {
                 json,
+                passes: vec![],
                 speed: false,
                 verify: false,
                 unspecialised_lighting: false,

@@ -15,6 +15,8 @@ use super::load_cases_isolated;
 pub(crate) struct Options {
     /// Print JSON instead of the table.
     pub json: bool,
+    /// Only these golden passes' image checks (all when empty), by name.
+    pub passes: Vec<String>,
     /// Run the speed checks.
     pub speed: bool,
     /// Verify the outputs kept of failing passes (for accepting them without rendering).
@@ -36,6 +38,7 @@ pub(crate) fn run(
     options: Options,
 ) -> anyhow::Result<ExitCode> {
     let (mut cases, broken) = load_cases_isolated(scenes)?;
+    narrow_passes(&mut cases, &options.passes)?;
     let variations = engine::renderer::Variations {
         unspecialised_lighting: options.unspecialised_lighting,
         ..Default::default()
@@ -90,12 +93,15 @@ pub(crate) fn run(
     bar.finish_and_clear();
     run.load_errors = broken;
     // With every scene checked, golden/'s folders too; otherwise the checked scenes' folders.
+    // (With some passes only, the others' goldens would look orphaned: not looked for.)
     let canonical = scenes
         .is_empty()
         .then(|| engine::scene_file::canonical_scenes(&harness::scenes_dir()));
-    match harness::golden::orphans::find(&store, &cases, canonical.as_deref()) {
-        Ok(orphans) => run.orphans = orphans,
-        Err(e) => eprintln!("note: cannot look for orphans in golden/: {e}"),
+    if options.passes.is_empty() {
+        match harness::golden::orphans::find(&store, &cases, canonical.as_deref()) {
+            Ok(orphans) => run.orphans = orphans,
+            Err(e) => eprintln!("note: cannot look for orphans in golden/: {e}"),
+        }
     }
     for orphan in &run.orphans {
         eprintln!("note: orphan: {orphan} (`harness bless --prune` removes it)");
@@ -120,6 +126,36 @@ pub(crate) fn run(
         &failures.display().to_string(),
         &options,
     )
+}
+
+/// Keeps only the golden passes named in `passes` (all when empty) in each case, and the cases
+/// left with any; a name that no case has is an error that lists the passes there are.
+fn narrow_passes(cases: &mut Vec<Case>, passes: &[String]) -> anyhow::Result<()> {
+    if passes.is_empty() {
+        return Ok(());
+    }
+    for name in passes {
+        if !cases
+            .iter()
+            .any(|c| c.passes.iter().any(|p| p.to_string() == *name))
+        {
+            let mut known: Vec<String> = cases
+                .iter()
+                .flat_map(|c| c.passes.iter().map(ToString::to_string))
+                .collect();
+            known.sort();
+            known.dedup();
+            anyhow::bail!(
+                "no scene checked has a golden pass `{name}` (they have: {})",
+                known.join(", ")
+            );
+        }
+    }
+    for case in cases.iter_mut() {
+        case.passes.retain(|p| passes.contains(&p.to_string()));
+    }
+    cases.retain(|c| !c.passes.is_empty());
+    Ok(())
 }
 
 /// Writes what a run leaves under `out` (the review page, last-check.json) and where `options`

@@ -142,9 +142,15 @@ pub fn verify(
         };
         progress(&source.name);
         let out = temp.path().join(format!("out-{}", source.name));
+        // Only the candidates' passes: the renders run what they need, and nothing else is
+        // compared.
+        let passes = candidates
+            .iter()
+            .flat_map(|(pass, _)| ["--pass".to_owned(), pass.to_string()]);
         let output = Command::new(exe)
             .args(["check", "--json", "--no-speed", "--no-verify", "--scene"])
             .arg(&case.loaded.path)
+            .args(passes)
             .arg("--out")
             .arg(&out)
             .env("HARNESS_ROOT", temp.path())

@@ -58,6 +58,19 @@ fn render_rejects_an_unknown_pass_before_rendering() {
     assert!(!stderr.contains("rendering"), "rendered first:\n{stderr}");
 }
 
+/// So is one given to `check --pass`, with the golden passes listed.
+#[test]
+fn check_rejects_an_unknown_pass_before_rendering() {
+    let (code, stdout, stderr) = harness(&["check", "--scene", "arrow", "--pass", "finall"]);
+    assert_eq!(code, 1, "{stdout}\n{stderr}");
+    assert!(
+        stderr.contains("no scene checked has a golden pass `finall`")
+            && stderr.contains("final, gbuffer_albedo"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("renders"), "rendered first:\n{stderr}");
+}
+
 /// `render` takes a scene file path as well as a name, and writes every pass with `--pass all`
 /// (PNG for 8-bit outputs, EXR for float ones).
 #[test]
