@@ -91,6 +91,41 @@ pub const LOCK_FILE: &str = ".bless.lock";
 #[derive(Clone, Debug)]
 pub struct GoldenStore {
     root: PathBuf,
+    /// Goldens decoded lately, shared by the clones: a check compares every backend's output
+    /// with one golden, which is decoded once.
+    decoded: std::sync::Arc<std::sync::Mutex<Decoded>>,
+}
+
+/// What identifies one version of a golden file: its length, modification time and inode (a
+/// bless writes a new file and renames it over the old, so the inode changes even where the
+/// clock is coarse).
+type Stamp = (u64, std::time::SystemTime, u64);
+
+/// The most recently decoded goldens, each with the [`Stamp`] of the file it was decoded from (a
+/// golden rewritten since is decoded again).
+#[derive(Debug, Default)]
+struct Decoded {
+    images: std::collections::VecDeque<(PathBuf, Stamp, Image)>,
+}
+
+impl Decoded {
+    /// How many goldens are kept (a scene has at most about a dozen golden passes).
+    const KEPT: usize = 16;
+
+    fn get(&self, path: &Path, stamp: Stamp) -> Option<Image> {
+        self.images
+            .iter()
+            .find(|(p, s, _)| p == path && *s == stamp)
+            .map(|(_, _, image)| image.clone())
+    }
+
+    fn put(&mut self, path: PathBuf, stamp: Stamp, image: Image) {
+        self.images.retain(|(p, _, _)| *p != path);
+        if self.images.len() == Self::KEPT {
+            self.images.pop_front();
+        }
+        self.images.push_back((path, stamp, image));
+    }
 }
 
 /// What `blessed.toml` holds for one pass.
@@ -142,7 +177,10 @@ pub fn is_eight_bit(image: &Image) -> bool {
 impl GoldenStore {
     /// A store rooted at `root` (usually `<workspace>/golden`).
     pub fn new(root: impl Into<PathBuf>) -> Self {
-        Self { root: root.into() }
+        Self {
+            root: root.into(),
+            decoded: Default::default(),
+        }
     }
 
     /// The workspace's `golden/` folder.
@@ -162,7 +200,8 @@ impl GoldenStore {
             .join(format!("{pass}.{}", if eight_bit { "png" } else { "exr" }))
     }
 
-    /// Loads a golden; `Ok(None)` when it does not exist.
+    /// Loads a golden; `Ok(None)` when it does not exist. Decoded once while the file is
+    /// unchanged (the last 16 goldens are kept).
     pub fn load(
         &self,
         scene: &str,
@@ -170,14 +209,31 @@ impl GoldenStore {
         eight_bit: bool,
     ) -> Result<Option<Image>, GoldenError> {
         let path = self.path(scene, pass, eight_bit);
-        if !path.exists() {
-            return Ok(None);
+        let stamp = match std::fs::metadata(&path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            // Unreadable: the read below says why.
+            Err(_) => None,
+            Ok(meta) => meta.modified().ok().map(|modified| {
+                #[cfg(unix)]
+                let inode = std::os::unix::fs::MetadataExt::ino(&meta);
+                #[cfg(not(unix))]
+                let inode = 0;
+                (meta.len(), modified, inode)
+            }),
+        };
+        let decoded = || self.decoded.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(image) = stamp.and_then(|stamp| decoded().get(&path, stamp)) {
+            return Ok(Some(image));
         }
-        Ok(Some(if eight_bit {
+        let image = if eight_bit {
             images::read_png(&path)?
         } else {
             images::read_exr(&path)?
-        }))
+        };
+        if let Some(stamp) = stamp {
+            decoded().put(path, stamp, image.clone());
+        }
+        Ok(Some(image))
     }
 
     fn record_path(&self, scene: &str) -> PathBuf {
@@ -396,6 +452,38 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("golden-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         GoldenStore::new(dir)
+    }
+
+    /// A golden is decoded once while its file is unchanged, and again once rewritten (here
+    /// through a clone of the store, which shares the decoded goldens).
+    #[test]
+    fn a_rewritten_golden_is_decoded_again() {
+        let store = temp_store("decoded");
+        let image = |value: f32| Image {
+            width: 1,
+            height: 1,
+            format: TextureFormat::Rgba16Float,
+            data: ImageData::F32(vec![value, 0.0, 0.0, 1.0]),
+        };
+        let bless = |store: &GoldenStore, value: f32| {
+            let lock = store.lock_scene("s", |_| {}).unwrap();
+            let provenance = Provenance {
+                backend: BackendKind::Gl,
+                driver: "llvmpipe",
+                previous: "new",
+                unverified: false,
+            };
+            store
+                .bless(&lock, TargetId::Light, &image(value), provenance)
+                .unwrap();
+        };
+        bless(&store, 1.0);
+        let load = || store.load("s", TargetId::Light, false).unwrap().unwrap();
+        assert_eq!(load().data, image(1.0).data);
+        assert_eq!(load().data, image(1.0).data);
+        bless(&store.clone(), 2.0);
+        assert_eq!(load().data, image(2.0).data);
+        let _ = std::fs::remove_dir_all(store.root());
     }
 
     #[test]
