@@ -281,6 +281,12 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
         );
     }
     print_diagnoses(run);
+    if !run.verifications.is_empty() {
+        println!("\nverified: the outputs kept of the failing passes, rendered again");
+        for v in &run.verifications {
+            println!("  {}", v.summary());
+        }
+    }
     print_speed(run);
     let failed = run.results.iter().filter(|r| !r.outcome.passed()).count()
         + run.speed.checks.iter().filter(|c| c.failed()).count()

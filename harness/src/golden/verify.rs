@@ -69,6 +69,37 @@ pub struct Verification {
     pub disagreements: Vec<Disagreement>,
 }
 
+impl Verification {
+    /// Whether every output verified reproduced under every source.
+    pub fn verified(&self) -> bool {
+        self.disagreements.is_empty()
+    }
+
+    /// One line: what was verified and how it went, with what to do.
+    pub fn summary(&self) -> String {
+        let passes = crate::names(&self.passes);
+        match self.disagreements.first() {
+            None => format!(
+                "{}'s new {passes} ({}) reproduce on every backend under {}: accepting them \
+                 (`harness review`, `bless --from-last-check`) renders nothing",
+                self.scene,
+                self.backend,
+                SOURCES.join(", ")
+            ),
+            Some(first) => format!(
+                "{}'s new {passes} ({}) do not reproduce: {first}{}; accepting them is refused \
+                 (`--unverified` records them anyway)",
+                self.scene,
+                self.backend,
+                match self.disagreements.len() {
+                    1 => String::new(),
+                    n => format!(" (and {} more)", n - 1),
+                }
+            ),
+        }
+    }
+}
+
 /// A digest of what a scene's render depends on that can change between a check and an
 /// accept: the scene file, every file its values name (assets beside it), and the harness
 /// executable that renders it. (Files an asset names in turn, such as an OBJ's material

@@ -48,6 +48,19 @@ pub(super) fn summary(out: &mut String, run: &CheckRun) {
         );
     }
     out.push_str("</table>");
+    for v in &run.verifications {
+        let class = if v.verified() {
+            "verified"
+        } else {
+            "not-verified"
+        };
+        let _ = write!(
+            out,
+            "<p class=\"{class}\" data-scene=\"{}\">{}</p>",
+            escape(&v.scene),
+            escape(&v.summary())
+        );
+    }
 }
 
 /// Backends, cross-backend agreement and GPU times.

@@ -57,6 +57,12 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
         return;
     }
     let (root, out) = check_after_a_light_change(true);
+    // The check verified what it kept, and the page says so.
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        page.contains("<p class=\"verified\" data-scene=\"arrow\">arrow's new light, final (gl)"),
+        "the page does not say the check verified arrow's outputs"
+    );
     // The same change blessed the usual way, in a second workspace.
     let blessed_root = workspace_with_a_light_change();
     let output = common::harness_command()
