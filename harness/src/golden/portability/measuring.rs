@@ -114,8 +114,10 @@ pub fn measure_environment(
                 std::process::id(),
                 source.name
             ));
+            // Images only: the speed checks (the timing model is `noise --timing`'s) and the
+            // verification of failing outputs are not this measurement's.
             let output = Command::new(exe)
-                .args(["check", "--json", "--scene"])
+                .args(["check", "--json", "--no-speed", "--no-verify", "--scene"])
                 .arg(&case.loaded.path)
                 .args(["--backend", backend.name(), "--out"])
                 .arg(&out)
