@@ -43,7 +43,8 @@ enum Command {
         #[arg(long = "backend")]
         backends: Vec<BackendKind>,
         /// Only these golden passes' image checks (repeatable; the renders run only what they
-        /// need). The speed checks are not narrowed (`--no-speed` skips them).
+        /// need). No verdicts are given (where a change starts needs every pass), and the
+        /// speed checks are not narrowed (`--no-speed` skips them).
         #[arg(long = "pass")]
         passes: Vec<String>,
         /// Print the results as JSON on stdout.

@@ -418,8 +418,13 @@ pub(crate) fn from_last_check(
         )
         .map_err(anyhow::Error::msg)?;
         if done.verified_by_check {
+            let outcome = if done.disagreements.is_empty() {
+                "verified by the last check"
+            } else {
+                "refused by the last check's verification"
+            };
             eprintln!(
-                "{}: verified by the last check (its inputs are unchanged); nothing rendered",
+                "{}: {outcome} (its inputs and kept outputs are unchanged); nothing rendered",
                 case.name()
             );
         }

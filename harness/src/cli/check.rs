@@ -38,6 +38,11 @@ pub(crate) fn run(
     options: Options,
 ) -> anyhow::Result<ExitCode> {
     let (mut cases, broken) = load_cases_isolated(scenes)?;
+    // Every scene's speed, before `--pass` narrows the image checks.
+    let speed_scenes: Vec<(String, String)> = cases
+        .iter()
+        .map(|c| (c.name().to_owned(), c.argument()))
+        .collect();
     narrow_passes(&mut cases, &options.passes)?;
     let variations = engine::renderer::Variations {
         unspecialised_lighting: options.unspecialised_lighting,
@@ -61,6 +66,11 @@ pub(crate) fn run(
             bar.set_message(what.to_owned());
         });
     let mut run = run;
+    if !options.passes.is_empty() {
+        // Where a change starts cannot be told from some passes only (the first one checked
+        // would look like the origin).
+        run.diagnoses.clear();
+    }
     let exe = std::env::current_exe()?;
     if options.verify {
         run.verifications =
@@ -69,10 +79,7 @@ pub(crate) fn run(
             });
     }
     if options.speed {
-        let scenes: Vec<(String, String)> = cases
-            .iter()
-            .map(|c| (c.name().to_owned(), c.argument()))
-            .collect();
+        let scenes = speed_scenes;
         let available: Vec<(BackendKind, String)> = run
             .backends
             .iter()

@@ -279,9 +279,9 @@ pub fn accept_scene(
         }
     }
     if !dry_run && !unverified && !kept.is_empty() {
-        if let Some(recorded) = recorded_verification(case, &kept) {
+        if let Some(recorded) = recorded_verification(store, case, &kept) {
             done.verified_by_check = true;
-            done.disagreements = recorded.disagreements.clone();
+            done.disagreements = recorded;
         } else {
             let images: Vec<_> = kept
                 .iter()
@@ -303,17 +303,32 @@ pub fn accept_scene(
     Ok(done)
 }
 
-/// The check's verification that covers every one of `kept`, while the scene's inputs are as
-/// they were when the check verified it (otherwise the accept must verify again).
-fn recorded_verification<'a>(
+/// What the check's own verification says of `kept` (see
+/// [`Verification::verdict_on`](crate::golden::verify::Verification::verdict_on)): `None` when
+/// the accept must verify again.
+fn recorded_verification(
+    store: &GoldenStore,
     case: &Case,
-    kept: &[(&'a Candidate, engine::Image)],
-) -> Option<&'a crate::golden::verify::Verification> {
-    let first = kept.first()?.0.verification.as_ref()?;
-    let all_covered = kept
+    kept: &[(&Candidate, engine::Image)],
+) -> Option<Vec<crate::golden::verify::Disagreement>> {
+    let record = kept.first()?.0.verification.as_ref()?;
+    if !kept
         .iter()
-        .all(|(c, _)| c.verification.as_ref() == Some(first));
-    (all_covered && first.inputs == crate::golden::verify::inputs_digest(case)).then_some(first)
+        .all(|(c, _)| c.verification.as_ref() == Some(record))
+    {
+        return None;
+    }
+    let files: Vec<_> = kept
+        .iter()
+        .map(|(c, _)| {
+            let digest = c.check.artifacts.actual.as_deref();
+            (
+                c.check.pass,
+                digest.and_then(crate::golden::verify::file_digest),
+            )
+        })
+        .collect();
+    record.verdict_on(&crate::golden::verify::inputs_digest(store, case), &files)
 }
 
 /// Accepts `checks` (speed checks of the last check, [`speed_candidates`]) as the timing

@@ -106,6 +106,9 @@ type Stamp = (u64, std::time::SystemTime, u64);
 #[derive(Debug, Default)]
 struct Decoded {
     images: std::collections::VecDeque<(PathBuf, Stamp, Image)>,
+    /// How many goldens were decoded (what the cache saved, for its test).
+    #[cfg(test)]
+    decodes: usize,
 }
 
 impl Decoded {
@@ -125,6 +128,10 @@ impl Decoded {
             self.images.pop_front();
         }
         self.images.push_back((path, stamp, image));
+        #[cfg(test)]
+        {
+            self.decodes += 1;
+        }
     }
 }
 
@@ -454,8 +461,8 @@ mod tests {
         GoldenStore::new(dir)
     }
 
-    /// A golden is decoded once while its file is unchanged, and again once rewritten (here
-    /// through a clone of the store, which shares the decoded goldens).
+    /// A golden is decoded once while its file is unchanged, also for a clone of the store
+    /// (which shares the decoded goldens), and again once rewritten.
     #[test]
     fn a_rewritten_golden_is_decoded_again() {
         let store = temp_store("decoded");
@@ -478,11 +485,17 @@ mod tests {
                 .unwrap();
         };
         bless(&store, 1.0);
-        let load = || store.load("s", TargetId::Light, false).unwrap().unwrap();
-        assert_eq!(load().data, image(1.0).data);
-        assert_eq!(load().data, image(1.0).data);
-        bless(&store.clone(), 2.0);
-        assert_eq!(load().data, image(2.0).data);
+        let clone = store.clone();
+        let load = |store: &GoldenStore| store.load("s", TargetId::Light, false).unwrap().unwrap();
+        let decodes = || store.decoded.lock().unwrap().decodes;
+        assert_eq!(load(&store).data, image(1.0).data);
+        assert_eq!(load(&store).data, image(1.0).data);
+        assert_eq!(load(&clone).data, image(1.0).data);
+        assert_eq!(decodes(), 1);
+        bless(&clone, 2.0);
+        assert_eq!(load(&store).data, image(2.0).data);
+        assert_eq!(load(&clone).data, image(2.0).data);
+        assert_eq!(decodes(), 2);
         let _ = std::fs::remove_dir_all(store.root());
     }
 

@@ -10,8 +10,9 @@
 //! `check` verifies the outputs it keeps of the reference backend's failing passes as it goes
 //! (unless `--no-verify`) and records a [`Verification`] in last-check.json, so that accepting
 //! them later (`harness review`, `bless --from-last-check`) renders nothing: the record is used
-//! while the scene's inputs ([`inputs_digest`]) are as they were; otherwise the accept verifies
-//! again.
+//! while the scene's inputs ([`inputs_digest`]) and the kept files are as they were, for the
+//! passes it speaks for ([`Verification::verdict_on`]); otherwise the accept verifies again. A
+//! verification that could not run is not recorded.
 
 use std::path::Path;
 use std::process::Command;
@@ -65,6 +66,9 @@ pub struct Verification {
     pub passes: Vec<TargetId>,
     /// The scene's inputs when it was verified ([`inputs_digest`]).
     pub inputs: String,
+    /// Each pass's output as the check kept it: a digest of the file's bytes ([`file_digest`]),
+    /// so that an accept takes the record only for the very files it verified.
+    pub kept: Vec<(TargetId, String)>,
     /// Where they did not reproduce (empty: verified under every source).
     pub disagreements: Vec<Disagreement>,
 }
@@ -73,6 +77,38 @@ impl Verification {
     /// Whether every output verified reproduced under every source.
     pub fn verified(&self) -> bool {
         self.disagreements.is_empty()
+    }
+
+    /// What this record says of `kept` (some of its passes, each with the file it keeps), while
+    /// `inputs` are the scene's now: `Some(empty)` verified, `Some(disagreements)` refused (the
+    /// ones about those passes, and render failures), `None` when it cannot say (other inputs,
+    /// other files, a pass it did not cover, or a refusal about other passes only: the
+    /// verification stops at the first source that disagrees, so the others were not tried
+    /// under every source) and the accept must verify again.
+    pub fn verdict_on(
+        &self,
+        inputs: &str,
+        kept: &[(TargetId, Option<String>)],
+    ) -> Option<Vec<Disagreement>> {
+        if self.inputs != inputs {
+            return None;
+        }
+        for (pass, digest) in kept {
+            let recorded = self.kept.iter().find(|(p, _)| p == pass).map(|(_, d)| d);
+            if digest.is_none() || recorded != digest.as_ref() {
+                return None;
+            }
+        }
+        if self.disagreements.is_empty() {
+            return Some(Vec::new());
+        }
+        let relevant: Vec<Disagreement> = self
+            .disagreements
+            .iter()
+            .filter(|d| d.pass.is_none_or(|p| kept.iter().any(|(k, _)| *k == p)))
+            .cloned()
+            .collect();
+        (!relevant.is_empty()).then_some(relevant)
     }
 
     /// One line: what was verified and how it went, with what to do.
@@ -100,13 +136,16 @@ impl Verification {
     }
 }
 
-/// A digest of what a scene's render depends on that can change between a check and an
-/// accept: the scene file, every file its values name (assets beside it), and the harness
-/// executable that renders it. (Files an asset names in turn, such as an OBJ's material
-/// library, are not followed: check again after changing one.)
-pub fn inputs_digest(case: &Case) -> String {
+/// A digest of what a scene's verification depends on that can change between a check and an
+/// accept: the scene file, every file its values name (assets beside it), the noise model the
+/// limits come from, and the harness executable that renders it. (Files an asset names in
+/// turn, such as an OBJ's material library, are not followed: check again after changing one.)
+pub fn inputs_digest(store: &GoldenStore, case: &Case) -> String {
     use std::hash::{Hash, Hasher};
     let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    std::fs::read(store.root().join("noise.toml"))
+        .unwrap_or_default()
+        .hash(&mut hasher);
     let path = &case.loaded.path;
     let text = std::fs::read_to_string(path).unwrap_or_default();
     text.hash(&mut hasher);
@@ -126,6 +165,15 @@ pub fn inputs_digest(case: &Case) -> String {
         meta.modified().ok().hash(&mut hasher);
     }
     format!("{:016x}", hasher.finish())
+}
+
+/// A digest of a file's bytes (None when it cannot be read).
+pub fn file_digest(path: &Path) -> Option<String> {
+    use std::hash::{Hash, Hasher};
+    let bytes = std::fs::read(path).ok()?;
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    bytes.hash(&mut hasher);
+    Some(format!("{:016x}", hasher.finish()))
 }
 
 /// Every string value in `value`, depth first.
@@ -265,35 +313,44 @@ pub fn verify_failing(
     };
     let mut verifications = Vec::new();
     for case in cases {
-        let candidates: Vec<(TargetId, Image)> = run
+        let failing: Vec<_> = run
             .results
             .iter()
             .filter(|r| r.scene == case.name() && r.backend == backend && !r.outcome.passed())
-            .filter_map(|r| {
-                let image = outputs.get(&(r.scene.clone(), r.pass, backend))?;
-                Some((r.pass, image.clone()))
-            })
             .collect();
+        let mut candidates: Vec<(TargetId, Image)> = Vec::new();
+        let mut kept = Vec::new();
+        for r in failing {
+            let image = outputs.get(&(r.scene.clone(), r.pass, backend));
+            let digest = r.artifacts.actual.as_deref().and_then(file_digest);
+            if let (Some(image), Some(digest)) = (image, digest) {
+                candidates.push((r.pass, image.clone()));
+                kept.push((r.pass, digest));
+            }
+        }
         if candidates.is_empty() {
             continue;
         }
         let scene = case.name();
-        let disagreements = verify(exe, store, case, &candidates, |source| {
+        let inputs = inputs_digest(store, case);
+        let verified = verify(exe, store, case, &candidates, |source| {
             progress(&format!("verifying {scene}'s new outputs under {source}"));
-        })
-        .unwrap_or_else(|e| {
-            vec![Disagreement {
-                source: "-".to_owned(),
-                backend: None,
-                pass: None,
-                detail: format!("could not verify: {e}"),
-            }]
         });
+        // Recorded only when it could say: not when it could not run (a child that gave no
+        // results has no backend), nor when the inputs changed meanwhile. The accept verifies.
+        let Ok(disagreements) = verified else {
+            continue;
+        };
+        if disagreements.iter().any(|d| d.backend.is_none()) || inputs_digest(store, case) != inputs
+        {
+            continue;
+        }
         verifications.push(Verification {
             scene: scene.to_owned(),
             backend,
             passes: candidates.iter().map(|(p, _)| *p).collect(),
-            inputs: inputs_digest(case),
+            inputs,
+            kept,
             disagreements,
         });
     }
@@ -313,4 +370,59 @@ fn copy_folder(from: &Path, to: &Path) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn disagreement(pass: Option<TargetId>) -> Disagreement {
+        Disagreement {
+            source: "cpu-avx".to_owned(),
+            backend: Some(BackendKind::WgpuVulkan),
+            pass,
+            detail: "moved".to_owned(),
+        }
+    }
+
+    /// A record of light and final: it speaks for either alone only with the same inputs and
+    /// files; a refusal about final does not refuse light (nor verify it: it was not tried under
+    /// every source), and a render failure refuses both.
+    #[test]
+    fn a_recorded_verification_speaks_only_for_what_it_verified() {
+        let (light, last) = (TargetId::Light, TargetId::Final);
+        let record = |disagreements| Verification {
+            scene: "arrow".to_owned(),
+            backend: BackendKind::Gl,
+            passes: vec![light, last],
+            inputs: "in".to_owned(),
+            kept: vec![(light, "l".to_owned()), (last, "f".to_owned())],
+            disagreements,
+        };
+        let kept_light = [(light, Some("l".to_owned()))];
+        let verified = record(vec![]);
+        assert_eq!(verified.verdict_on("in", &kept_light), Some(vec![]));
+        assert_eq!(verified.verdict_on("other", &kept_light), None);
+        assert_eq!(
+            verified.verdict_on("in", &[(light, Some("x".to_owned()))]),
+            None
+        );
+        assert_eq!(verified.verdict_on("in", &[(light, None)]), None);
+        assert_eq!(
+            verified.verdict_on("in", &[(TargetId::Depth, Some("l".to_owned()))]),
+            None
+        );
+        let final_refused = record(vec![disagreement(Some(last))]);
+        assert_eq!(final_refused.verdict_on("in", &kept_light), None);
+        let both = [(light, Some("l".to_owned())), (last, Some("f".to_owned()))];
+        assert_eq!(
+            final_refused.verdict_on("in", &both),
+            Some(vec![disagreement(Some(last))])
+        );
+        let render_failed = record(vec![disagreement(None)]);
+        assert_eq!(
+            render_failed.verdict_on("in", &kept_light),
+            Some(vec![disagreement(None)])
+        );
+    }
 }

@@ -416,8 +416,9 @@ fn check_notes_a_driver_other_than_the_blessing_one() {
 
 /// Shards: `check --scene` on three "jobs" (arrow after a light change, corner, ibl), each with
 /// its own `--out`, joined by `report --merge` into one run that equals the unsharded check of
-/// the three scenes (its results, verdicts and cross-backend comparisons, its JUnit file and its
-/// summary, with the GPU times and the output folders' names aside); one page; a
+/// the three scenes (its results, verdicts, verification of arrow's new outputs and
+/// cross-backend comparisons, its JUnit file and its summary, with the GPU times and the output
+/// folders' names aside); one page; a
 /// last-check.json whose failure images resolve into the shards (accepting from it works); a
 /// scene checked in two shards, or a shard given twice, is refused.
 #[test]
@@ -446,7 +447,6 @@ fn sharded_checks_merge_into_one_report() {
         let out = root.path().join(name);
         let args = [
             "check",
-            "--no-verify",
             "--no-speed",
             "--backend",
             "gl",
@@ -482,7 +482,6 @@ fn sharded_checks_merge_into_one_report() {
     let whole = root.path().join("unsharded");
     let (code, whole_text) = run(&[
         "check",
-        "--no-verify",
         "--no-speed",
         "--backend",
         "gl",
@@ -520,6 +519,14 @@ fn sharded_checks_merge_into_one_report() {
             "the merged {file} differs from the unsharded one"
         );
     }
+    let joined: harness::golden::check::CheckRun =
+        serde_json::from_slice(&std::fs::read(merged.join("last-check.json")).unwrap()).unwrap();
+    let verified: Vec<&str> = joined
+        .verifications
+        .iter()
+        .map(|v| v.scene.as_str())
+        .collect();
+    assert_eq!(verified, ["arrow"]);
     let report =
         quick_junit::Report::deserialize_from_str(&std::fs::read_to_string(&junit).unwrap())
             .unwrap();

@@ -58,17 +58,46 @@ fn render_rejects_an_unknown_pass_before_rendering() {
     assert!(!stderr.contains("rendering"), "rendered first:\n{stderr}");
 }
 
-/// So is one given to `check --pass`, with the golden passes listed.
+/// So is one given to `check --pass`, with the golden passes listed, and nothing is written;
+/// a known one is the only pass checked, without a verdict (which needs every pass).
 #[test]
-fn check_rejects_an_unknown_pass_before_rendering() {
-    let (code, stdout, stderr) = harness(&["check", "--scene", "arrow", "--pass", "finall"]);
+fn check_pass_checks_only_that_pass_and_rejects_an_unknown_one() {
+    if !crate::common::gl_available() {
+        return;
+    }
+    let out = tempfile::tempdir().unwrap();
+    let out_arg = out.path().to_str().unwrap();
+    let (code, stdout, stderr) = harness(&[
+        "check", "--scene", "arrow", "--pass", "finall", "--out", out_arg,
+    ]);
     assert_eq!(code, 1, "{stdout}\n{stderr}");
     assert!(
         stderr.contains("no scene checked has a golden pass `finall`")
             && stderr.contains("final, gbuffer_albedo"),
         "{stderr}"
     );
-    assert!(!stderr.contains("renders"), "rendered first:\n{stderr}");
+    assert!(
+        !out.path().join("last-check.json").exists(),
+        "it ran the check"
+    );
+    let (code, stdout, stderr) = harness(&[
+        "check",
+        "--scene",
+        "arrow",
+        "--backend",
+        "gl",
+        "--pass",
+        "light",
+        "--no-speed",
+        "--json",
+        "--out",
+        out_arg,
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    let run: harness::golden::check::CheckRun = serde_json::from_str(&stdout).unwrap();
+    let checked: Vec<_> = run.results.iter().map(|r| r.pass.to_string()).collect();
+    assert_eq!(checked, ["light"]);
+    assert!(run.diagnoses.is_empty());
 }
 
 /// `render` takes a scene file path as well as a name, and writes every pass with `--pass all`
