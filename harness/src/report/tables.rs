@@ -167,8 +167,12 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
         };
         let _ = write!(
             out,
-            "<tr class=\"{class}\"><td>{}</td><td>{}</td><td>{}</td><td>{label}</td><td>{}</td>\
-             <td>{}</td><td>{}</td><td>{:.2}</td><td>{}</td></tr>",
+            "<tr class=\"{class}\" data-speed=\"1\" data-scene=\"{}\" data-pass=\"{}\" \
+             data-backend=\"{}\"><td>{}</td><td>{}</td><td>{}</td><td class=\"result\">{label}</td>\
+             <td>{}</td><td>{}</td><td>{}</td><td>{:.2}</td><td>{}</td></tr>",
+            escape(&c.scene),
+            c.pass,
+            c.backend,
             escape(&c.scene),
             c.pass,
             c.backend,

@@ -10,11 +10,14 @@
     ' .accept-bar{margin:.5em 0} .accept-bar button{margin-right:.4em}';
   document.head.appendChild(style);
 
+  // A speed row's pass is a plan pass; the server names an accepted timing `speed <pass>`.
+  const key = (row) => (row.dataset.speed ? 'speed ' : '') + row.dataset.pass;
+
   function mark(accepted) {
     for (const [scene, pass] of accepted) {
       const rows = document.querySelectorAll('tr[data-scene][data-pass]');
       for (const row of rows) {
-        if (row.dataset.scene !== scene || row.dataset.pass !== pass) continue;
+        if (row.dataset.scene !== scene || key(row) !== pass) continue;
         row.classList.add('accepted');
         const result = row.querySelector('td.result');
         if (result) result.textContent = 'ACCEPTED';
@@ -60,10 +63,13 @@
     const button = document.createElement('button');
     button.className = 'accept';
     button.textContent = 'Accept';
-    button.title = 'bless this output of ' + row.dataset.backend + ' as the golden';
+    const speed = Boolean(row.dataset.speed);
+    button.title = speed
+      ? 'record the ratio the check measured on ' + row.dataset.backend + ' as the timing golden'
+      : 'bless this output of ' + row.dataset.backend + ' as the golden';
     button.onclick = () =>
       accept(
-        { scene: row.dataset.scene, pass: row.dataset.pass, backend: row.dataset.backend },
+        { scene: row.dataset.scene, pass: row.dataset.pass, backend: row.dataset.backend, speed },
         button
       );
     row.lastElementChild.prepend(button);

@@ -1,8 +1,9 @@
 //! `harness review`: the last check's review page served on 127.0.0.1, with Accept buttons on
 //! each failing pass, each scene and the whole run. Accepting blesses exactly the outputs that
 //! `check` rendered and kept ([`crate::golden::accept`]), verified and recorded as any bless
-//! ([`crate::golden::verify`]); it never renders the check again. A scene's or the run's Accept
-//! also records the speed ratios the check measured beyond their limits as the timing goldens.
+//! ([`crate::golden::verify`]); it never renders the check again. A failing speed row's Accept
+//! records the ratio the check measured as that pass's timing golden; a scene's or the run's
+//! Accept records every such ratio of theirs.
 //! The page marks what was accepted; a later `check` shows it passing.
 //!
 //! The server answers only its own page: every request must name it in its Host header
@@ -52,6 +53,10 @@ pub struct AcceptRequest {
     pub pass: Option<String>,
     /// The backend whose outputs to accept (the reference backend by default).
     pub backend: Option<BackendKind>,
+    /// A speed check's row: the pass is a plan pass, and its timing golden is accepted (on the
+    /// backend given, or every backend).
+    #[serde(default)]
+    pub speed: bool,
 }
 
 /// The answer to an accept request.
@@ -200,6 +205,20 @@ impl Review {
     /// Accepts what `ask` names from the last check: verified, then blessed, scene by scene.
     fn accept(&mut self, ask: &AcceptRequest, store: &GoldenStore) -> AcceptAnswer {
         let mut answer = AcceptAnswer::default();
+        if ask.speed {
+            let scenes: Vec<String> = ask.scene.iter().cloned().collect();
+            let passes: Vec<String> = ask.pass.iter().cloned().collect();
+            self.accept_timings(&scenes, &passes, ask.backend, store, &mut answer);
+            if answer.accepted.is_empty() && answer.refused.is_empty() {
+                let what = format!("{} {}", scenes.join(","), passes.join(","));
+                answer.refused.push((
+                    what,
+                    "speed".into(),
+                    "the last check has no speed check beyond its limit there".into(),
+                ));
+            }
+            return answer;
+        }
         let backend = ask.backend.unwrap_or(suite::REFERENCE_BACKEND);
         let scenes: Vec<String> = ask.scene.iter().cloned().collect();
         let passes: Vec<String> = ask.pass.iter().cloned().collect();
@@ -271,15 +290,26 @@ impl Review {
         }
         // A scene's or the run's Accept takes its timing goldens too, as the check measured.
         if ask.pass.is_none() {
-            self.accept_timings(&scenes, store, &mut answer);
+            self.accept_timings(&scenes, &[], None, store, &mut answer);
         }
         answer
     }
 
-    /// Accepts the last check's speed checks beyond their limits of `scenes` (all when empty).
-    fn accept_timings(&self, scenes: &[String], store: &GoldenStore, answer: &mut AcceptAnswer) {
-        let checks = match accept::speed_candidates(&self.out, scenes, &[]) {
-            Ok(checks) => checks,
+    /// Accepts the last check's speed checks beyond their limits of `scenes` and `passes` (plan
+    /// passes; all when empty), on `backend` (every one when None).
+    fn accept_timings(
+        &mut self,
+        scenes: &[String],
+        passes: &[String],
+        backend: Option<BackendKind>,
+        store: &GoldenStore,
+        answer: &mut AcceptAnswer,
+    ) {
+        let checks = match accept::speed_candidates(&self.out, scenes, passes) {
+            Ok(checks) => checks
+                .into_iter()
+                .filter(|c| backend.is_none_or(|b| c.backend == b))
+                .collect::<Vec<_>>(),
             Err(e) => {
                 answer
                     .refused
@@ -292,6 +322,7 @@ impl Review {
                 Ok(_) => {
                     for c in checks.iter().filter(|c| c.scene == scene) {
                         let pass = format!("speed {}", c.pass);
+                        self.accepted.insert((scene.clone(), pass.clone()));
                         answer.accepted.push((scene.clone(), pass, c.backend));
                     }
                 }

@@ -153,10 +153,11 @@ fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
     );
 }
 
-/// The timing goldens are accepted from the last check too: arrow's lighting golden on gl
-/// divided by 3 makes the check fail that pass's speed check (SLOWER); `bless --from-last-check
-/// --speed-only` records the ratio the check measured, without probing again, and the next
-/// check passes it.
+/// The timing goldens are accepted from the last check too: arrow's geometry and lighting
+/// goldens on gl divided by 3 make the check fail those passes' speed checks (SLOWER); `bless
+/// --from-last-check --speed-only --pass lighting_pbr` records the ratio the check measured,
+/// without probing again, and so does the review page's Accept on the geometry pass's speed row
+/// (rendering forbidden); the next check passes both.
 #[test]
 fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
     if !common::gl_available() {
@@ -165,8 +166,10 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
     let root = common::temp_workspace();
     let timing = root.path().join("golden/arrow/timing.toml");
     let mut goldens: toml::Table = std::fs::read_to_string(&timing).unwrap().parse().unwrap();
-    let ratio = &mut goldens["gl"]["passes"]["lighting_pbr"]["ratio"];
-    *ratio = toml::Value::Float(ratio.as_float().unwrap() / 3.0);
+    for pass in ["geometry", "lighting_pbr"] {
+        let ratio = &mut goldens["gl"]["passes"][pass]["ratio"];
+        *ratio = toml::Value::Float(ratio.as_float().unwrap() / 3.0);
+    }
     std::fs::write(&timing, toml::to_string(&goldens).unwrap()).unwrap();
     let out = root.path().join("out");
     let check = || {
@@ -194,7 +197,13 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
             .collect();
         (output.status.code(), slower)
     };
-    assert_eq!(check(), (Some(1), vec!["lighting_pbr".to_owned()]));
+    let slower = vec!["geometry".to_owned(), "lighting_pbr".to_owned()];
+    assert_eq!(check(), (Some(1), slower));
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(page.contains(
+        "<tr class=\"failed\" data-speed=\"1\" data-scene=\"arrow\" data-pass=\"geometry\" \
+         data-backend=\"gl\">"
+    ));
     let output = common::harness_command()
         .args([
             "bless",
@@ -202,6 +211,8 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
             "--speed-only",
             "--scene",
             "arrow",
+            "--pass",
+            "lighting_pbr",
             "--out",
         ])
         .arg(&out)
@@ -211,8 +222,19 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(output.status.success(), "{stdout}");
     assert!(
-        stdout.contains("arrow/lighting_pbr on gl (speed): ratio ") && stdout.contains("written"),
+        stdout.contains("arrow/lighting_pbr on gl (speed): ratio ")
+            && stdout.contains("written")
+            && !stdout.contains("geometry"),
         "{stdout}"
     );
+    let server = crate::review::Server::start(root.path(), &out);
+    let answer = server.accept(&serde_json::json!({
+        "scene": "arrow", "pass": "geometry", "backend": "gl", "speed": true
+    }));
+    assert_eq!(
+        answer,
+        serde_json::json!({ "accepted": [["arrow", "speed geometry", "gl"]], "refused": [] })
+    );
+    drop(server);
     assert_eq!(check(), (Some(0), vec![]));
 }

@@ -17,24 +17,89 @@ use serde_json::json;
 use super::report::{check_after_a_light_change, chromium, workspace_with_a_light_change, Browser};
 use crate::common;
 
-/// Sends a raw HTTP request to 127.0.0.1:`port` and returns its status code.
-fn status(port: u16, request: &str) -> u16 {
+/// Sends a raw HTTP request to 127.0.0.1:`port`: its status code and body.
+fn send(port: u16, request: &str) -> (u16, String) {
     let mut stream = TcpStream::connect(("127.0.0.1", port)).unwrap();
     stream.write_all(request.as_bytes()).unwrap();
     let mut answer = String::new();
     let _ = stream.read_to_string(&mut answer);
-    answer
+    let code = answer
         .split_whitespace()
         .nth(1)
         .and_then(|code| code.parse().ok())
-        .unwrap_or_else(|| panic!("no status in {answer:?}"))
+        .unwrap_or_else(|| panic!("no status in {answer:?}"));
+    let body = answer.split_once("\r\n\r\n").map(|(_, b)| b.to_owned());
+    (code, body.unwrap_or_default())
 }
 
-/// Kills the review server when the test ends, however it ends; holds its stdout open until
-/// then (a closed pipe would end it at its next line).
-struct Server {
+/// Sends a raw HTTP request to 127.0.0.1:`port` and returns its status code.
+fn status(port: u16, request: &str) -> u16 {
+    send(port, request).0
+}
+
+/// A `harness review` server, killed when the test ends, however it ends; holds its stdout
+/// open until then (a closed pipe would end it at its next line).
+pub(crate) struct Server {
     child: std::process::Child,
     _stdout: BufReader<std::process::ChildStdout>,
+    /// The page's address, token included.
+    pub url: String,
+    /// Its port.
+    pub port: u16,
+    /// The page's token.
+    pub token: String,
+}
+
+impl Server {
+    /// Serves the check kept under `out` of the workspace at `root`, rendering forbidden.
+    pub(crate) fn start(root: &std::path::Path, out: &std::path::Path) -> Self {
+        let mut child = common::harness_command()
+            .args(["review", "--out"])
+            .arg(out)
+            .env("HARNESS_ROOT", root)
+            .env(harness::faults::NO_RENDER, "1")
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        let mut first = String::new();
+        let mut stdout = BufReader::new(child.stdout.take().unwrap());
+        stdout.read_line(&mut first).unwrap();
+        let url = first
+            .split_whitespace()
+            .find(|w| w.starts_with("http://127.0.0.1:"))
+            .unwrap_or_else(|| panic!("no address in {first:?}"))
+            .to_owned();
+        let port: u16 = url["http://127.0.0.1:".len()..]
+            .split('/')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        let token = url.split("token=").nth(1).unwrap().to_owned();
+        Server {
+            child,
+            _stdout: stdout,
+            url,
+            port,
+            token,
+        }
+    }
+
+    /// Posts `body` to /accept as the page does; the answer's JSON.
+    pub(crate) fn accept(&self, body: &serde_json::Value) -> serde_json::Value {
+        let body = body.to_string();
+        let request = format!(
+            "POST /accept HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nX-Harness-Token: {}\r\n\
+             Content-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{body}",
+            self.port,
+            self.token,
+            body.len()
+        );
+        let (code, answer) = send(self.port, &request);
+        assert_eq!(code, 200, "{answer}");
+        serde_json::from_str(&answer).unwrap()
+    }
 }
 
 impl Drop for Server {
@@ -71,34 +136,8 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
         .output()
         .unwrap();
     assert!(output.status.success(), "{output:?}");
-    let mut child = common::harness_command()
-        .args(["review", "--out"])
-        .arg(&out)
-        .env("HARNESS_ROOT", root.path())
-        .env(harness::faults::NO_RENDER, "1")
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut first = String::new();
-    let mut stdout = BufReader::new(child.stdout.take().unwrap());
-    stdout.read_line(&mut first).unwrap();
-    let server = Server {
-        child,
-        _stdout: stdout,
-    };
-    let url = first
-        .split_whitespace()
-        .find(|w| w.starts_with("http://127.0.0.1:"))
-        .unwrap_or_else(|| panic!("no address in {first:?}"))
-        .to_owned();
-    let port: u16 = url["http://127.0.0.1:".len()..]
-        .split('/')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
-    let token = url.split("token=").nth(1).unwrap().to_owned();
+    let server = Server::start(root.path(), &out);
+    let (url, port, token) = (server.url.clone(), server.port, server.token.clone());
     let host = format!("Host: 127.0.0.1:{port}\r\n");
     let post = |headers: &str| {
         format!(
