@@ -1,8 +1,9 @@
 //! Faults injected into real runs, for the tests that prove what the harness does when a backend
 //! misbehaves. [`FaultyBackend`] forwards to a real backend with faults on request: a shader that
 //! does not compile, a device lost at submit, a failed readback, or outputs perturbed on that
-//! backend alone. [`create_backend`] is how `check`, `bless` (and so verification's child checks)
-//! and the speed probes make their backends: a real one, unless the environment, which child
+//! backend alone. [`create_backend`] is how the harness makes every backend it renders with
+//! (`check`, `bless` and so the verification's child checks, `render`, the self-test, the speed
+//! probes, bench, sweeps and hard cases): a real one, unless the environment, which child
 //! processes inherit, asks otherwise:
 //! - `HARNESS_INJECT_FAULT=<backend>:perturb-output`: that backend's readbacks are perturbed
 //!   (8-bit red +24, float red x1.1 + 0.01), so its every pass moves and the others do not;

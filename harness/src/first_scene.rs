@@ -53,7 +53,7 @@ impl Agreement {
 
 /// Renders the first scene on `kind`.
 pub fn render(kind: BackendKind) -> Result<LitCubeImages, backend::BackendError> {
-    let mut backend = backend::create(kind)?;
+    let mut backend = crate::faults::create_backend(kind)?;
     lit_cube::render(backend.as_mut(), SIZE)
 }
 

@@ -361,7 +361,7 @@ fn each_scene_and_backend<R>(
     let mut results = Vec::new();
     let mut failed = false;
     for kind in kinds {
-        if let Err(e) = engine::backend::create(kind) {
+        if let Err(e) = harness::faults::create_backend(kind) {
             eprintln!("skipping {kind}: {e}");
             failed |= !backends.is_empty();
             continue;

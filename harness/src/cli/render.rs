@@ -41,7 +41,7 @@ pub(crate) fn run(
                 )
             })?
     };
-    let mut backend = engine::backend::create(kind)?;
+    let mut backend = harness::faults::create_backend(kind)?;
     eprintln!(
         "rendering {} ({}x{}) on {kind} ...",
         scene.name, scene.quality.width, scene.quality.height

@@ -231,7 +231,7 @@ pub fn run(
     kind: BackendKind,
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<HardCaseRow>, HardCaseError> {
-    let mut backend = backend::create(kind)?;
+    let mut backend = crate::faults::create_backend(kind)?;
     let mut rows = Vec::new();
     for case in SCENE_CASES {
         progress(case);

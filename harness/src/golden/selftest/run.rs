@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 
-use engine::backend::{self, BackendKind};
+use engine::backend::BackendKind;
 use engine::plan::TargetId;
 use engine::renderer::{self, PreparedFrame, Readback};
 use engine::Image;
@@ -128,7 +128,7 @@ fn run_backend(
     result: &mut SelfTest,
 ) {
     let wanted: &[TargetId] = &case.passes;
-    let mut backend = match backend::create(kind) {
+    let mut backend = match crate::faults::create_backend(kind) {
         Ok(backend) => backend,
         Err(e) => {
             result

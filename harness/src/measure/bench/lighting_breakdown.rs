@@ -8,7 +8,7 @@
 //! of the pass with medians, 88-108% with the lower quartile, over the same six runs (three of
 //! 5 frames, three of 21). Scheduling only adds time, so the lower frames measure the work.
 
-use engine::backend::{self, Backend, BackendKind};
+use engine::backend::{Backend, BackendKind};
 use engine::plan::{LightingFeature, PassId, PassSpec, RenderPlan};
 use engine::renderer::{PassTimes, PreparedFrame, Variations};
 use engine::scene::Scene;
@@ -72,7 +72,7 @@ pub fn breakdown(
     frames: usize,
     progress: impl Fn(&str),
 ) -> Result<Vec<PassBreakdown>, BenchError> {
-    let mut backend = backend::create(kind).map_err(|e| BenchError::Backend {
+    let mut backend = crate::faults::create_backend(kind).map_err(|e| BenchError::Backend {
         backend: kind,
         message: e.to_string(),
     })?;
@@ -314,7 +314,7 @@ mod tests {
     /// One frame's timings: the pass `pass` took `ms`.
     fn frame(pass: PassId, ms: f64) -> PassTimes {
         PassTimes {
-            passes: vec![backend::PassTiming {
+            passes: vec![engine::backend::PassTiming {
                 name: pass.to_string(),
                 gpu_ns: Some(ms * 1e6),
             }],

@@ -1,7 +1,7 @@
 //! The scaling series: how a frame's or a pass's cost grows with resolution, point lights,
 //! triangles and shadow-map size.
 
-use engine::backend::{self, BackendKind};
+use engine::backend::BackendKind;
 use engine::plan::PassId;
 use engine::scene::{LightingModel, Scene};
 
@@ -130,7 +130,7 @@ pub fn series(
             })
             .collect::<Result<_, BenchError>>()?,
     };
-    let mut backend = backend::create(kind).map_err(|e| BenchError::Backend {
+    let mut backend = crate::faults::create_backend(kind).map_err(|e| BenchError::Backend {
         backend: kind,
         message: e.to_string(),
     })?;

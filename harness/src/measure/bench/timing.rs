@@ -229,7 +229,7 @@ pub fn bench_scene_with(
         backend: kind,
         message: e.to_string(),
     };
-    let mut backend = backend::create(kind).map_err(backend_error)?;
+    let mut backend = crate::faults::create_backend(kind).map_err(backend_error)?;
     let frames = frames.max(1);
     let prepared = prepare(scene, kind)?;
     let plan = prepared.plan();

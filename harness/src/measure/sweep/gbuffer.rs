@@ -1,7 +1,7 @@
 //! The G-buffer sweep: every position storage and normal encoding, with the scene at the origin
 //! and moved far from it, timed and measured against the default storage at the origin.
 
-use engine::backend::{self, BackendKind};
+use engine::backend::BackendKind;
 use engine::plan::{PassId, TargetId};
 use engine::renderer::{self, Frame, Readback};
 use engine::scene::Scene;
@@ -89,7 +89,8 @@ pub fn gbuffer_sweep(
     repeats: usize,
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<GbufferSweepRow>, SweepError> {
-    let mut backend = backend::create(kind).map_err(|e| SweepError::Render(e.to_string()))?;
+    let mut backend =
+        crate::faults::create_backend(kind).map_err(|e| SweepError::Render(e.to_string()))?;
     let wanted = [TargetId::Light, TargetId::Mask(0)];
     let mut render = |scene: &Scene| {
         renderer::render(backend.as_mut(), scene, Readback::Only(&wanted))

@@ -1,7 +1,7 @@
 //! The IBL sweep: the IBL precompute's settings one knob at a time, each timed (precompute
 //! and lighting pass) and measured against the Monte Carlo reference per roughness.
 
-use engine::backend::{self, BackendKind};
+use engine::backend::BackendKind;
 use engine::renderer::{self, Readback};
 use engine::scene::Scene;
 
@@ -161,7 +161,8 @@ pub fn ibl_sweep_with(
         .environment
         .as_ref()
         .ok_or_else(|| SweepError::NoEnvironment(scene.name.clone()))?;
-    let mut backend = backend::create(kind).map_err(|e| SweepError::Render(e.to_string()))?;
+    let mut backend =
+        crate::faults::create_backend(kind).map_err(|e| SweepError::Render(e.to_string()))?;
     let mut rows = Vec::new();
     let mut references = None;
     let mut built: Vec<(engine::ibl::cache::Key, f64)> = Vec::new();

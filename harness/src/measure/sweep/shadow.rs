@@ -1,7 +1,7 @@
 //! The shadow sweep: every shadow filter at several map sizes, timed, and its shadow term
 //! measured against exact visibility by ray casting and against the converged soft filter.
 
-use engine::backend::{self, BackendKind};
+use engine::backend::BackendKind;
 use engine::plan::TargetId;
 use engine::renderer::PreparedFrame;
 use engine::renderer::{self, Frame, Readback};
@@ -120,7 +120,8 @@ pub fn shadow_sweep_with(
         } => Some((s.filter, s.map_size)),
         _ => None,
     };
-    let mut backend = backend::create(kind).map_err(|e| SweepError::Render(e.to_string()))?;
+    let mut backend =
+        crate::faults::create_backend(kind).map_err(|e| SweepError::Render(e.to_string()))?;
     let term_name = TargetId::ShadowTerm { light };
     // What the ray-cast comparison reads (shadow settings change no target but the maps').
     let hard = PreparedFrame::new(&with_shadow(scene, ShadowFilter::Hard, 512))
