@@ -157,7 +157,8 @@ fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
 /// goldens on gl divided by 3 make the check fail those passes' speed checks (SLOWER); `bless
 /// --from-last-check --speed-only --pass lighting_pbr` records the ratio the check measured,
 /// without probing again, and so does the review page's Accept on the geometry pass's speed row
-/// (rendering forbidden); the next check passes both.
+/// (clicked in Chromium, or posted as the page would without it; rendering forbidden); the next
+/// check passes both.
 #[test]
 fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
     if !common::gl_available() {
@@ -228,13 +229,27 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
         "{stdout}"
     );
     let server = crate::review::Server::start(root.path(), &out);
-    let answer = server.accept(&serde_json::json!({
-        "scene": "arrow", "pass": "geometry", "backend": "gl", "speed": true
-    }));
-    assert_eq!(
-        answer,
-        serde_json::json!({ "accepted": [["arrow", "speed geometry", "gl"]], "refused": [] })
-    );
+    if let Some(executable) = crate::report::chromium() {
+        // The speed row's own Accept button, clicked in a browser.
+        let mut browser = crate::report::Browser::launch(executable);
+        browser.open(&server.url);
+        let row = "tr[data-speed='1'][data-scene=arrow][data-pass=geometry][data-backend=gl]";
+        browser.click_on(&format!("{row} button.accept"));
+        let marked = browser.eval(&crate::review::wait_for(
+            &format!("document.querySelector(\"{row}\")"),
+            "r.classList.contains('accepted')",
+            "r.querySelector('td.result').textContent",
+        ));
+        assert_eq!(marked, serde_json::json!("ACCEPTED"));
+    } else {
+        let answer = server.accept(&serde_json::json!({
+            "scene": "arrow", "pass": "geometry", "backend": "gl", "speed": true
+        }));
+        assert_eq!(
+            answer,
+            serde_json::json!({ "accepted": [["arrow", "speed geometry", "gl"]], "refused": [] })
+        );
+    }
     drop(server);
     assert_eq!(check(), (Some(0), vec![]));
 }

@@ -242,7 +242,7 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
 
 /// A CDP expression that waits (up to 2 minutes) until `done` holds of `r` (the element
 /// `element` finds), then gives `value` of it, or what the element shows if it never does.
-fn wait_for(element: &str, done: &str, value: &str) -> String {
+pub(crate) fn wait_for(element: &str, done: &str, value: &str) -> String {
     format!(
         "new Promise((resolve) => {{ const start = Date.now(); const poll = () => {{ \
          const r = {element}; \
