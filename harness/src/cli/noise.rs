@@ -125,11 +125,7 @@ fn available_backends() -> anyhow::Result<(Vec<BackendKind>, BackendKind)> {
         .into_iter()
         .filter(|&k| engine::backend::probe(k).available)
         .collect();
-    let Some(&reference) = backends
-        .iter()
-        .find(|&&k| k == harness::golden::suite::REFERENCE_BACKEND)
-        .or(backends.first())
-    else {
+    let Some(reference) = harness::golden::suite::reference_among(&backends) else {
         anyhow::bail!("no backend is available; run `harness backends` for the reasons");
     };
     Ok((backends, reference))

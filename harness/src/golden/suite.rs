@@ -21,6 +21,16 @@ use crate::images::{self, PngCompression};
 /// The backend goldens are blessed from by default (the others are checked against them).
 pub const REFERENCE_BACKEND: BackendKind = BackendKind::Gl;
 
+/// The backend that stands for `backends` where one must: the reference backend when it is
+/// among them, else the first (None when there are none).
+pub fn reference_among(backends: &[BackendKind]) -> Option<BackendKind> {
+    backends
+        .iter()
+        .copied()
+        .find(|&k| k == REFERENCE_BACKEND)
+        .or(backends.first().copied())
+}
+
 /// Why the suite could not be set up.
 #[derive(Debug, thiserror::Error)]
 pub enum SuiteError {

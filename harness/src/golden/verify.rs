@@ -304,11 +304,7 @@ pub fn verify_failing(
         .filter(|b| b.unavailable.is_none())
         .map(|b| b.backend)
         .collect();
-    let Some(&backend) = available
-        .iter()
-        .find(|&&b| b == super::suite::REFERENCE_BACKEND)
-        .or(available.first())
-    else {
+    let Some(backend) = super::suite::reference_among(&available) else {
         return Vec::new();
     };
     let mut verifications = Vec::new();

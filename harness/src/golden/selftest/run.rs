@@ -102,11 +102,7 @@ fn run_case(
             (pass, golden.ok().flatten())
         })
         .collect();
-    let reference = backends
-        .iter()
-        .copied()
-        .find(|&k| k == suite::REFERENCE_BACKEND)
-        .or(backends.first().copied());
+    let reference = suite::reference_among(backends);
     for &kind in backends {
         let reference = Some(kind) == reference;
         run_backend(case, kind, reference, &goldens, checks, &mut result);
