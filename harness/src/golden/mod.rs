@@ -19,5 +19,6 @@ mod store;
 pub mod suite;
 pub mod tolerance;
 pub mod verify;
+pub mod verify_cache;
 
 pub use store::*;

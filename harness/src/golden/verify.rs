@@ -177,7 +177,7 @@ pub fn file_digest(path: &Path) -> Option<String> {
 }
 
 /// Every string value in `value`, depth first.
-fn collect_strings(value: &toml::Value, into: &mut Vec<String>) {
+pub(crate) fn collect_strings(value: &toml::Value, into: &mut Vec<String>) {
     match value {
         toml::Value::String(s) => into.push(s.clone()),
         toml::Value::Array(items) => items.iter().for_each(|v| collect_strings(v, into)),
@@ -212,6 +212,20 @@ pub fn verify(
         let path = candidate_store.path(case.name(), *pass, super::is_eight_bit(image));
         crate::images::write_image(image, &path, crate::images::PngCompression::Fast)
             .map_err(|e| e.to_string())?;
+    }
+    // The same candidates of the same scene verified before, under the same drivers and
+    // environment (only where HARNESS_VERIFY_CACHE names a folder).
+    let passes: Vec<TargetId> = candidates.iter().map(|(pass, _)| *pass).collect();
+    let cache = super::verify_cache::folder()
+        .and_then(|folder| Some((super::verify_cache::key(case, &golden, &passes)?, folder)));
+    if let Some((key, folder)) = &cache {
+        if let Some(kept) = super::verify_cache::lookup(folder, key) {
+            progress(&format!(
+                "every source: the same candidates were verified before ({})",
+                super::verify_cache::CACHE_ENV
+            ));
+            return Ok(kept);
+        }
     }
     let (all, _) = sources(store);
     let mut disagreements = Vec::new();
@@ -282,6 +296,9 @@ pub fn verify(
         if !disagreements.is_empty() {
             break;
         }
+    }
+    if let Some((key, folder)) = &cache {
+        super::verify_cache::keep(folder, key, &disagreements);
     }
     Ok(disagreements)
 }

@@ -80,14 +80,39 @@ pub fn temp_workspace() -> tempfile::TempDir {
 /// points HARNESS_ROOT at a temporary copy (the maps depend only on the environment image, the
 /// IBL settings and the precompute's code; the cache itself is tested in
 /// engine/tests/integration/ibl.rs). Without it, every run in a temporary workspace would
-/// precompute the maps again.
+/// precompute the maps again. It also shares this test run's kept verifications
+/// ([`verify_cache`]).
 pub fn harness_command() -> std::process::Command {
     let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_harness"));
     command.env(
         "HARNESS_IBL_CACHE",
         harness::ibl_cache_dir().unwrap_or_default(),
     );
+    command.env(harness::golden::verify_cache::CACHE_ENV, verify_cache());
     command
+}
+
+/// The folder in which this test run's `harness` children keep their verifications
+/// (`harness::golden::verify_cache`): several tests check, bless and accept the same change
+/// (arrow's light brightened), and its candidates need rendering under every source once per
+/// run. A folder per test process, under target/tmp, so each run verifies afresh; the folders
+/// of runs that have ended are removed.
+pub fn verify_cache() -> &'static std::path::Path {
+    static FOLDER: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+    FOLDER.get_or_init(|| {
+        let base = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("verify-cache");
+        for entry in std::fs::read_dir(&base).into_iter().flatten().flatten() {
+            let ended = entry
+                .file_name()
+                .to_str()
+                .and_then(|name| name.parse::<u32>().ok())
+                .is_some_and(|pid| !std::path::Path::new(&format!("/proc/{pid}")).exists());
+            if ended {
+                let _ = std::fs::remove_dir_all(entry.path());
+            }
+        }
+        base.join(std::process::id().to_string())
+    })
 }
 
 /// Writes `<dir>/<name>.toml`: the canonical ibl scene with `[quality.ibl] extract_sun = true`

@@ -36,3 +36,4 @@ mod selftest;
 mod shadows;
 mod speed;
 mod sweeps;
+mod verify_cache;

@@ -1,0 +1,47 @@
+//! Kept verifications (`HARNESS_VERIFY_CACHE`): the key changes with everything a
+//! verification's child checks read, and the tests' runs reuse what they verified.
+
+use engine::backend;
+use engine::plan::TargetId;
+use harness::golden::suite::Case;
+use harness::golden::verify_cache::key;
+
+use crate::common;
+
+/// The candidates, the passes verified and the scene's assets (a material library its OBJ
+/// names, which the scene file does not) each change the key; nothing else does.
+#[test]
+fn a_kept_verification_is_keyed_by_everything_its_checks_read() {
+    // The key names the drivers this process has loaded: load them, as a check has.
+    let Some(kind) = common::available_backends().into_iter().next() else {
+        return;
+    };
+    let _backend = backend::create(kind).unwrap();
+    let root = common::temp_workspace();
+    let scene = root.path().join("scenes/chess.toml");
+    let case = Case::load(scene.to_str().unwrap()).unwrap();
+    let golden = tempfile::tempdir().unwrap();
+    let candidate = golden.path().join("chess/light.exr");
+    std::fs::create_dir_all(candidate.parent().unwrap()).unwrap();
+    std::fs::write(&candidate, b"candidate").unwrap();
+    let passes = [TargetId::Light, TargetId::Final];
+    let key_now = || key(&case, golden.path(), &passes).expect("a key where drivers are loaded");
+
+    let first = key_now();
+    assert_eq!(key_now(), first, "the same inputs give the same key");
+
+    std::fs::write(&candidate, b"another candidate").unwrap();
+    let other_candidate = key_now();
+    assert_ne!(other_candidate, first, "a changed candidate");
+
+    assert_ne!(
+        key(&case, golden.path(), &passes[..1]).unwrap(),
+        other_candidate,
+        "other passes"
+    );
+
+    let mtl = root.path().join("scenes/assets/board.mtl");
+    let text = std::fs::read_to_string(&mtl).unwrap();
+    std::fs::write(&mtl, format!("{text}\n# edited\n")).unwrap();
+    assert_ne!(key_now(), other_candidate, "an edited material library");
+}
