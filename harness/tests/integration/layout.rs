@@ -1,8 +1,10 @@
 //! The layout rules a newcomer relies on: no source file over 600 lines (shaders, scripts and
 //! the review page's JS and CSS included), so each concern stays in a file that can be read in
 //! one sitting, and no relative link in the Markdown (README.md, docs/, ...) leads nowhere.
-//! Function length is clippy's `too_many_lines` (see clippy.toml).
+//! Function length is clippy's `too_many_lines` (see clippy.toml). And the README's two commands
+//! share one build.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// The longest a source file may be.
@@ -83,4 +85,54 @@ fn relative_links(text: &str) -> Vec<&str> {
             (!external && !target.starts_with('#') && !target.is_empty()).then_some(target)
         })
         .collect()
+}
+
+/// The README's two commands share one build: every crate that `cargo run -p harness` builds is
+/// built by `cargo test --workspace` with the same features (the dev-dependencies turn some on;
+/// harness/Cargo.toml names those, or the tests would build engine and harness a second time).
+#[test]
+fn the_main_command_and_the_tests_build_the_same_crates() {
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let tree = |args: &[&str]| -> BTreeMap<String, String> {
+        let output = std::process::Command::new(std::env::var("CARGO").unwrap_or("cargo".into()))
+            .args([
+                "tree",
+                "--offline",
+                "--prefix",
+                "none",
+                "--format",
+                "{p}|{f}",
+            ])
+            .args(args)
+            .current_dir(&workspace)
+            .output()
+            .unwrap();
+        assert!(
+            output.status.success(),
+            "cargo tree: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        String::from_utf8_lossy(&output.stdout)
+            .lines()
+            .filter_map(|line| {
+                let (package, features) = line.trim_end_matches(" (*)").split_once('|')?;
+                Some((package.to_owned(), features.to_owned()))
+            })
+            .collect()
+    };
+    let main = tree(&["-p", "harness", "-e", "normal,build"]);
+    let tests = tree(&["--workspace", "-e", "normal,build,dev"]);
+    assert!(main.len() > 100, "{} crates", main.len());
+    let differ: Vec<String> = main
+        .iter()
+        .filter_map(|(package, features)| {
+            let in_tests = tests.get(package)?;
+            (in_tests != features).then(|| format!("{package}: [{features}] vs [{in_tests}]"))
+        })
+        .collect();
+    assert!(
+        differ.is_empty(),
+        "`cargo test` would build these again with other features (name them in \
+         harness/Cargo.toml): {differ:#?}"
+    );
 }
