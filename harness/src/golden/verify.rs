@@ -147,18 +147,12 @@ pub fn inputs_digest(store: &GoldenStore, case: &Case) -> String {
         .unwrap_or_default()
         .hash(&mut hasher);
     let path = &case.loaded.path;
-    let text = std::fs::read_to_string(path).unwrap_or_default();
-    text.hash(&mut hasher);
-    if let (Ok(table), Some(dir)) = (text.parse::<toml::Table>(), path.parent()) {
-        let mut named = Vec::new();
-        collect_strings(&toml::Value::Table(table), &mut named);
-        for name in named {
-            let file = dir.join(&name);
-            if file.is_file() {
-                name.hash(&mut hasher);
-                std::fs::read(&file).unwrap_or_default().hash(&mut hasher);
-            }
-        }
+    std::fs::read_to_string(path)
+        .unwrap_or_default()
+        .hash(&mut hasher);
+    for (name, file) in named_files(path) {
+        name.hash(&mut hasher);
+        std::fs::read(&file).unwrap_or_default().hash(&mut hasher);
     }
     if let Ok(meta) = std::env::current_exe().and_then(std::fs::metadata) {
         meta.len().hash(&mut hasher);
@@ -176,8 +170,27 @@ pub fn file_digest(path: &Path) -> Option<String> {
     Some(format!("{:016x}", hasher.finish()))
 }
 
+/// The files the values of the scene file at `path` name (its assets), each as named and as
+/// found beside the scene file.
+pub(crate) fn named_files(path: &Path) -> Vec<(String, std::path::PathBuf)> {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    let (Ok(table), Some(dir)) = (text.parse::<toml::Table>(), path.parent()) else {
+        return Vec::new();
+    };
+    let mut named = Vec::new();
+    collect_strings(&toml::Value::Table(table), &mut named);
+    named
+        .into_iter()
+        .map(|name| {
+            let file = dir.join(&name);
+            (name, file)
+        })
+        .filter(|(_, file)| file.is_file())
+        .collect()
+}
+
 /// Every string value in `value`, depth first.
-pub(crate) fn collect_strings(value: &toml::Value, into: &mut Vec<String>) {
+fn collect_strings(value: &toml::Value, into: &mut Vec<String>) {
     match value {
         toml::Value::String(s) => into.push(s.clone()),
         toml::Value::Array(items) => items.iter().for_each(|v| collect_strings(v, into)),
@@ -216,8 +229,13 @@ pub fn verify(
     // The same candidates of the same scene verified before, under the same drivers and
     // environment (only where HARNESS_VERIFY_CACHE names a folder).
     let passes: Vec<TargetId> = candidates.iter().map(|(pass, _)| *pass).collect();
-    let cache = super::verify_cache::folder()
-        .and_then(|folder| Some((super::verify_cache::key(case, &golden, &passes)?, folder)));
+    let cache = super::verify_cache::folder().and_then(|folder| {
+        let inputs = inputs_digest(store, case);
+        Some((
+            super::verify_cache::key(&inputs, case, &golden, &passes)?,
+            folder,
+        ))
+    });
     if let Some((key, folder)) = &cache {
         if let Some(kept) = super::verify_cache::lookup(folder, key) {
             progress(&format!(

@@ -41,41 +41,29 @@ pub fn folder() -> Option<PathBuf> {
         .map(PathBuf::from)
 }
 
-/// The key of verifying `candidates` of `case` against the temporary golden folder `golden`
-/// (which holds them and the limits), or None when an input cannot be hashed with certainty.
-pub fn key(case: &Case, golden: &Path, candidates: &[TargetId]) -> Option<String> {
+/// The key of verifying `candidates` of `case`, whose inputs digest is `inputs`
+/// ([`super::verify::inputs_digest`]: the scene file, the files it names, the executable),
+/// against the temporary golden folder `golden` (which holds them and the limits); None when an
+/// input cannot be hashed with certainty.
+pub fn key(inputs: &str, case: &Case, golden: &Path, candidates: &[TargetId]) -> Option<String> {
     let mut hasher = DefaultHasher::new();
     "verification 1".hash(&mut hasher);
+    inputs.hash(&mut hasher);
     candidates.hash(&mut hasher);
     hash_tree(golden, &mut hasher)?;
-    // The scene file, every file its values name, the folders they are in (an OBJ's material
-    // library and textures lie beside it), and the scene's own folder.
+    // The folders of the scene file and of every file it names, whole: an OBJ's material
+    // library and textures lie beside it, and the scene file does not name them.
     let scene = &case.loaded.path;
-    let text = std::fs::read_to_string(scene).ok()?;
-    text.hash(&mut hasher);
-    let dir = scene.parent()?;
-    let mut folders = vec![dir.to_path_buf()];
-    if let Ok(table) = text.parse::<toml::Table>() {
-        let mut named = Vec::new();
-        super::verify::collect_strings(&toml::Value::Table(table), &mut named);
-        for name in named {
-            let file = dir.join(&name);
-            if file.is_file() {
-                name.hash(&mut hasher);
-                std::fs::read(&file).ok()?.hash(&mut hasher);
-                folders.extend(file.parent().map(Path::to_path_buf));
-            }
-        }
-    }
+    let mut folders: Vec<PathBuf> = super::verify::named_files(scene)
+        .into_iter()
+        .filter_map(|(_, file)| file.parent().map(Path::to_path_buf))
+        .collect();
+    folders.push(scene.parent()?.to_path_buf());
     folders.sort();
     folders.dedup();
     for folder in &folders {
         hash_tree(folder, &mut hasher)?;
     }
-    // The executable that renders (the engine's code and shaders are in it).
-    let exe = std::env::current_exe().and_then(std::fs::metadata).ok()?;
-    exe.len().hash(&mut hasher);
-    exe.modified().ok().hash(&mut hasher);
     // The environment the children inherit.
     let mut vars: Vec<(String, String)> = std::env::vars()
         .filter(|(k, _)| {

@@ -5,6 +5,7 @@ use engine::backend;
 use engine::plan::TargetId;
 use harness::golden::suite::Case;
 use harness::golden::verify_cache::key;
+use harness::golden::GoldenStore;
 
 use crate::common;
 
@@ -25,7 +26,9 @@ fn a_kept_verification_is_keyed_by_everything_its_checks_read() {
     std::fs::create_dir_all(candidate.parent().unwrap()).unwrap();
     std::fs::write(&candidate, b"candidate").unwrap();
     let passes = [TargetId::Light, TargetId::Final];
-    let key_now = || key(&case, golden.path(), &passes).expect("a key where drivers are loaded");
+    let inputs = harness::golden::verify::inputs_digest(&GoldenStore::new(golden.path()), &case);
+    let key_now =
+        || key(&inputs, &case, golden.path(), &passes).expect("a key where drivers are loaded");
 
     let first = key_now();
     assert_eq!(key_now(), first, "the same inputs give the same key");
@@ -35,7 +38,7 @@ fn a_kept_verification_is_keyed_by_everything_its_checks_read() {
     assert_ne!(other_candidate, first, "a changed candidate");
 
     assert_ne!(
-        key(&case, golden.path(), &passes[..1]).unwrap(),
+        key(&inputs, &case, golden.path(), &passes[..1]).unwrap(),
         other_candidate,
         "other passes"
     );
