@@ -19,6 +19,8 @@ pub struct IblSweepRow {
     pub precompute_s: f64,
     /// Median GPU time of the lighting pass, ms.
     pub lighting_ms: Option<f64>,
+    /// GPU memory of the prefiltered specular cube, every level (RGBA16F), MiB.
+    pub specular_mib: f64,
     /// Error of the light buffer against the Monte Carlo reference, per roughness.
     pub by_roughness: Vec<crate::reference::ibl::RoughnessError>,
     /// Mean relative error over every reference pixel.
@@ -119,6 +121,43 @@ pub fn ibl_settings() -> Vec<(String, engine::ibl::IblSettings)> {
     ]
 }
 
+/// The cube sizes the timed sweep (`harness sweep --knob ibl`) adds to [`ibl_settings`]: what a
+/// mirror's texel costs (a specular cube of 512² needs a source cube as large; "source 512"
+/// separates the two). Not in the sweep tests' settings: each is a precompute of seconds.
+pub fn ibl_size_settings() -> Vec<(String, engine::ibl::IblSettings)> {
+    use engine::ibl::IblSettings;
+    let d = IblSettings::default();
+    vec![
+        (
+            "source 512".to_owned(),
+            IblSettings {
+                source_size: 512,
+                ..d.clone()
+            },
+        ),
+        (
+            "specular 512".to_owned(),
+            IblSettings {
+                source_size: 512,
+                specular_size: 512,
+                ..d
+            },
+        ),
+    ]
+}
+
+/// GPU memory of the prefiltered specular cube of `settings`: six RGBA16F faces per level, from
+/// `specular_size` down to 4 x 4, MiB.
+pub fn specular_mib(settings: &engine::ibl::IblSettings) -> f64 {
+    let mut size = u64::from(settings.specular_size);
+    let mut bytes = 0u64;
+    while size >= 4 {
+        bytes += 6 * size * size * 8;
+        size /= 2;
+    }
+    bytes as f64 / f64::from(1u32 << 20)
+}
+
 /// Reference pixels and directions per strategy of the IBL sweep's Monte Carlo reference.
 pub const IBL_REFERENCE_PIXELS: usize = 576;
 /// Directions per strategy and pixel (three or four strategies).
@@ -166,7 +205,11 @@ pub fn ibl_sweep_with(
     let mut rows = Vec::new();
     let mut references = None;
     let mut built: Vec<(engine::ibl::cache::Key, f64)> = Vec::new();
-    for (name, settings) in ibl_settings() {
+    let mut settings_list = ibl_settings();
+    if maps == MapSource::Timed {
+        settings_list.extend(ibl_size_settings());
+    }
+    for (name, settings) in settings_list {
         // Cached: the render below prepares its maps through the caches, as any render does.
         let precompute_s = match maps {
             MapSource::Cached => f64::NAN,
@@ -215,11 +258,13 @@ pub fn ibl_sweep_with(
             .sum::<f64>()
             / total.max(1) as f64;
         let is_default = settings == engine::ibl::IblSettings::default();
+        let specular_mib = specular_mib(&settings);
         rows.push(IblSweepRow {
             setting: name,
             settings,
             precompute_s,
             lighting_ms: pass_ms(&frames, lighting),
+            specular_mib,
             by_roughness,
             mean_relative,
             p99_max_relative: (p99, max),
@@ -247,4 +292,21 @@ pub fn ibl_sweep_with(
         row.pareto = on_front;
     }
     Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_specular_cube_holds_six_rgba16f_faces_per_level_down_to_4x4() {
+        let cube = |specular_size| engine::ibl::IblSettings {
+            specular_size,
+            ..Default::default()
+        };
+        // 128, 64, 32, 16, 8 and 4: 21,840 texels a face.
+        let bytes = 6.0 * 8.0 * 21_840.0;
+        assert_eq!(specular_mib(&cube(128)), bytes / f64::from(1u32 << 20));
+        assert!((specular_mib(&cube(512)) / specular_mib(&cube(256)) - 4.0).abs() < 1e-3);
+    }
 }

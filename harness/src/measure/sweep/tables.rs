@@ -68,8 +68,8 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
         return String::new();
     };
     let mut out = format!(
-        "{:<15} {:>13} {:>12}",
-        "setting", "precompute s", "lighting ms"
+        "{:<15} {:>13} {:>12} {:>9}",
+        "setting", "precompute s", "lighting ms", "spec MiB"
     );
     for g in &first.by_roughness {
         out.push_str(&format!(" {:>7}", format!("r {:.1}", g.roughness)));
@@ -77,10 +77,11 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
     out.push_str(&format!(" {:>7} {:>7} {:>7}\n", "mean", "p99", "max"));
     for r in rows {
         out.push_str(&format!(
-            "{:<15} {:>13.3} {:>12}",
+            "{:<15} {:>13.3} {:>12} {:>9.2}",
             format!("{}{}", r.setting, if r.pareto { " *" } else { "" }),
             r.precompute_s,
-            r.lighting_ms.map_or("-".to_owned(), |v| format!("{v:.1}"))
+            r.lighting_ms.map_or("-".to_owned(), |v| format!("{v:.1}")),
+            r.specular_mib
         ));
         for g in &r.by_roughness {
             out.push_str(&format!(" {:>6.2}%", g.mean_relative * 100.0));
@@ -91,13 +92,19 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
             r.p99_max_relative.0 * 100.0,
             r.p99_max_relative.1 * 100.0
         ));
-        out.push_str(&format!("{:<15} {:>13} {:>12}", "  (median)", "", ""));
+        out.push_str(&format!(
+            "{:<15} {:>13} {:>12} {:>9}",
+            "  (median)", "", "", ""
+        ));
         for g in &r.by_roughness {
             out.push_str(&format!(" {:>6.2}%", g.median_relative * 100.0));
         }
         out.push('\n');
     }
-    out.push_str(&format!("{:<15} {:>13} {:>12}", "(ref. noise)", "", ""));
+    out.push_str(&format!(
+        "{:<15} {:>13} {:>12} {:>9}",
+        "(ref. noise)", "", "", ""
+    ));
     for g in &first.by_roughness {
         out.push_str(&format!(" {:>6.2}%", g.reference_noise * 100.0));
     }
