@@ -79,7 +79,6 @@ pub(crate) fn run(
             });
     }
     if options.speed {
-        let scenes = speed_scenes;
         let available: Vec<(BackendKind, String)> = run
             .backends
             .iter()
@@ -89,7 +88,7 @@ pub(crate) fn run(
         run.speed = harness::golden::speed::check_scenes(
             &exe,
             store.root(),
-            &scenes,
+            &speed_scenes,
             &available,
             variations,
             &[],

@@ -23,13 +23,14 @@ use super::verify::Disagreement;
 pub const CACHE_ENV: &str = "HARNESS_VERIFY_CACHE";
 
 /// Environment variables that can change what a child check renders or reads, by prefix (the
-/// drivers' own, the loader's, the harness's). `HARNESS_ROOT` and `HARNESS_IBL_CACHE` are set
-/// for the children by the verification itself (the IBL maps' own key covers their inputs).
+/// drivers' own, the loader's, the harness's), less [`NOT_IN_THE_KEY`].
 const ENV_PREFIXES: [&str; 12] = [
     "GALLIUM_", "LP_", "LIBGL_", "MESA_", "VK_", "EGL_", "__EGL", "__GLX", "DRI_", "WGPU_", "LD_",
     "HARNESS_",
 ];
-const ENV_SET_BY_THE_VERIFICATION: [&str; 3] = ["HARNESS_ROOT", "HARNESS_IBL_CACHE", CACHE_ENV];
+/// `HARNESS_ROOT` and `HARNESS_IBL_CACHE` are set for the children by the verification itself
+/// (the IBL maps' own key covers their inputs); the cache's folder changes no outcome.
+const NOT_IN_THE_KEY: [&str; 3] = ["HARNESS_ROOT", "HARNESS_IBL_CACHE", CACHE_ENV];
 
 /// An asset folder larger than this is not hashed (and its scene's verifications not kept).
 const MAX_HASHED_BYTES: u64 = 256 << 20;
@@ -67,8 +68,7 @@ pub fn key(inputs: &str, case: &Case, golden: &Path, candidates: &[TargetId]) ->
     // The environment the children inherit.
     let mut vars: Vec<(String, String)> = std::env::vars()
         .filter(|(k, _)| {
-            ENV_PREFIXES.iter().any(|p| k.starts_with(p))
-                && !ENV_SET_BY_THE_VERIFICATION.contains(&k.as_str())
+            ENV_PREFIXES.iter().any(|p| k.starts_with(p)) && !NOT_IN_THE_KEY.contains(&k.as_str())
         })
         .collect();
     vars.sort();
