@@ -162,7 +162,7 @@ mod tests {
         let bindings = ModuleBindings::of(shaders::LIGHTING).unwrap();
         let layouts = bindings.layouts();
         let numbers: Vec<u32> = layouts.iter().map(|l| l.binding).collect();
-        assert_eq!(numbers, (0..=18).collect::<Vec<_>>());
+        assert_eq!(numbers, (0..=19).collect::<Vec<_>>());
         assert_eq!(kind(&bindings, "u"), BindingKind::UniformBuffer);
         let texture = |sample_type, view| BindingKind::Texture { sample_type, view };
         // Loaded only: unfilterable. Sampled through a filtering sampler: filterable.

@@ -1,5 +1,5 @@
 // Lighting shader, part 5 of 6: image-based lighting (the split sum, and filtered importance
-// sampling of the prefiltered cube).
+// sampling of the radiance chain).
 
 // World direction to environment-map direction (the rotation about +Y, as skybox.wgsl).
 fn environment_direction(d: vec3<f32>) -> vec3<f32> {
@@ -21,8 +21,28 @@ fn ibl_prefiltered(r: vec3<f32>, roughness: f32) -> vec3<f32> {
 // samples of the GGX lobe (anisotropic where the surface is; the stretched-slope sampling of
 // Heitz's "Understanding the Masking-Shadowing Function", so the pdf is D(h) n.h), stratified in
 // the radial variable and radical-inverse in the angle, each weighted by F V 4 v.h n.l / n.h
-// and read from the prefiltered cube at the roughness whose lobe (about 4 pi alpha^2 steradians)
-// covers the sample's solid angle 1 / (N pdf). Unlike the split sum, the lobe follows the view.
+// and read from the radiance chain (the environment box-filtered, not GGX-prefiltered: a read
+// blurs its footprint once) at the level whose texels cover IBL_FOOTPRINT times the sample's
+// solid angle 1 / (N pdf): lod = log2(that / a level-0 texel's solid angle) / 2. Krivanek and
+// Colbert read one level up (a footprint of 4); the IBL sweep measured 1 closer to the path
+// tracer under both shipped skies. Unlike the split sum, the lobe follows the view.
+
+// The radiance chain's level-0 texel solid angle and top level, asked once per pixel.
+struct RadianceChain {
+    texel_solid_angle: f32,
+    top: f32,
+}
+
+fn radiance_chain() -> RadianceChain {
+    let size = f32(textureDimensions(ibl_radiance).x);
+    return RadianceChain(4.0 * PI / (6.0 * size * size), f32(textureNumLevels(ibl_radiance) - 1u));
+}
+
+fn ibl_radiance_at(chain: RadianceChain, l: vec3<f32>, sample_solid_angle: f32) -> vec3<f32> {
+    let footprint = IBL_FOOTPRINT * sample_solid_angle;
+    let lod = clamp(0.5 * log2(footprint / chain.texel_solid_angle), 0.0, chain.top);
+    return textureSampleLevel(ibl_radiance, ibl_sampler, environment_direction(l), lod).rgb;
+}
 fn ibl_specular_sampled(s: Surface, v: vec3<f32>, f0: vec3<f32>) -> vec3<f32> {
     let n = s.normal;
     let n_dot_v = max(dot(n, v), MIN_N_DOT_V);
@@ -42,6 +62,7 @@ fn ibl_specular_sampled(s: Surface, v: vec3<f32>, f0: vec3<f32>) -> vec3<f32> {
     }
     let b = cross(n, t);
     let count = f32(IBL_SAMPLES);
+    let chain = radiance_chain();
     var sum = vec3<f32>(0.0);
     for (var i = 0u; i < IBL_SAMPLES; i++) {
         let u1 = (f32(i) + 0.5) / count;
@@ -71,9 +92,8 @@ fn ibl_specular_sampled(s: Surface, v: vec3<f32>, f0: vec3<f32>) -> vec3<f32> {
             vis = v_smith_ggx_correlated(n_dot_v, n_dot_l, alpha);
         }
         let pdf = max(d * n_dot_h / (4.0 * v_dot_h), 1e-6);
-        let lobe_roughness = sqrt(sqrt(1.0 / (count * pdf) / (4.0 * PI)));
         let fresnel = f0 + (vec3<f32>(1.0) - f0) * pow5(1.0 - v_dot_h);
-        sum += ibl_prefiltered(l, lobe_roughness) * fresnel * (vis * 4.0 * v_dot_h * n_dot_l / n_dot_h);
+        sum += ibl_radiance_at(chain, l, 1.0 / (count * pdf)) * fresnel * (vis * 4.0 * v_dot_h * n_dot_l / n_dot_h);
     }
     return sum / count;
 }

@@ -43,6 +43,8 @@ override SUN_DISC: bool = false;
 override IBL: bool = false;
 // Filtered importance samples of the PBR specular IBL per pixel; 0: the split sum.
 override IBL_SAMPLES: u32 = 0u;
+// How many times its own solid angle each of those samples reads from the radiance chain.
+override IBL_FOOTPRINT: f32 = 1.0;
 // Whether any surface of this model can have clearcoat or anisotropy: per-pixel values, so when
 // true the shader still branches on the pixel's value.
 override CLEARCOAT: bool = true;
@@ -157,4 +159,8 @@ struct ShadowUniforms {
 // Screen-space ambient occlusion (shaders/ssao.wgsl; r = 1 unoccluded .. 0), read where
 // AMBIENT_OCCLUSION is set.
 @group(0) @binding(18) var ambient_occlusion: texture_2d<f32>;
+
+// The environment cube with box-filtered mips (crate::ibl, `radiance`), read by the filtered
+// importance samples of IBL_SAMPLES > 0 (a 1 x 1 black placeholder in other scenes).
+@group(0) @binding(19) var ibl_radiance: texture_cube<f32>;
 

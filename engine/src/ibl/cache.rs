@@ -19,7 +19,7 @@ use crate::scene::EnvironmentImage;
 
 /// Bump when the entry layout changes (an algorithm change already changes the key through
 /// [`ALGORITHM_SOURCES`]).
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 
 /// The source of every file of the IBL precompute (this folder), part of every key: the maps
 /// are a function of the image, the settings and this code. A test checks the list covers the
@@ -89,6 +89,7 @@ pub fn key(image: &EnvironmentImage, settings: &IblSettings) -> Key {
     // across them.
     let maps_settings = IblSettings {
         runtime_samples: 0,
+        runtime_footprint: IblSettings::default().runtime_footprint,
         sun_shadow: true,
         ..settings.clone()
     };
@@ -175,9 +176,11 @@ fn push_level(out: &mut Vec<u8>, level: &CubeLevel) {
 /// The bytes of an entry: header, payload, SHA-256 of the payload.
 pub fn encode(key: &Key, maps: &IblMaps) -> Vec<u8> {
     let mut payload = Vec::new();
-    payload.extend_from_slice(&(maps.specular.levels.len() as u32).to_le_bytes());
-    for level in &maps.specular.levels {
-        push_level(&mut payload, level);
+    for chain in [&maps.specular, &maps.radiance] {
+        payload.extend_from_slice(&(chain.levels.len() as u32).to_le_bytes());
+        for level in &chain.levels {
+            push_level(&mut payload, level);
+        }
     }
     push_level(&mut payload, &maps.irradiance);
     payload.extend_from_slice(&(maps.dfg.len() as u32).to_le_bytes());
@@ -248,6 +251,19 @@ impl<'a> Reader<'a> {
             .collect::<Result<_, String>>()?;
         Ok(CubeLevel { size, texels })
     }
+
+    /// A level count, then the levels of a mip chain.
+    fn chain(&mut self) -> Result<CubeMap, String> {
+        let levels = self.u32()?;
+        if levels == 0 || levels > 16 {
+            return Err(format!("bad level count {levels}"));
+        }
+        Ok(CubeMap {
+            levels: (0..levels)
+                .map(|_| self.level())
+                .collect::<Result<_, _>>()?,
+        })
+    }
 }
 
 /// Parses an entry, checking its header, key and checksum.
@@ -275,13 +291,8 @@ pub fn decode(key: &Key, bytes: &[u8]) -> Result<IblMaps, String> {
         return Err("checksum mismatch".into());
     }
     let mut p = Reader(payload);
-    let levels = p.u32()?;
-    if levels == 0 || levels > 16 {
-        return Err(format!("bad level count {levels}"));
-    }
-    let specular = CubeMap {
-        levels: (0..levels).map(|_| p.level()).collect::<Result<_, _>>()?,
-    };
+    let specular = p.chain()?;
+    let radiance = p.chain()?;
     let irradiance = p.level()?;
     let dfg_len = p.u32()? as usize;
     if p.0.len() < dfg_len * 8 {
@@ -306,6 +317,7 @@ pub fn decode(key: &Key, bytes: &[u8]) -> Result<IblMaps, String> {
         specular,
         irradiance,
         dfg,
+        radiance,
         sun,
     })
 }

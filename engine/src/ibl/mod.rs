@@ -7,6 +7,10 @@
 //! - `irradiance`: diffuse irradiance / pi as a small cube, by exact convolution (default) or
 //!   SH9 ([`irradiance`] says why).
 //! - `dfg`: the DFG lookup table of the split sum ([`dfg`]).
+//! - `radiance`: the environment cube itself with a box-filtered mip chain, which the lighting
+//!   pass's filtered importance samples read (`[quality.ibl] runtime_samples`): a sample reads
+//!   the level whose texels cover its solid angle, so its footprint is blurred once, by the box
+//!   filter, instead of by the GGX prefilter of the specular cube as well.
 //!
 //! Why the CPU: the maps are a pure function of the image and [`IblSettings`], so computing
 //! them once, identically for every backend, keeps driver differences out of them (one golden
@@ -32,7 +36,7 @@ pub use cube::{CubeLevel, CubeMap};
 
 use crate::scene::EnvironmentImage;
 
-pub use crate::scene::{IblSettings, IrradianceMethod};
+pub use crate::scene::{Footprint, IblSettings, IrradianceMethod};
 
 /// The settings' line in plans and reports (it names the precompute's own constants).
 impl IblSettings {
@@ -76,6 +80,9 @@ pub struct IblMaps {
     pub irradiance: CubeLevel,
     /// DFG table (`scale`, `bias`), [`dfg::SIZE`] square, `NoV` across, roughness down.
     pub dfg: Vec<[f32; 2]>,
+    /// The environment cube the prefilter reads (`source_size` faces), box-filtered down to
+    /// 1 x 1: what filtered importance samples read.
+    pub radiance: CubeMap,
     /// With `extract_sun`: the sun cut out of the maps, to be lit as a directional light.
     pub sun: Option<sun::Sun>,
 }
@@ -93,6 +100,7 @@ pub fn build(image: &EnvironmentImage, settings: &IblSettings) -> IblMaps {
         specular: specular::prefilter(&source, settings),
         irradiance: irradiance::irradiance(&source, settings.irradiance_size, settings.irradiance),
         dfg: dfg_table().as_ref().clone(),
+        radiance: source,
         sun,
     }
 }

@@ -94,7 +94,11 @@ impl fmt::Display for LightingVariant {
             }
         }
         if self.ibl && self.ibl_samples > 0 {
-            write!(f, ", ibl ({} samples)", self.ibl_samples)?;
+            write!(
+                f,
+                ", ibl ({} samples, footprint {})",
+                self.ibl_samples, self.ibl_footprint
+            )?;
         }
         for (on, name) in [
             (self.sun_disc, "sun disc"),

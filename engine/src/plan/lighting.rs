@@ -44,6 +44,9 @@ pub struct LightingVariant {
     /// Filtered importance samples of the specular IBL per pixel; 0 for the split sum
     /// (`IBL_SAMPLES`, from `[quality.ibl] runtime_samples`).
     pub ibl_samples: u32,
+    /// How many times its own solid angle each of those samples reads (`IBL_FOOTPRINT`, from
+    /// `[quality.ibl] runtime_footprint`; one without samples).
+    pub ibl_footprint: crate::scene::Footprint,
     /// Some surface of the model has clearcoat (`CLEARCOAT`; the shader still branches per
     /// pixel when true).
     pub clearcoat: bool,
@@ -97,6 +100,7 @@ impl LightingVariant {
             ("SUN_DISC", flag(self.sun_disc)),
             ("IBL", flag(self.ibl)),
             ("IBL_SAMPLES", f64::from(self.ibl_samples)),
+            ("IBL_FOOTPRINT", self.ibl_footprint.factor()),
             ("CLEARCOAT", flag(self.clearcoat)),
             ("ANISOTROPY", flag(self.anisotropy)),
             ("POSITION_MODE", position),
@@ -288,6 +292,7 @@ pub(super) fn lighting_passes(
                 vogel_samples: 0,
                 ibl: false,
                 ibl_samples: 0,
+                ibl_footprint: crate::scene::Footprint::ONE,
                 clearcoat: pbr
                     && materials().any(|m| m.clearcoat != 0.0 || m.clearcoat_map.is_some()),
                 anisotropy: pbr && materials().any(|m| m.anisotropy != 0.0),
@@ -324,6 +329,15 @@ pub(super) fn lighting_passes(
                                     scene.quality.ibl.runtime_samples
                                 } else {
                                     0
+                                },
+                                ibl_footprint: if ibl
+                                    && index == 0
+                                    && pbr
+                                    && scene.quality.ibl.runtime_samples > 0
+                                {
+                                    scene.quality.ibl.runtime_footprint
+                                } else {
+                                    crate::scene::Footprint::ONE
                                 },
                                 ..base
                             },
@@ -412,6 +426,7 @@ impl RenderPlan {
                     LightingFeature::Ibl => {
                         draw.variant.ibl = false;
                         draw.variant.ibl_samples = 0;
+                        draw.variant.ibl_footprint = crate::scene::Footprint::ONE;
                     }
                     LightingFeature::Shadows => draw.shadowed = None,
                     LightingFeature::Clearcoat => draw.variant.clearcoat = false,
@@ -426,6 +441,7 @@ impl RenderPlan {
                         draw.shadowed = None;
                         draw.variant.ibl = false;
                         draw.variant.ibl_samples = 0;
+                        draw.variant.ibl_footprint = crate::scene::Footprint::ONE;
                     }
                     LightingFeature::Lights => {
                         draw.lights.clear();

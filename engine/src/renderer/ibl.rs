@@ -5,7 +5,7 @@
 use crate::backend::*;
 use crate::ibl::{CubeLevel, IblMaps};
 
-/// Textures and sampler bound at `lighting.wgsl` bindings 13..16.
+/// Textures and sampler bound at `lighting.wgsl` bindings 13..16 and 19.
 pub(super) struct IblTextures {
     /// Irradiance / pi cube.
     pub irradiance: Handle<Texture>,
@@ -13,6 +13,9 @@ pub(super) struct IblTextures {
     pub specular: Handle<Texture>,
     /// DFG table.
     pub dfg: Handle<Texture>,
+    /// The environment with its box-filtered mips, for filtered importance samples (a black
+    /// placeholder where the scene does not sample).
+    pub radiance: Handle<Texture>,
     /// Trilinear, clamp to edge.
     pub sampler: Handle<Sampler>,
     /// Highest specular mip (roughness 1).
@@ -59,11 +62,13 @@ fn cube(
     Ok(texture)
 }
 
-/// Uploads `maps`, or placeholders when there are none.
+/// Uploads `maps`, or placeholders when there are none; the radiance chain only when `sampled`
+/// (the scene's specular IBL takes filtered importance samples), else a placeholder.
 pub(super) fn upload(
     backend: &mut dyn Backend,
     scope: &mut ResourceScope,
     maps: Option<&IblMaps>,
+    sampled: bool,
 ) -> Result<IblTextures> {
     let black = [CubeLevel {
         size: 1,
@@ -81,6 +86,11 @@ pub(super) fn upload(
     let irradiance = cube(backend, scope, "ibl irradiance", irradiance)?;
     let max_lod = (specular.len() - 1) as f32;
     let specular = cube(backend, scope, "ibl specular", specular)?;
+    let radiance = match maps {
+        Some(maps) if sampled => &maps.radiance.levels[..],
+        _ => &black[..],
+    };
+    let radiance = cube(backend, scope, "ibl radiance", radiance)?;
     let dfg_texture = scope.texture(
         backend,
         &TextureDesc::d2("ibl dfg", dfg_size, dfg_size, TextureFormat::Rgba16Float),
@@ -99,6 +109,7 @@ pub(super) fn upload(
         irradiance,
         specular,
         dfg: dfg_texture,
+        radiance,
         sampler,
         max_lod,
     })

@@ -23,6 +23,58 @@ impl IrradianceMethod {
     }
 }
 
+/// How many times its own solid angle a filtered importance sample reads (`[quality.ibl]
+/// runtime_footprint`): a power of two from 1/16 to 64, kept as its exponent so that settings
+/// compare and hash exactly. Written and read in scene files as the number (`0.25`, `1`, `4`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(try_from = "f64", into = "f64")]
+pub struct Footprint {
+    log2: i8,
+}
+
+impl Footprint {
+    /// A read the size of the sample's solid angle.
+    pub const ONE: Self = Self { log2: 0 };
+
+    /// The footprint `2^log2`, if `log2` is in -4..=6.
+    pub fn from_log2(log2: i8) -> Option<Self> {
+        (-4..=6).contains(&log2).then_some(Self { log2 })
+    }
+
+    /// The factor.
+    pub fn factor(self) -> f64 {
+        2f64.powi(i32::from(self.log2))
+    }
+}
+
+impl TryFrom<f64> for Footprint {
+    type Error = String;
+
+    fn try_from(value: f64) -> Result<Self, String> {
+        let log2 = value.log2();
+        if value > 0.0 && log2.fract() == 0.0 {
+            if let Some(footprint) = Self::from_log2(log2 as i8) {
+                return Ok(footprint);
+            }
+        }
+        Err(format!(
+            "runtime_footprint {value} must be a power of two from 1/16 to 64 (0.0625 .. 64)"
+        ))
+    }
+}
+
+impl From<Footprint> for f64 {
+    fn from(footprint: Footprint) -> f64 {
+        footprint.factor()
+    }
+}
+
+impl std::fmt::Display for Footprint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.factor())
+    }
+}
+
 /// The IBL quality knobs (`[quality.ibl]` in scene files).
 #[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -44,12 +96,16 @@ pub struct IblSettings {
     pub seed: u32,
     /// Specular IBL at render time: 0 uses the split sum (one lookup in the prefiltered cube
     /// with the DFG table); N > 0 integrates the full GGX lobe (anisotropic where the surface
-    /// is) with N filtered importance samples per pixel, each read from the prefiltered cube at
-    /// the roughness whose lobe covers the sample's solid angle (Krivanek and Colbert, "Real-time
-    /// Shading with Filtered Importance Sampling", 2008). Lobes narrower than a level-0 texel
-    /// of the prefiltered cube (alpha < 2 / `specular_size`) keep the split sum's lookup. It
-    /// changes no precomputed map.
+    /// is) with N filtered importance samples per pixel, each read from the environment's
+    /// box-filtered mip chain at the level whose texels cover `runtime_footprint` times the
+    /// sample's solid angle (Krivanek and Colbert, "Real-time Shading with Filtered Importance
+    /// Sampling", 2008). Lobes narrower than a level-0 texel of the prefiltered cube (alpha <
+    /// 2 / `specular_size`) keep the split sum's lookup. It changes no precomputed map.
     pub runtime_samples: u32,
+    /// How many times its own solid angle a filtered importance sample's read covers (a power
+    /// of two from 1/16 to 64; Krivanek and Colbert read 4, one level up). It changes no
+    /// precomputed map.
+    pub runtime_footprint: Footprint,
     /// Cut the environment's sun out of the maps and light it as a directional light instead
     /// ([`crate::ibl::sun`]).
     pub extract_sun: bool,
@@ -70,6 +126,7 @@ impl Default for IblSettings {
             irradiance: IrradianceMethod::Convolution,
             seed: 0,
             runtime_samples: 0,
+            runtime_footprint: Footprint::ONE,
             extract_sun: false,
             sun_shadow: true,
         }

@@ -59,6 +59,7 @@ fn uniform_environment_gives_uniform_maps() {
             irradiance: method,
             seed: 0,
             runtime_samples: 0,
+            runtime_footprint: ibl::Footprint::ONE,
             extract_sun: false,
             sun_shadow: true,
         };
@@ -68,6 +69,15 @@ fn uniform_environment_gives_uniform_maps() {
                 for c in t {
                     assert!((c - 1.0).abs() < 1e-4, "specular level {m}: {c}");
                 }
+            }
+        }
+        // The radiance chain the filtered importance samples read: the source cube, box-filtered
+        // down to 1 x 1 (32, 16, 8, 4, 2, 1), stays uniform.
+        let sizes: Vec<u32> = maps.radiance.levels.iter().map(|l| l.size).collect();
+        assert_eq!(sizes, [32, 16, 8, 4, 2, 1]);
+        for (m, level) in maps.radiance.levels.iter().enumerate() {
+            for c in level.texels.iter().flatten() {
+                assert!((c - 1.0).abs() < 1e-5, "radiance level {m}: {c}");
             }
         }
         for t in &maps.irradiance.texels {

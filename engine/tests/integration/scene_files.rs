@@ -347,3 +347,29 @@ fn negative_intensities_and_absolute_paths_are_warned_about() {
         );
     }
 }
+
+/// `[quality.ibl] runtime_footprint` reads as a number, a power of two from 1/16 to 64, and
+/// anything else is an error naming the file, the line and the value.
+#[test]
+fn the_ibl_footprint_is_a_power_of_two_read_as_a_number() {
+    let with = |footprint: &str| {
+        format!("{CAMERA}\n[quality.ibl]\nruntime_samples = 64\nruntime_footprint = {footprint}\n")
+    };
+    for (text, factor) in [("0.25", 0.25), ("1", 1.0), ("4.0", 4.0), ("64", 64.0)] {
+        let scene = scene_file::parse(Path::new("dir/ok.toml"), &with(text))
+            .unwrap_or_else(|e| panic!("{text}: {e}"));
+        let ibl = scene.quality.ibl.expect("[quality.ibl]");
+        assert_eq!(ibl.runtime_footprint.factor(), factor, "{text}");
+    }
+    for bad in ["0.3", "3", "128", "0", "-1", "0.03125"] {
+        let e = parse_err(&with(bad));
+        assert!(e.starts_with("dir/bad.toml:7:"), "{bad}: {e}");
+        assert!(
+            e.contains("runtime_footprint") && e.contains("power of two"),
+            "{e}"
+        );
+    }
+    // The default reads a sample's own solid angle.
+    let default = engine::scene::IblSettings::default();
+    assert_eq!(default.runtime_footprint.factor(), 1.0);
+}

@@ -105,7 +105,8 @@ impl<'a> LightingResources<'a> {
         ibl_maps: Option<&crate::ibl::IblMaps>,
     ) -> Result<Self, RenderError> {
         let lighting_shader = shader(scope, backend, shaders::LIGHTING)?;
-        let ibl = ibl::upload(backend, scope, ibl_maps)?;
+        let sampled = scene.quality.ibl.runtime_samples > 0;
+        let ibl = ibl::upload(backend, scope, ibl_maps, sampled)?;
         let jitter = upload_jitter(backend, scope)?;
         let mut lights = light_uniforms(scene);
         if let Some(scale) = variations.light_radiance_scale {
@@ -247,6 +248,7 @@ impl<'a> LightingResources<'a> {
             ),
             ("ibl_specular", BindingResource::Texture(self.ibl.specular)),
             ("ibl_dfg", BindingResource::Texture(self.ibl.dfg)),
+            ("ibl_radiance", BindingResource::Texture(self.ibl.radiance)),
             ("ibl_sampler", BindingResource::Sampler(self.ibl.sampler)),
             ("scene_depth", texture(TargetId::Depth)),
             // Read only by draws with AMBIENT_OCCLUSION, in scenes that have the target.

@@ -146,6 +146,39 @@ pub fn ibl_size_settings() -> Vec<(String, engine::ibl::IblSettings)> {
     ]
 }
 
+/// What the timed sweep adds for the filtered importance samples: other footprints (the
+/// default reads once a sample's solid angle; Krivanek and Colbert read 4 times), and 256
+/// samples over a 256² specular cube, whose level 0 the sharpest lobes still read.
+pub fn ibl_sampling_settings() -> Vec<(String, engine::ibl::IblSettings)> {
+    let d = engine::ibl::IblSettings::default();
+    let mut rows: Vec<_> = [64, 256]
+        .into_iter()
+        .flat_map(|samples| [(samples, -2), (samples, 2)])
+        .filter_map(|(samples, log2)| {
+            let footprint = engine::ibl::Footprint::from_log2(log2)?;
+            Some((
+                format!("fis {samples} footprint {footprint}"),
+                engine::ibl::IblSettings {
+                    runtime_samples: samples,
+                    runtime_footprint: footprint,
+                    ..d.clone()
+                },
+            ))
+        })
+        .collect();
+    for samples in [256, 1024] {
+        rows.push((
+            format!("fis {samples} specular 256"),
+            engine::ibl::IblSettings {
+                runtime_samples: samples,
+                specular_size: 256,
+                ..d.clone()
+            },
+        ));
+    }
+    rows
+}
+
 /// GPU memory of the prefiltered specular cube of `settings`: six RGBA16F faces per level, from
 /// `specular_size` down to 4 x 4, MiB.
 pub fn specular_mib(settings: &engine::ibl::IblSettings) -> f64 {
@@ -208,6 +241,7 @@ pub fn ibl_sweep_with(
     let mut settings_list = ibl_settings();
     if maps == MapSource::Timed {
         settings_list.extend(ibl_size_settings());
+        settings_list.extend(ibl_sampling_settings());
     }
     for (name, settings) in settings_list {
         // Cached: the render below prepares its maps through the caches, as any render does.

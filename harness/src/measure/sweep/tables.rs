@@ -67,8 +67,15 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
     let Some(first) = rows.first() else {
         return String::new();
     };
+    // The setting column fits the longest name with its Pareto mark.
+    let w = rows
+        .iter()
+        .map(|r| r.setting.len() + 2)
+        .max()
+        .unwrap_or(0)
+        .max(15);
     let mut out = format!(
-        "{:<15} {:>13} {:>12} {:>9}",
+        "{:<w$} {:>13} {:>12} {:>9}",
         "setting", "precompute s", "lighting ms", "spec MiB"
     );
     for g in &first.by_roughness {
@@ -77,7 +84,7 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
     out.push_str(&format!(" {:>7} {:>7} {:>7}\n", "mean", "p99", "max"));
     for r in rows {
         out.push_str(&format!(
-            "{:<15} {:>13.3} {:>12} {:>9.2}",
+            "{:<w$} {:>13.3} {:>12} {:>9.2}",
             format!("{}{}", r.setting, if r.pareto { " *" } else { "" }),
             r.precompute_s,
             r.lighting_ms.map_or("-".to_owned(), |v| format!("{v:.1}")),
@@ -93,7 +100,7 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
             r.p99_max_relative.1 * 100.0
         ));
         out.push_str(&format!(
-            "{:<15} {:>13} {:>12} {:>9}",
+            "{:<w$} {:>13} {:>12} {:>9}",
             "  (median)", "", "", ""
         ));
         for g in &r.by_roughness {
@@ -102,7 +109,7 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
         out.push('\n');
     }
     out.push_str(&format!(
-        "{:<15} {:>13} {:>12} {:>9}",
+        "{:<w$} {:>13} {:>12} {:>9}",
         "(ref. noise)", "", "", ""
     ));
     for g in &first.by_roughness {
