@@ -43,7 +43,7 @@ fn ibl_radiance_at(chain: RadianceChain, l: vec3<f32>, sample_solid_angle: f32) 
     let lod = clamp(0.5 * log2(footprint / chain.texel_solid_angle), 0.0, chain.top);
     return textureSampleLevel(ibl_radiance, ibl_sampler, environment_direction(l), lod).rgb;
 }
-fn ibl_specular_sampled(s: Surface, v: vec3<f32>, f0: vec3<f32>) -> vec3<f32> {
+fn ibl_specular_sampled(s: Surface, v: vec3<f32>, f0: vec3<f32>, samples: u32) -> vec3<f32> {
     let n = s.normal;
     let n_dot_v = max(dot(n, v), MIN_N_DOT_V);
     let alpha = s.roughness * s.roughness + 0.001;
@@ -61,10 +61,10 @@ fn ibl_specular_sampled(s: Surface, v: vec3<f32>, f0: vec3<f32>) -> vec3<f32> {
         t = normalize(cross(up, n));
     }
     let b = cross(n, t);
-    let count = f32(IBL_SAMPLES);
+    let count = f32(samples);
     let chain = radiance_chain();
     var sum = vec3<f32>(0.0);
-    for (var i = 0u; i < IBL_SAMPLES; i++) {
+    for (var i = 0u; i < samples; i++) {
         let u1 = (f32(i) + 0.5) / count;
         let u2 = f32(reverseBits(i)) * 2.3283064365386963e-10;
         let slope = sqrt(u1 / (1.0 - u1));
@@ -130,9 +130,14 @@ fn pbr_ibl(s: Surface, v: vec3<f32>, occlusion: f32) -> vec3<f32> {
     // alpha against the texel's 2 / size radians): a narrower lobe is the level 0 lookup the
     // split sum makes, while its samples' solid-angle lod would blur the tail samples' reads.
     // (`&&` short-circuits: the split-sum variant makes no size query.)
+    // IBL_ANISOTROPIC_SAMPLES: sampling where the split sum is furthest off, the anisotropic
+    // pixels, and the split sum everywhere else.
     if IBL_SAMPLES > 0u
         && s.roughness * s.roughness >= 2.0 / f32(textureDimensions(ibl_specular).x) {
-        specular = ibl_specular_sampled(s, v, f0);
+        specular = ibl_specular_sampled(s, v, f0, IBL_SAMPLES);
+    } else if IBL_ANISOTROPIC_SAMPLES > 0u && ANISOTROPY && s.anisotropy != 0.0
+        && s.roughness * s.roughness >= 2.0 / f32(textureDimensions(ibl_specular).x) {
+        specular = ibl_specular_sampled(s, v, f0, IBL_ANISOTROPIC_SAMPLES);
     } else {
         specular = ibl_prefiltered(dominant, s.roughness) * e;
     }

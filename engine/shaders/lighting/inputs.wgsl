@@ -45,6 +45,9 @@ override IBL: bool = false;
 override IBL_SAMPLES: u32 = 0u;
 // How many times its own solid angle each of those samples reads from the radiance chain.
 override IBL_FOOTPRINT: f32 = 1.0;
+// Filtered importance samples of the anisotropic pixels only, where IBL_SAMPLES is 0 (the split
+// sum elsewhere).
+override IBL_ANISOTROPIC_SAMPLES: u32 = 0u;
 // Whether any surface of this model can have clearcoat or anisotropy: per-pixel values, so when
 // true the shader still branches on the pixel's value.
 override CLEARCOAT: bool = true;

@@ -90,6 +90,7 @@ pub fn key(image: &EnvironmentImage, settings: &IblSettings) -> Key {
     let maps_settings = IblSettings {
         runtime_samples: 0,
         runtime_footprint: IblSettings::default().runtime_footprint,
+        anisotropic_samples: 0,
         sun_shadow: true,
         ..settings.clone()
     };

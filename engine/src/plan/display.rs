@@ -100,6 +100,13 @@ impl fmt::Display for LightingVariant {
                 self.ibl_samples, self.ibl_footprint
             )?;
         }
+        if self.ibl && self.ibl_anisotropic_samples > 0 {
+            write!(
+                f,
+                ", ibl ({} samples on anisotropic pixels, footprint {})",
+                self.ibl_anisotropic_samples, self.ibl_footprint
+            )?;
+        }
         for (on, name) in [
             (self.sun_disc, "sun disc"),
             (self.ibl && self.ibl_samples == 0, "ibl"),

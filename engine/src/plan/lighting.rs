@@ -47,6 +47,9 @@ pub struct LightingVariant {
     /// How many times its own solid angle each of those samples reads (`IBL_FOOTPRINT`, from
     /// `[quality.ibl] runtime_footprint`; one without samples).
     pub ibl_footprint: crate::scene::Footprint,
+    /// Filtered importance samples of the anisotropic pixels when `ibl_samples` is 0
+    /// (`IBL_ANISOTROPIC_SAMPLES`, from `[quality.ibl] anisotropic_samples`).
+    pub ibl_anisotropic_samples: u32,
     /// Some surface of the model has clearcoat (`CLEARCOAT`; the shader still branches per
     /// pixel when true).
     pub clearcoat: bool,
@@ -101,6 +104,10 @@ impl LightingVariant {
             ("IBL", flag(self.ibl)),
             ("IBL_SAMPLES", f64::from(self.ibl_samples)),
             ("IBL_FOOTPRINT", self.ibl_footprint.factor()),
+            (
+                "IBL_ANISOTROPIC_SAMPLES",
+                f64::from(self.ibl_anisotropic_samples),
+            ),
             ("CLEARCOAT", flag(self.clearcoat)),
             ("ANISOTROPY", flag(self.anisotropy)),
             ("POSITION_MODE", position),
@@ -293,6 +300,7 @@ pub(super) fn lighting_passes(
                 ibl: false,
                 ibl_samples: 0,
                 ibl_footprint: crate::scene::Footprint::ONE,
+                ibl_anisotropic_samples: 0,
                 clearcoat: pbr
                     && materials().any(|m| m.clearcoat != 0.0 || m.clearcoat_map.is_some()),
                 anisotropy: pbr && materials().any(|m| m.anisotropy != 0.0),
@@ -333,11 +341,22 @@ pub(super) fn lighting_passes(
                                 ibl_footprint: if ibl
                                     && index == 0
                                     && pbr
-                                    && scene.quality.ibl.runtime_samples > 0
+                                    && (scene.quality.ibl.runtime_samples > 0
+                                        || (base.anisotropy
+                                            && scene.quality.ibl.anisotropic_samples > 0))
                                 {
                                     scene.quality.ibl.runtime_footprint
                                 } else {
                                     crate::scene::Footprint::ONE
+                                },
+                                ibl_anisotropic_samples: if ibl
+                                    && index == 0
+                                    && base.anisotropy
+                                    && scene.quality.ibl.runtime_samples == 0
+                                {
+                                    scene.quality.ibl.anisotropic_samples
+                                } else {
+                                    0
                                 },
                                 ..base
                             },
@@ -427,6 +446,7 @@ impl RenderPlan {
                         draw.variant.ibl = false;
                         draw.variant.ibl_samples = 0;
                         draw.variant.ibl_footprint = crate::scene::Footprint::ONE;
+                        draw.variant.ibl_anisotropic_samples = 0;
                     }
                     LightingFeature::Shadows => draw.shadowed = None,
                     LightingFeature::Clearcoat => draw.variant.clearcoat = false,
@@ -442,6 +462,7 @@ impl RenderPlan {
                         draw.variant.ibl = false;
                         draw.variant.ibl_samples = 0;
                         draw.variant.ibl_footprint = crate::scene::Footprint::ONE;
+                        draw.variant.ibl_anisotropic_samples = 0;
                     }
                     LightingFeature::Lights => {
                         draw.lights.clear();

@@ -106,6 +106,10 @@ pub struct IblSettings {
     /// of two from 1/16 to 64; Krivanek and Colbert read 4, one level up). It changes no
     /// precomputed map.
     pub runtime_footprint: Footprint,
+    /// With `runtime_samples` 0: this many filtered importance samples for the anisotropic
+    /// pixels only (0: the split sum there too), where the split sum's isotropic prefilter is
+    /// furthest off. It changes no precomputed map.
+    pub anisotropic_samples: u32,
     /// Cut the environment's sun out of the maps and light it as a directional light instead
     /// ([`crate::ibl::sun`]).
     pub extract_sun: bool,
@@ -127,6 +131,7 @@ impl Default for IblSettings {
             seed: 0,
             runtime_samples: 0,
             runtime_footprint: Footprint::ONE,
+            anisotropic_samples: 0,
             extract_sun: false,
             sun_shadow: true,
         }
@@ -156,6 +161,12 @@ impl IblSettings {
             return Some(format!(
                 "ibl specular_samples {} must be in 1..65536",
                 self.specular_samples
+            ));
+        }
+        if self.anisotropic_samples > 1024 {
+            return Some(format!(
+                "ibl anisotropic_samples {} must be at most 1024",
+                self.anisotropic_samples
             ));
         }
         if self.runtime_samples > 1024 {

@@ -60,6 +60,7 @@ fn uniform_environment_gives_uniform_maps() {
             seed: 0,
             runtime_samples: 0,
             runtime_footprint: ibl::Footprint::ONE,
+            anisotropic_samples: 0,
             extract_sun: false,
             sun_shadow: true,
         };
@@ -244,6 +245,13 @@ fn disk_cache_round_trips_and_rebuilds_corrupt_entries() {
         ..settings.clone()
     };
     assert_eq!(ibl::cache::key(&image, &sampled), key);
+    // Nor do the samples' footprint and the anisotropic pixels' samples.
+    let footprint = IblSettings {
+        runtime_footprint: ibl::Footprint::from_log2(2).unwrap(),
+        anisotropic_samples: 16,
+        ..settings.clone()
+    };
+    assert_eq!(ibl::cache::key(&image, &footprint), key);
     let finer = IblSettings {
         specular_samples: 32,
         ..settings.clone()

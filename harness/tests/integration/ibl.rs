@@ -374,3 +374,50 @@ fn extracted_sun_reflects_as_a_disc() {
         );
     }
 }
+
+/// `anisotropic_samples` samples the anisotropic pixels and nothing else: on every backend the
+/// ibl scene's light buffer changes only where the G-buffer holds a non-zero anisotropy (the
+/// albedo target's alpha), and there it does change.
+#[test]
+fn anisotropic_samples_change_only_the_anisotropic_pixels() {
+    harness::use_ibl_cache();
+    let loaded =
+        engine::scene_file::load(&harness::workspace_root().join("scenes/ibl.toml")).unwrap();
+    let mut sampled = loaded.scene.clone();
+    sampled.quality.ibl.anisotropic_samples = 16;
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        let split_sum = render(backend.as_mut(), &loaded.scene);
+        let anisotropic = render(backend.as_mut(), &sampled);
+        fn light(frame: &Frame) -> &[f32] {
+            frame.output(TargetId::Light).unwrap().as_f32().unwrap()
+        }
+        let albedo = split_sum
+            .output(TargetId::GBuffer(GBufferTarget::Albedo))
+            .unwrap()
+            .as_f32()
+            .unwrap();
+        let (mut changed_anisotropic, mut changed_other) = (0, 0);
+        for (i, (a, b)) in light(&split_sum)
+            .chunks_exact(4)
+            .zip(light(&anisotropic).chunks_exact(4))
+            .enumerate()
+        {
+            if a != b {
+                if albedo[i * 4 + 3] != 0.0 {
+                    changed_anisotropic += 1;
+                } else {
+                    changed_other += 1;
+                }
+            }
+        }
+        assert_eq!(
+            changed_other, 0,
+            "{kind}: pixels without anisotropy changed"
+        );
+        assert!(
+            changed_anisotropic > 1000,
+            "{kind}: only {changed_anisotropic} anisotropic pixels changed"
+        );
+    }
+}

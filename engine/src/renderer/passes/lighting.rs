@@ -105,7 +105,8 @@ impl<'a> LightingResources<'a> {
         ibl_maps: Option<&crate::ibl::IblMaps>,
     ) -> Result<Self, RenderError> {
         let lighting_shader = shader(scope, backend, shaders::LIGHTING)?;
-        let sampled = scene.quality.ibl.runtime_samples > 0;
+        let sampled =
+            scene.quality.ibl.runtime_samples > 0 || scene.quality.ibl.anisotropic_samples > 0;
         let ibl = ibl::upload(backend, scope, ibl_maps, sampled)?;
         let jitter = upload_jitter(backend, scope)?;
         let mut lights = light_uniforms(scene);

@@ -166,6 +166,15 @@ pub fn ibl_sampling_settings() -> Vec<(String, engine::ibl::IblSettings)> {
             ))
         })
         .collect();
+    for samples in [4, 8, 16] {
+        rows.push((
+            format!("aniso fis {samples}"),
+            engine::ibl::IblSettings {
+                anisotropic_samples: samples,
+                ..d.clone()
+            },
+        ));
+    }
     for samples in [256, 1024] {
         rows.push((
             format!("fis {samples} specular 256"),
