@@ -25,6 +25,7 @@ Mitsuba's own noise, about 1/sqrt(spp) of the pixel value; the ratio of means do
     pip install mitsuba          # 3.x; the scalar_rgb variant ships in the wheel
     python3 scripts/mitsuba_crosscheck.py [--spp 1024] [--out target/mitsuba] [--min-n-dot-v 0.3]
                                           [--harness target/debug/harness] [--rotation 0]
+                                          [--ibl runtime_samples=256 --ibl specular_size=256]
 
 Not part of `cargo test`: it takes a few minutes and needs Mitsuba. The README's "IBL against a
 path tracer" section records its table.
@@ -65,8 +66,9 @@ def sphere_x(index):
     return (index - (len(SPHERES) - 1) / 2) * 2.2
 
 
-def harness_scene(environment, rotation):
-    """The scene file the harness renders (in the folder that holds a copy of the environment)."""
+def harness_scene(environment, rotation, ibl=()):
+    """The scene file the harness renders (in the folder that holds a copy of the environment),
+    with `ibl`'s `key = value` lines under [quality.ibl]."""
     lines = [
         "# Written by scripts/mitsuba_crosscheck.py.",
         'description = "Spheres lit by the environment only, for the Mitsuba cross-check"',
@@ -80,6 +82,8 @@ def harness_scene(environment, rotation):
         f"width = {WIDTH}",
         f"height = {HEIGHT}",
         "exposure = 1.0",
+        "[quality.ibl]",
+        *ibl,
         "[environment]",
         f'path = "{environment}"',
         f"rotation = {rotation}",
@@ -218,6 +222,11 @@ def main():
         help="a built harness binary (e.g. target/debug/harness) instead of `cargo run --release`",
     )
     parser.add_argument(
+        "--ibl", action="append", default=[], metavar="KEY=VALUE",
+        help="a [quality.ibl] setting of the harness's scene (repeatable), e.g. --ibl "
+        "runtime_samples=256 --ibl specular_size=256; default: the defaults (the split sum)",
+    )
+    parser.add_argument(
         "--rotation", type=float, default=0.0,
         help="environment rotation about +Y in degrees, in both renderers (default 0); the camera "
         "looks down -Z, so this turns which part of the sky each sphere reflects",
@@ -235,7 +244,7 @@ def main():
         shutil.copyfile(source, os.path.join(work, environment))
         scene_path = os.path.join(work, "spheres.toml")
         with open(scene_path, "w") as f:
-            f.write(harness_scene(environment, args.rotation))
+            f.write(harness_scene(environment, args.rotation, [kv.replace("=", " = ", 1) for kv in args.ibl]))
         print(f"{environment}: harness ...", file=sys.stderr)
         harness = run_harness(scene_path, os.path.join(work, "light.exr"), args.harness)
         texels = np.array(mi.Bitmap(source), dtype=np.float32)[..., :3]
