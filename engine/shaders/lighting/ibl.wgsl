@@ -121,10 +121,18 @@ fn pbr_ibl(s: Surface, v: vec3<f32>, occlusion: f32) -> vec3<f32> {
         let amount = abs(s.anisotropy) * clamp(5.0 * s.roughness, 0.0, 1.0);
         bent = safe_normalize(mix(n, anisotropic_normal, amount), n);
     }
-    // The lobe's dominant direction leans from R towards N as roughness grows (Filament's
-    // getSpecularDominantDirection): the split sum's N = V = R assumption misses that.
+    // The lobe's dominant direction leans from R towards N as roughness grows: the split sum's
+    // N = V = R assumption misses that. Filament's getSpecularDominantDirection leans by
+    // roughness^4; Lagarde and de Rousiers' ("Moving Frostbite to PBR", 2014) keep
+    // (1 - a)(sqrt(1 - a) + a) of R, a = roughness^2, which leans further.
     let r = reflect(-v, bent);
-    let dominant = safe_normalize(mix(r, bent, s.roughness * s.roughness * s.roughness * s.roughness), r);
+    var dominant: vec3<f32>;
+    if IBL_FROSTBITE_DOMINANT {
+        let a = s.roughness * s.roughness;
+        dominant = safe_normalize(mix(bent, r, (1.0 - a) * (sqrt(1.0 - a) + a)), r);
+    } else {
+        dominant = safe_normalize(mix(r, bent, s.roughness * s.roughness * s.roughness * s.roughness), r);
+    }
     var specular: vec3<f32>;
     // Sampling only where the lobe is wider than a texel of the prefiltered cube's level 0 (GGX
     // alpha against the texel's 2 / size radians): a narrower lobe is the level 0 lookup the

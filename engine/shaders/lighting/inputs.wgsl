@@ -48,6 +48,8 @@ override IBL_FOOTPRINT: f32 = 1.0;
 // Filtered importance samples of the anisotropic pixels only, where IBL_SAMPLES is 0 (the split
 // sum elsewhere).
 override IBL_ANISOTROPIC_SAMPLES: u32 = 0u;
+// The split sum's dominant direction: Lagarde and de Rousiers' (true) or Filament's.
+override IBL_FROSTBITE_DOMINANT: bool = false;
 // Whether any surface of this model can have clearcoat or anisotropy: per-pixel values, so when
 // true the shader still branches on the pixel's value.
 override CLEARCOAT: bool = true;

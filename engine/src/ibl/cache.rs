@@ -91,6 +91,7 @@ pub fn key(image: &EnvironmentImage, settings: &IblSettings) -> Key {
         runtime_samples: 0,
         runtime_footprint: IblSettings::default().runtime_footprint,
         anisotropic_samples: 0,
+        dominant_direction: super::DominantDirection::default(),
         sun_shadow: true,
         ..settings.clone()
     };

@@ -36,7 +36,7 @@ pub use cube::{CubeLevel, CubeMap};
 
 use crate::scene::EnvironmentImage;
 
-pub use crate::scene::{Footprint, IblSettings, IrradianceMethod};
+pub use crate::scene::{DominantDirection, Footprint, IblSettings, IrradianceMethod};
 
 /// The settings' line in plans and reports (it names the precompute's own constants).
 impl IblSettings {

@@ -100,6 +100,9 @@ impl fmt::Display for LightingVariant {
                 self.ibl_samples, self.ibl_footprint
             )?;
         }
+        if self.ibl && self.ibl_dominant == crate::scene::DominantDirection::Frostbite {
+            write!(f, ", ibl frostbite dominant direction")?;
+        }
         if self.ibl && self.ibl_anisotropic_samples > 0 {
             write!(
                 f,

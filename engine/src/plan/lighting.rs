@@ -50,6 +50,9 @@ pub struct LightingVariant {
     /// Filtered importance samples of the anisotropic pixels when `ibl_samples` is 0
     /// (`IBL_ANISOTROPIC_SAMPLES`, from `[quality.ibl] anisotropic_samples`).
     pub ibl_anisotropic_samples: u32,
+    /// The split sum's dominant direction (`IBL_FROSTBITE_DOMINANT`, from `[quality.ibl]
+    /// dominant_direction`).
+    pub ibl_dominant: crate::scene::DominantDirection,
     /// Some surface of the model has clearcoat (`CLEARCOAT`; the shader still branches per
     /// pixel when true).
     pub clearcoat: bool,
@@ -107,6 +110,10 @@ impl LightingVariant {
             (
                 "IBL_ANISOTROPIC_SAMPLES",
                 f64::from(self.ibl_anisotropic_samples),
+            ),
+            (
+                "IBL_FROSTBITE_DOMINANT",
+                flag(self.ibl_dominant == crate::scene::DominantDirection::Frostbite),
             ),
             ("CLEARCOAT", flag(self.clearcoat)),
             ("ANISOTROPY", flag(self.anisotropy)),
@@ -301,6 +308,7 @@ pub(super) fn lighting_passes(
                 ibl_samples: 0,
                 ibl_footprint: crate::scene::Footprint::ONE,
                 ibl_anisotropic_samples: 0,
+                ibl_dominant: crate::scene::DominantDirection::Filament,
                 clearcoat: pbr
                     && materials().any(|m| m.clearcoat != 0.0 || m.clearcoat_map.is_some()),
                 anisotropy: pbr && materials().any(|m| m.anisotropy != 0.0),
@@ -348,6 +356,11 @@ pub(super) fn lighting_passes(
                                     scene.quality.ibl.runtime_footprint
                                 } else {
                                     crate::scene::Footprint::ONE
+                                },
+                                ibl_dominant: if ibl && index == 0 && pbr {
+                                    scene.quality.ibl.dominant_direction
+                                } else {
+                                    crate::scene::DominantDirection::Filament
                                 },
                                 ibl_anisotropic_samples: if ibl
                                     && index == 0

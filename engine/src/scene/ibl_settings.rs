@@ -23,6 +23,19 @@ impl IrradianceMethod {
     }
 }
 
+/// Where the split sum looks up its prefiltered lobe: the reflection vector leaned towards the
+/// normal as roughness grows, by one of two published rules.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DominantDirection {
+    /// Filament's getSpecularDominantDirection: `mix(R, N, roughness^4)`.
+    #[default]
+    Filament,
+    /// Lagarde and de Rousiers, "Moving Frostbite to PBR" (2014): `mix(N, R, (1 - a)(sqrt(1 - a)
+    /// + a))` with `a = roughness^2`, which leans further towards N.
+    Frostbite,
+}
+
 /// How many times its own solid angle a filtered importance sample reads (`[quality.ibl]
 /// runtime_footprint`): a power of two from 1/16 to 64, kept as its exponent so that settings
 /// compare and hash exactly. Written and read in scene files as the number (`0.25`, `1`, `4`).
@@ -110,6 +123,9 @@ pub struct IblSettings {
     /// pixels only (0: the split sum there too), where the split sum's isotropic prefilter is
     /// furthest off. It changes no precomputed map.
     pub anisotropic_samples: u32,
+    /// The split sum's dominant direction (`filament` or `frostbite`). It changes no
+    /// precomputed map.
+    pub dominant_direction: DominantDirection,
     /// Cut the environment's sun out of the maps and light it as a directional light instead
     /// ([`crate::ibl::sun`]).
     pub extract_sun: bool,
@@ -132,6 +148,7 @@ impl Default for IblSettings {
             runtime_samples: 0,
             runtime_footprint: Footprint::ONE,
             anisotropic_samples: 0,
+            dominant_direction: DominantDirection::Filament,
             extract_sun: false,
             sun_shadow: true,
         }

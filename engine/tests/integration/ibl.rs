@@ -61,6 +61,7 @@ fn uniform_environment_gives_uniform_maps() {
             runtime_samples: 0,
             runtime_footprint: ibl::Footprint::ONE,
             anisotropic_samples: 0,
+            dominant_direction: ibl::DominantDirection::Filament,
             extract_sun: false,
             sun_shadow: true,
         };

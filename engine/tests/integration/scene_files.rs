@@ -373,3 +373,20 @@ fn the_ibl_footprint_is_a_power_of_two_read_as_a_number() {
     let default = engine::scene::IblSettings::default();
     assert_eq!(default.runtime_footprint.factor(), 1.0);
 }
+
+/// `[quality.ibl] dominant_direction` names one of the two rules, and another name is an error
+/// naming the line and the choices.
+#[test]
+fn the_ibl_dominant_direction_is_one_of_two_rules() {
+    let with = |rule: &str| format!("{CAMERA}\n[quality.ibl]\ndominant_direction = \"{rule}\"\n");
+    for (name, rule) in [
+        ("filament", engine::scene::DominantDirection::Filament),
+        ("frostbite", engine::scene::DominantDirection::Frostbite),
+    ] {
+        let scene = scene_file::parse(Path::new("dir/ok.toml"), &with(name)).unwrap();
+        assert_eq!(scene.quality.ibl.unwrap().dominant_direction, rule);
+    }
+    let e = parse_err(&with("unreal"));
+    assert!(e.starts_with("dir/bad.toml:6:"), "{e}");
+    assert!(e.contains("filament") && e.contains("frostbite"), "{e}");
+}

@@ -166,6 +166,22 @@ pub fn ibl_sampling_settings() -> Vec<(String, engine::ibl::IblSettings)> {
             ))
         })
         .collect();
+    let frostbite = engine::ibl::DominantDirection::Frostbite;
+    rows.push((
+        "frostbite dominant".to_owned(),
+        engine::ibl::IblSettings {
+            dominant_direction: frostbite,
+            ..d.clone()
+        },
+    ));
+    rows.push((
+        "frostbite + aniso fis 16".to_owned(),
+        engine::ibl::IblSettings {
+            dominant_direction: frostbite,
+            anisotropic_samples: 16,
+            ..d.clone()
+        },
+    ));
     for samples in [4, 8, 16] {
         rows.push((
             format!("aniso fis {samples}"),
