@@ -17,17 +17,8 @@ fn ibl_prefiltered(r: vec3<f32>, roughness: f32) -> vec3<f32> {
     return textureSampleLevel(ibl_specular, ibl_sampler, environment_direction(r), lod).rgb;
 }
 
-// The PBR specular IBL by filtered importance sampling (Krivanek and Colbert 2008): IBL_SAMPLES
-// samples of the GGX lobe (anisotropic where the surface is; the stretched-slope sampling of
-// Heitz's "Understanding the Masking-Shadowing Function", so the pdf is D(h) n.h), stratified in
-// the radial variable and radical-inverse in the angle, each weighted by F V 4 v.h n.l / n.h
-// and read from the radiance chain (the environment box-filtered, not GGX-prefiltered: a read
-// blurs its footprint once) at the level whose texels cover IBL_FOOTPRINT times the sample's
-// solid angle 1 / (N pdf): lod = log2(that / a level-0 texel's solid angle) / 2. Krivanek and
-// Colbert read one level up (a footprint of 4); the IBL sweep measured 1 closer to the path
-// tracer under both shipped skies. Unlike the split sum, the lobe follows the view.
-
-// The radiance chain's level-0 texel solid angle and top level, asked once per pixel.
+// The radiance chain's (binding 19) level-0 texel solid angle and top level, asked once per
+// pixel.
 struct RadianceChain {
     texel_solid_angle: f32,
     top: f32,
@@ -43,6 +34,17 @@ fn ibl_radiance_at(chain: RadianceChain, l: vec3<f32>, sample_solid_angle: f32) 
     let lod = clamp(0.5 * log2(footprint / chain.texel_solid_angle), 0.0, chain.top);
     return textureSampleLevel(ibl_radiance, ibl_sampler, environment_direction(l), lod).rgb;
 }
+
+// The PBR specular IBL by filtered importance sampling (Krivanek and Colbert 2008): `samples`
+// (IBL_SAMPLES, or IBL_ANISOTROPIC_SAMPLES on anisotropic pixels) samples of the GGX lobe
+// (anisotropic where the surface is; the stretched-slope sampling of Heitz's "Understanding the
+// Masking-Shadowing Function", so the pdf is D(h) n.h), stratified in the radial variable and
+// radical-inverse in the angle, each weighted by F V 4 v.h n.l / n.h and read from the radiance
+// chain (the environment box-filtered, not GGX-prefiltered: a read blurs its footprint once) at
+// the level whose texels cover IBL_FOOTPRINT times the sample's solid angle 1 / (N pdf): lod =
+// log2(that / a level-0 texel's solid angle) / 2. Krivanek and Colbert read one level up (a
+// footprint of 4); the IBL sweep measured 1 closer to the path tracer under both shipped skies.
+// Unlike the split sum, the lobe follows the view.
 fn ibl_specular_sampled(s: Surface, v: vec3<f32>, f0: vec3<f32>, samples: u32) -> vec3<f32> {
     let n = s.normal;
     let n_dot_v = max(dot(n, v), MIN_N_DOT_V);

@@ -166,6 +166,7 @@ struct ShadowUniforms {
 @group(0) @binding(18) var ambient_occlusion: texture_2d<f32>;
 
 // The environment cube with box-filtered mips (crate::ibl, `radiance`), read by the filtered
-// importance samples of IBL_SAMPLES > 0 (a 1 x 1 black placeholder in other scenes).
+// importance samples of IBL_SAMPLES and IBL_ANISOTROPIC_SAMPLES (a 1 x 1 black placeholder in
+// scenes that take none).
 @group(0) @binding(19) var ibl_radiance: texture_cube<f32>;
 

@@ -8,9 +8,10 @@
 //!   SH9 ([`irradiance`] says why).
 //! - `dfg`: the DFG lookup table of the split sum ([`dfg`]).
 //! - `radiance`: the environment cube itself with a box-filtered mip chain, which the lighting
-//!   pass's filtered importance samples read (`[quality.ibl] runtime_samples`): a sample reads
-//!   the level whose texels cover its solid angle, so its footprint is blurred once, by the box
-//!   filter, instead of by the GGX prefilter of the specular cube as well.
+//!   pass's filtered importance samples read (`[quality.ibl] runtime_samples`,
+//!   `anisotropic_samples`): a sample reads the level whose texels cover `runtime_footprint`
+//!   times its solid angle, so its footprint is blurred once, by the box filter, instead of by
+//!   the GGX prefilter of the specular cube as well.
 //!
 //! Why the CPU: the maps are a pure function of the image and [`IblSettings`], so computing
 //! them once, identically for every backend, keeps driver differences out of them (one golden
@@ -65,8 +66,21 @@ impl IblSettings {
                 "; specular by {} filtered importance samples per pixel",
                 self.runtime_samples
             )
+        } else if self.anisotropic_samples != 0 {
+            format!(
+                "; specular by {} filtered importance samples on anisotropic pixels",
+                self.anisotropic_samples
+            )
         } else {
             String::new()
+        } + &if self.runtime_footprint != Footprint::ONE {
+            format!(", each reading {}x its solid angle", self.runtime_footprint)
+        } else {
+            String::new()
+        } + if self.dominant_direction == DominantDirection::Frostbite {
+            "; Frostbite's dominant direction"
+        } else {
+            ""
         }
     }
 }

@@ -460,6 +460,7 @@ impl RenderPlan {
                         draw.variant.ibl_samples = 0;
                         draw.variant.ibl_footprint = crate::scene::Footprint::ONE;
                         draw.variant.ibl_anisotropic_samples = 0;
+                        draw.variant.ibl_dominant = crate::scene::DominantDirection::Filament;
                     }
                     LightingFeature::Shadows => draw.shadowed = None,
                     LightingFeature::Clearcoat => draw.variant.clearcoat = false,
@@ -476,6 +477,7 @@ impl RenderPlan {
                         draw.variant.ibl_samples = 0;
                         draw.variant.ibl_footprint = crate::scene::Footprint::ONE;
                         draw.variant.ibl_anisotropic_samples = 0;
+                        draw.variant.ibl_dominant = crate::scene::DominantDirection::Filament;
                     }
                     LightingFeature::Lights => {
                         draw.lights.clear();

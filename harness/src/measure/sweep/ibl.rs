@@ -146,9 +146,11 @@ pub fn ibl_size_settings() -> Vec<(String, engine::ibl::IblSettings)> {
     ]
 }
 
-/// What the timed sweep adds for the filtered importance samples: other footprints (the
-/// default reads once a sample's solid angle; Krivanek and Colbert read 4 times), and 256
-/// samples over a 256² specular cube, whose level 0 the sharpest lobes still read.
+/// What the timed sweep adds for the specular IBL's candidates: other sample footprints (the
+/// default reads once a sample's solid angle; Krivanek and Colbert read 4 times), Frostbite's
+/// dominant direction for the split sum, samples on the anisotropic pixels only (alone and with
+/// that direction), and sampling over a 256² specular cube, whose level 0 the sharpest lobes
+/// still read.
 pub fn ibl_sampling_settings() -> Vec<(String, engine::ibl::IblSettings)> {
     let d = engine::ibl::IblSettings::default();
     let mut rows: Vec<_> = [64, 256]
