@@ -6,7 +6,9 @@
 //! entry is written to a temporary file in the same directory and renamed into place, so a
 //! reader never sees half of one. Each entry ends with the SHA-256 of its payload: an entry
 //! that is truncated, corrupt or from another version is rebuilt (with a warning), never
-//! trusted.
+//! trusted. A folder keeps at most [`MAX_DIRECTORY_BYTES`] of entries: each write removes the
+//! entries used longest ago past that (a hit marks its entry used), since every edit of this
+//! folder's code makes new keys and the old entries would otherwise stay forever.
 
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
@@ -35,6 +37,10 @@ pub const ALGORITHM_SOURCES: [(&str, &str); 7] = [
 ];
 
 const MAGIC: &[u8; 8] = b"IBLMAPS\0";
+
+/// The most bytes of entries one cache folder keeps (see [`evict`]): the maps of every scene,
+/// sweep setting and sky the tests and sweeps use (about 60 entries of 1.7 to 8 MB) fit.
+pub const MAX_DIRECTORY_BYTES: u64 = 512 << 20;
 
 /// Maps kept in memory per process (most recent first out last).
 const MEMORY_ENTRIES: usize = 8;
@@ -341,7 +347,14 @@ pub fn read(directory: &Path, key: &Key) -> Option<IblMaps> {
         }
     };
     match decode(key, &bytes) {
-        Ok(maps) => Some(maps),
+        Ok(maps) => {
+            // Used now: the last to go when the folder is over its size (best effort).
+            let _ = std::fs::File::options()
+                .write(true)
+                .open(&path)
+                .and_then(|f| f.set_modified(std::time::SystemTime::now()));
+            Some(maps)
+        }
         Err(problem) => {
             log::warn!(
                 "IBL cache `{}` is invalid ({problem}); rebuilding",
@@ -361,5 +374,37 @@ pub fn write(directory: &Path, key: &Key, maps: &IblMaps) -> Result<PathBuf, Cac
     std::fs::create_dir_all(directory).map_err(err(directory))?;
     let path = directory.join(file_name(key));
     crate::files::write_atomically(&path, &encode(key, maps)).map_err(err(&path))?;
+    evict(directory, MAX_DIRECTORY_BYTES);
     Ok(path)
+}
+
+/// Removes the entries of `directory` used longest ago (by modification time: written or last
+/// read) until the rest take at most `budget` bytes; the newest entry always stays. Best effort:
+/// an entry another process removed first, or one that cannot be removed, is passed over.
+/// Returns how many it removed.
+pub fn evict(directory: &Path, budget: u64) -> usize {
+    let Ok(listing) = std::fs::read_dir(directory) else {
+        return 0;
+    };
+    let mut entries: Vec<(std::time::SystemTime, u64, PathBuf)> = listing
+        .filter_map(|e| {
+            let e = e.ok()?;
+            let name = e.file_name().into_string().ok()?;
+            if !(name.starts_with("ibl-") && name.ends_with(".bin")) {
+                return None;
+            }
+            let meta = e.metadata().ok()?;
+            Some((meta.modified().ok()?, meta.len(), e.path()))
+        })
+        .collect();
+    entries.sort_by_key(|e| std::cmp::Reverse(e.0));
+    let mut kept = 0u64;
+    let mut removed = 0;
+    for (index, (_, size, path)) in entries.into_iter().enumerate() {
+        kept += size;
+        if index > 0 && kept > budget && std::fs::remove_file(&path).is_ok() {
+            removed += 1;
+        }
+    }
+    removed
 }

@@ -420,3 +420,46 @@ fn the_cache_key_covers_every_source_file_of_the_precompute() {
         assert_eq!(std::fs::read_to_string(folder.join(name)).unwrap(), source);
     }
 }
+
+/// The disk cache stays within its size: past the budget, the entries used longest ago go (a
+/// read hit counts as a use), the newest always stays, and other files are left alone.
+#[test]
+fn the_disk_cache_removes_the_entries_used_longest_ago() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = uniform(0.5);
+    let settings = |seed| IblSettings {
+        source_size: 16,
+        specular_size: 8,
+        specular_samples: 4,
+        irradiance_size: 4,
+        seed,
+        ..IblSettings::default()
+    };
+    let mut paths = Vec::new();
+    for seed in 1..=3 {
+        let key = ibl::cache::key(&image, &settings(seed));
+        paths.push(
+            ibl::cache::write(dir.path(), &key, &ibl::build(&image, &settings(seed))).unwrap(),
+        );
+    }
+    // Written an hour, two and three hours ago: seed 1 is the oldest.
+    let now = std::time::SystemTime::now();
+    for (hours, path) in [3u64, 2, 1].into_iter().zip(&paths) {
+        std::fs::File::options()
+            .write(true)
+            .open(path)
+            .unwrap()
+            .set_modified(now - std::time::Duration::from_secs(hours * 3600))
+            .unwrap();
+    }
+    std::fs::write(dir.path().join("notes.txt"), "not an entry").unwrap();
+    // Reading seed 1 makes it the newest; seed 2 is now the one used longest ago.
+    assert!(ibl::cache::read(dir.path(), &ibl::cache::key(&image, &settings(1))).is_some());
+    let entry = std::fs::metadata(&paths[0]).unwrap().len();
+    assert_eq!(ibl::cache::evict(dir.path(), 2 * entry + entry / 2), 1);
+    assert!(paths[0].exists() && !paths[1].exists() && paths[2].exists());
+    assert!(dir.path().join("notes.txt").exists());
+    // A budget smaller than one entry still keeps the newest.
+    assert_eq!(ibl::cache::evict(dir.path(), 1), 1);
+    assert!(paths[0].exists() && !paths[2].exists());
+}
