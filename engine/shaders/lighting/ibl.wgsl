@@ -136,18 +136,19 @@ fn pbr_ibl(s: Surface, v: vec3<f32>, occlusion: f32) -> vec3<f32> {
         dominant = safe_normalize(mix(r, bent, s.roughness * s.roughness * s.roughness * s.roughness), r);
     }
     var specular: vec3<f32>;
+    // Samples: IBL_SAMPLES on every pixel, or IBL_ANISOTROPIC_SAMPLES on the anisotropic ones
+    // (where the split sum is furthest off), else none.
+    var samples = IBL_SAMPLES;
+    if samples == 0u && ANISOTROPY && s.anisotropy != 0.0 {
+        samples = IBL_ANISOTROPIC_SAMPLES;
+    }
     // Sampling only where the lobe is wider than a texel of the prefiltered cube's level 0 (GGX
     // alpha against the texel's 2 / size radians): a narrower lobe is the level 0 lookup the
     // split sum makes, while its samples' solid-angle lod would blur the tail samples' reads.
-    // (`&&` short-circuits: the split-sum variant makes no size query.)
-    // IBL_ANISOTROPIC_SAMPLES: sampling where the split sum is furthest off, the anisotropic
-    // pixels, and the split sum everywhere else.
-    if IBL_SAMPLES > 0u
+    // (`&&` short-circuits: a variant without samples makes no size query.)
+    if samples > 0u
         && s.roughness * s.roughness >= 2.0 / f32(textureDimensions(ibl_specular).x) {
-        specular = ibl_specular_sampled(s, v, f0, IBL_SAMPLES);
-    } else if IBL_ANISOTROPIC_SAMPLES > 0u && ANISOTROPY && s.anisotropy != 0.0
-        && s.roughness * s.roughness >= 2.0 / f32(textureDimensions(ibl_specular).x) {
-        specular = ibl_specular_sampled(s, v, f0, IBL_ANISOTROPIC_SAMPLES);
+        specular = ibl_specular_sampled(s, v, f0, samples);
     } else {
         specular = ibl_prefiltered(dominant, s.roughness) * e;
     }

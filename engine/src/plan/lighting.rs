@@ -74,6 +74,22 @@ pub struct LightingVariant {
 }
 
 impl LightingVariant {
+    /// Whether the draw takes filtered importance samples of the environment (of every pixel or
+    /// of the anisotropic ones), which read the IBL's radiance chain.
+    pub fn samples_ibl(&self) -> bool {
+        self.ibl_samples > 0 || self.ibl_anisotropic_samples > 0
+    }
+
+    /// No IBL in the draw, and its knobs back to what a draw without IBL has (so that variants
+    /// that differ only there share a pipeline).
+    pub fn remove_ibl(&mut self) {
+        self.ibl = false;
+        self.ibl_samples = 0;
+        self.ibl_anisotropic_samples = 0;
+        self.ibl_footprint = crate::scene::Footprint::ONE;
+        self.ibl_dominant = crate::scene::DominantDirection::Filament;
+    }
+
     /// The pipeline-overridable constants of `lighting.wgsl`, by name, for this variant.
     pub fn constants(&self) -> Vec<(String, f64)> {
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
@@ -334,6 +350,16 @@ pub(super) fn lighting_passes(
                     .iter()
                     .enumerate()
                     .map(|(index, (lights, shadowed))| {
+                        // The first draw of the PBR model carries its IBL and the IBL's knobs.
+                        let knobs = &scene.quality.ibl;
+                        let pbr_ibl = ibl && index == 0 && pbr;
+                        let ibl_samples = if pbr_ibl { knobs.runtime_samples } else { 0 };
+                        let anisotropic_samples = if pbr_ibl && base.anisotropy && ibl_samples == 0
+                        {
+                            knobs.anisotropic_samples
+                        } else {
+                            0
+                        };
                         let mut draw = LightingDraw {
                             lights: lights.clone(),
                             shadowed: *shadowed,
@@ -341,35 +367,17 @@ pub(super) fn lighting_passes(
                             variant: LightingVariant {
                                 ibl: ibl && index == 0,
                                 ambient_occlusion: scene.quality.ssao.is_some() && index == 0,
-                                ibl_samples: if ibl && index == 0 && pbr {
-                                    scene.quality.ibl.runtime_samples
-                                } else {
-                                    0
-                                },
-                                ibl_footprint: if ibl
-                                    && index == 0
-                                    && pbr
-                                    && (scene.quality.ibl.runtime_samples > 0
-                                        || (base.anisotropy
-                                            && scene.quality.ibl.anisotropic_samples > 0))
-                                {
-                                    scene.quality.ibl.runtime_footprint
+                                ibl_samples,
+                                ibl_anisotropic_samples: anisotropic_samples,
+                                ibl_footprint: if ibl_samples > 0 || anisotropic_samples > 0 {
+                                    knobs.runtime_footprint
                                 } else {
                                     crate::scene::Footprint::ONE
                                 },
-                                ibl_dominant: if ibl && index == 0 && pbr {
-                                    scene.quality.ibl.dominant_direction
+                                ibl_dominant: if pbr_ibl {
+                                    knobs.dominant_direction
                                 } else {
                                     crate::scene::DominantDirection::Filament
-                                },
-                                ibl_anisotropic_samples: if ibl
-                                    && index == 0
-                                    && base.anisotropy
-                                    && scene.quality.ibl.runtime_samples == 0
-                                {
-                                    scene.quality.ibl.anisotropic_samples
-                                } else {
-                                    0
                                 },
                                 ..base
                             },
@@ -456,11 +464,7 @@ impl RenderPlan {
                 match feature {
                     LightingFeature::Shading => draw.variant.input_floor = true,
                     LightingFeature::Ibl => {
-                        draw.variant.ibl = false;
-                        draw.variant.ibl_samples = 0;
-                        draw.variant.ibl_footprint = crate::scene::Footprint::ONE;
-                        draw.variant.ibl_anisotropic_samples = 0;
-                        draw.variant.ibl_dominant = crate::scene::DominantDirection::Filament;
+                        draw.variant.remove_ibl();
                     }
                     LightingFeature::Shadows => draw.shadowed = None,
                     LightingFeature::Clearcoat => draw.variant.clearcoat = false,
@@ -473,11 +477,7 @@ impl RenderPlan {
                     LightingFeature::Lighting => {
                         draw.lights.clear();
                         draw.shadowed = None;
-                        draw.variant.ibl = false;
-                        draw.variant.ibl_samples = 0;
-                        draw.variant.ibl_footprint = crate::scene::Footprint::ONE;
-                        draw.variant.ibl_anisotropic_samples = 0;
-                        draw.variant.ibl_dominant = crate::scene::DominantDirection::Filament;
+                        draw.variant.remove_ibl();
                     }
                     LightingFeature::Lights => {
                         draw.lights.clear();

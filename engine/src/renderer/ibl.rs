@@ -63,7 +63,7 @@ fn cube(
 }
 
 /// Uploads `maps`, or placeholders when there are none; the radiance chain only when `sampled`
-/// (the scene's specular IBL takes filtered importance samples), else a placeholder.
+/// (a draw of the plan takes filtered importance samples), else a placeholder.
 pub(super) fn upload(
     backend: &mut dyn Backend,
     scope: &mut ResourceScope,

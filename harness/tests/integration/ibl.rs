@@ -381,13 +381,12 @@ fn extracted_sun_reflects_as_a_disc() {
 #[test]
 fn anisotropic_samples_change_only_the_anisotropic_pixels() {
     harness::use_ibl_cache();
-    let loaded =
-        engine::scene_file::load(&harness::workspace_root().join("scenes/ibl.toml")).unwrap();
-    let mut sampled = loaded.scene.clone();
+    let scene = harness::load_scene("ibl").unwrap().scene;
+    let mut sampled = scene.clone();
     sampled.quality.ibl.anisotropic_samples = 16;
     for kind in common::available_backends() {
         let mut backend = engine::backend::create(kind).unwrap();
-        let split_sum = render(backend.as_mut(), &loaded.scene);
+        let split_sum = render(backend.as_mut(), &scene);
         let anisotropic = render(backend.as_mut(), &sampled);
         fn light(frame: &Frame) -> &[f32] {
             frame.output(TargetId::Light).unwrap().as_f32().unwrap()

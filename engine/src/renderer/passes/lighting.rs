@@ -102,12 +102,9 @@ impl<'a> LightingResources<'a> {
         frame: &'a FrameResources,
         views: &[ShadowView],
         variations: &Variations,
-        ibl_maps: Option<&crate::ibl::IblMaps>,
+        ibl: IblTextures,
     ) -> Result<Self, RenderError> {
         let lighting_shader = shader(scope, backend, shaders::LIGHTING)?;
-        let sampled =
-            scene.quality.ibl.runtime_samples > 0 || scene.quality.ibl.anisotropic_samples > 0;
-        let ibl = ibl::upload(backend, scope, ibl_maps, sampled)?;
         let jitter = upload_jitter(backend, scope)?;
         let mut lights = light_uniforms(scene);
         if let Some(scale) = variations.light_radiance_scale {
@@ -337,6 +334,14 @@ fn resources<'c, 'a>(
     ctx: &'c mut FrameContext<'a>,
 ) -> Result<&'c mut LightingResources<'a>, RenderError> {
     if ctx.lighting.is_none() {
+        // The radiance chain only where a draw of the plan samples it.
+        let sampled = ctx
+            .plan
+            .lighting
+            .iter()
+            .flat_map(|pass| &pass.draws)
+            .any(|draw| draw.variant.samples_ibl());
+        let ibl = ibl::upload(ctx.backend, ctx.scope, ctx.ibl_maps, sampled)?;
         let made = LightingResources::create(
             ctx.backend,
             ctx.scope,
@@ -344,7 +349,7 @@ fn resources<'c, 'a>(
             ctx.frame,
             &ctx.views,
             ctx.variations,
-            ctx.ibl_maps,
+            ibl,
         )?;
         ctx.lighting = Some(made);
     }
