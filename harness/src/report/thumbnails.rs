@@ -16,28 +16,31 @@ const PREVIEW: u32 = 160;
 /// An 8-bit thumbnail of a pass output: HDR values Reinhard-mapped, depth stretched over its
 /// range, 8-bit images as they are; box-downscaled to at most [`PREVIEW`] pixels.
 pub fn preview(image: &Image, pass: TargetId) -> Image {
+    // The mapped values in the image's shape (not `..image.clone()`, which copied the pixels
+    // only to drop them).
+    let mapped = |data: Vec<f32>| Image {
+        width: image.width,
+        height: image.height,
+        format: image.format,
+        data: ImageData::F32(data),
+    };
     let display = match (&image.data, display(image, pass)) {
         (ImageData::F32(data), Display::Depth) => {
             let finite = data.iter().copied().filter(|v| v.is_finite() && *v < 1.0);
             let (lo, hi) = finite.fold((f32::MAX, f32::MIN), |(lo, hi), v| (lo.min(v), hi.max(v)));
             let span = (hi - lo).max(1e-9);
-            let mapped = data
+            let stretched = data
                 .iter()
                 .map(|&v| if v >= 1.0 { 1.0 } else { (v - lo) / span })
                 .collect();
-            images::display_u8(&Image {
-                data: ImageData::F32(mapped),
-                ..image.clone()
-            })
+            images::display_u8(&mapped(stretched))
         }
-        (ImageData::F32(data), Display::Hdr) => images::display_u8(&Image {
-            data: ImageData::F32(data.iter().map(|&v| v / (1.0 + v.abs())).collect()),
-            ..image.clone()
-        }),
-        (ImageData::F32(data), Display::Signed) => images::display_u8(&Image {
-            data: ImageData::F32(data.iter().map(|&v| v * 0.5 + 0.5).collect()),
-            ..image.clone()
-        }),
+        (ImageData::F32(data), Display::Hdr) => {
+            images::display_u8(&mapped(data.iter().map(|&v| v / (1.0 + v.abs())).collect()))
+        }
+        (ImageData::F32(data), Display::Signed) => {
+            images::display_u8(&mapped(data.iter().map(|&v| v * 0.5 + 0.5).collect()))
+        }
         _ => images::display_u8(image),
     };
     downscale(&display)
