@@ -25,6 +25,7 @@
 use std::borrow::Cow;
 
 pub mod compare;
+mod flip_memo;
 
 use engine::{Image, ImageData};
 
@@ -394,9 +395,18 @@ impl<'a> Pair<'a> {
         };
         let rgb =
             |d: &[u8]| -> Vec<u8> { d.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect() };
-        let reference = nv_flip::FlipImageRgb8::with_data(golden.width, golden.height, &rgb(g));
-        let test = nv_flip::FlipImageRgb8::with_data(actual.width, actual.height, &rgb(a));
-        Ok(nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE).to_vec())
+        let (reference, test) = (rgb(g), rgb(a));
+        let ppd = nv_flip::DEFAULT_PIXELS_PER_DEGREE;
+        let key = flip_memo::key(&reference, &test, golden.width, golden.height, ppd);
+        let len = golden.width as usize * golden.height as usize;
+        if let Some(map) = flip_memo::get(&key, len) {
+            return Ok(map.as_ref().clone());
+        }
+        let reference = nv_flip::FlipImageRgb8::with_data(golden.width, golden.height, &reference);
+        let test = nv_flip::FlipImageRgb8::with_data(actual.width, actual.height, &test);
+        let map = nv_flip::flip(reference, test, ppd).to_vec();
+        flip_memo::put(key, std::sync::Arc::new(map.clone()));
+        Ok(map)
     }
 }
 

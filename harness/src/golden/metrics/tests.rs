@@ -47,6 +47,38 @@ fn identical_images_have_zero_error() {
 }
 
 #[test]
+fn a_flip_map_computed_again_is_the_kept_one_and_equals_nv_flip() {
+    let golden = u8_image(24, 16, |x, y| [x as u8 * 9, y as u8 * 13, 40, 255]);
+    let actual = u8_image(24, 16, |x, y| {
+        [x as u8 * 9 + (x % 3) as u8, y as u8 * 13, 41, 255]
+    });
+    let rgb = |i: &Image| -> Vec<u8> {
+        let ImageData::U8(d) = &i.data else {
+            unreachable!()
+        };
+        d.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect()
+    };
+    let direct = |reference: &Image, test: &Image| {
+        nv_flip::flip(
+            nv_flip::FlipImageRgb8::with_data(24, 16, &rgb(reference)),
+            nv_flip::FlipImageRgb8::with_data(24, 16, &rgb(test)),
+            nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+        )
+        .to_vec()
+    };
+    let first = Pair::flip_map(&actual, &golden).unwrap();
+    assert_eq!(first, direct(&golden, &actual));
+    assert!(first.iter().any(|&v| v > 0.0));
+    // The second evaluation is the kept map; the swapped pair (FLIP is not symmetric) has its
+    // own.
+    assert_eq!(Pair::flip_map(&actual, &golden).unwrap(), first);
+    assert_eq!(
+        Pair::flip_map(&golden, &actual).unwrap(),
+        direct(&actual, &golden)
+    );
+}
+
+#[test]
 fn largest_difference_says_where_and_how_many() {
     let golden = u8_image(4, 3, |_, _| [10, 10, 10, 255]);
     let actual = u8_image(4, 3, |x, y| match (x, y) {
