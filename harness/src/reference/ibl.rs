@@ -395,9 +395,15 @@ fn light_buffer(frame: &Frame) -> &[f32] {
 
 /// Relative error (r + g + b) of the light buffer at one reference pixel.
 fn pixel_error(light: &[f32], r: &PixelReference) -> Option<f64> {
+    signed_pixel_error(light, r).map(f64::abs)
+}
+
+/// (render - reference) / reference of the sum r + g + b at a reference pixel: positive where
+/// the render is too bright.
+fn signed_pixel_error(light: &[f32], r: &PixelReference) -> Option<f64> {
     let g = light.get(r.index * 4..r.index * 4 + 3)?;
     let expected = r.radiance.element_sum();
-    Some((f64::from(g[0] + g[1] + g[2]) - expected).abs() / expected.max(1e-6))
+    Some((f64::from(g[0] + g[1] + g[2]) - expected) / expected.max(1e-6))
 }
 
 /// Relative error (r + g + b) of the light buffer at every reference pixel.
@@ -463,6 +469,9 @@ pub struct CellError {
     pub mean: f64,
     /// 95th percentile (nearest rank) of the cell's relative errors.
     pub p95: f64,
+    /// Mean signed relative error: positive where the render is brighter than the reference
+    /// on average, negative where darker (which way an approximation misses).
+    pub bias: f64,
     /// Reference pixels in the cell.
     pub pixels: usize,
 }
@@ -490,7 +499,7 @@ pub fn error_by_family(frame: &Frame, references: &[PixelReference]) -> Vec<Fami
     let light = light_buffer(frame);
     let mut groups: std::collections::BTreeMap<(&str, i64), Vec<f64>> = Default::default();
     for r in references {
-        let Some(error) = pixel_error(light, r) else {
+        let Some(error) = signed_pixel_error(light, r) else {
             continue;
         };
         groups
@@ -502,12 +511,15 @@ pub fn error_by_family(frame: &Frame, references: &[PixelReference]) -> Vec<Fami
             .push(error);
     }
     let mut rows: Vec<FamilyRow> = Vec::new();
-    for ((family, key), mut errors) in groups {
+    for ((family, key), signed) in groups {
+        let count = signed.len() as f64;
+        let mut errors: Vec<f64> = signed.iter().map(|e| e.abs()).collect();
         errors.sort_by(f64::total_cmp);
         let cell = CellError {
             roughness: key as f64 / 10.0,
-            mean: errors.iter().sum::<f64>() / errors.len() as f64,
+            mean: errors.iter().sum::<f64>() / count,
             p95: engine::stats::percentile_of_sorted(&errors, 0.95),
+            bias: signed.iter().sum::<f64>() / count,
             pixels: errors.len(),
         };
         match rows.iter_mut().find(|(f, _)| f == family) {
@@ -567,5 +579,22 @@ mod tests {
             "{value} +- {error}, expected {expected}"
         );
         assert!(error.x < 5e-3 * expected, "{error}");
+    }
+
+    /// The signed error says which way a pixel misses; the relative error is its size.
+    #[test]
+    fn a_pixel_too_bright_has_a_positive_signed_error_and_one_too_dark_a_negative() {
+        let reference = |index| PixelReference {
+            index,
+            surface: surface(0.5, 0.0, 0.5, 0.5),
+            radiance: DVec3::splat(1.0),
+            standard_error: DVec3::ZERO,
+        };
+        // Pixel 0 renders 6 (r + g + b against the reference's 3), pixel 1 renders 1.5.
+        let light = [2.0, 2.0, 2.0, 1.0, 0.5, 0.5, 0.5, 1.0];
+        assert_eq!(signed_pixel_error(&light, &reference(0)), Some(1.0));
+        assert_eq!(signed_pixel_error(&light, &reference(1)), Some(-0.5));
+        assert_eq!(pixel_error(&light, &reference(1)), Some(0.5));
+        assert_eq!(signed_pixel_error(&light, &reference(2)), None);
     }
 }

@@ -119,7 +119,7 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
     out.push_str("* = on the Pareto front of precompute time, lighting time and mean error\n");
     for row in family_rows(rows) {
         out.push_str(&format!(
-            "\n{}, relative error per material row (mean, then p95):\n",
+            "\n{}, relative error per material row (mean, p95, then the signed mean: + too bright):\n",
             row.setting
         ));
         for (family, cells) in &row.by_family {
@@ -130,6 +130,10 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
             out.push_str(&format!("\n{:<15} {:>13} {:>12}", "", "", "p95"));
             for cell in cells {
                 out.push_str(&format!(" {:>6.2}%", cell.p95 * 100.0));
+            }
+            out.push_str(&format!("\n{:<15} {:>13} {:>12}", "", "", "bias"));
+            for cell in cells {
+                out.push_str(&format!(" {:>+6.1}%", cell.bias * 100.0));
             }
             out.push('\n');
         }
