@@ -69,8 +69,9 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ImageFileError>
     })
 }
 
-/// How hard the PNG encoder works. Measured on the canonical goldens' PNGs (512x512): the
-/// smallest setting took 0.93 s for 727 KB, balanced 0.31 s for 751 KB, fast 0.04 s for 898 KB.
+/// How hard an image file's encoder works (PNG; for EXR, fast is RLE and the others ZIP).
+/// Measured on the canonical goldens' PNGs (512x512): the smallest setting took 0.93 s for
+/// 727 KB, balanced 0.31 s for 751 KB, fast 0.04 s for 898 KB.
 /// - Generated scene assets are written once and must regenerate byte for byte: smallest.
 /// - Goldens are kept in the repository and rewritten by every bless that changes them: balanced
 ///   (3% larger than the smallest for a third of the time; the encoding was half the CPU of
@@ -78,12 +79,12 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ImageFileError>
 /// - Outputs for looking at (renders, failure images, report previews) are written on every
 ///   run: fast.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PngCompression {
-    /// Best compression with adaptive filtering.
+pub enum FileCompression {
+    /// Best compression with adaptive filtering (EXR: ZIP).
     Smallest,
-    /// The encoder's default level with adaptive filtering.
+    /// The encoder's default level with adaptive filtering (EXR: ZIP).
     Balanced,
-    /// The encoder's fast mode.
+    /// The encoder's fast mode (EXR: RLE).
     Fast,
 }
 
@@ -91,7 +92,7 @@ pub enum PngCompression {
 pub fn encode_png(
     image: &Image,
     path: &Path,
-    compression: PngCompression,
+    compression: FileCompression,
 ) -> Result<Vec<u8>, ImageFileError> {
     let data = image.as_u8().ok_or_else(|| ImageFileError::Unsupported {
         path: path.to_owned(),
@@ -117,13 +118,13 @@ pub fn png_bytes(
     width: u32,
     height: u32,
     colour: image::ExtendedColorType,
-    compression: PngCompression,
+    compression: FileCompression,
 ) -> Result<Vec<u8>, image::ImageError> {
     use image::ImageEncoder;
     let level = match compression {
-        PngCompression::Smallest => image::codecs::png::CompressionType::Best,
-        PngCompression::Balanced => image::codecs::png::CompressionType::Default,
-        PngCompression::Fast => image::codecs::png::CompressionType::Fast,
+        FileCompression::Smallest => image::codecs::png::CompressionType::Best,
+        FileCompression::Balanced => image::codecs::png::CompressionType::Default,
+        FileCompression::Fast => image::codecs::png::CompressionType::Fast,
     };
     let mut out = Vec::new();
     image::codecs::png::PngEncoder::new_with_quality(
@@ -165,7 +166,7 @@ pub fn display_u8(image: &Image) -> Image {
 pub fn write_image(
     image: &Image,
     path: &Path,
-    compression: PngCompression,
+    compression: FileCompression,
 ) -> Result<(), ImageFileError> {
     let extension = path
         .extension()
@@ -182,12 +183,13 @@ pub fn write_image(
     }
 }
 
-/// EXR bytes of a float image: ZIP-compressed, or with [`PngCompression::Fast`] RLE (an
-/// output for looking at: ZIP's deflate was a tenth of a failing `check`'s CPU).
+/// EXR bytes of a float image: ZIP-compressed, or with [`FileCompression::Fast`] RLE (an
+/// output for looking at: ZIP's deflate was 5% of a failing `check`'s CPU in a profile, RLE's
+/// files 40% larger).
 pub fn encode_exr(
     image: &Image,
     path: &Path,
-    compression: PngCompression,
+    compression: FileCompression,
 ) -> Result<Vec<u8>, ImageFileError> {
     use exr::prelude::*;
     let data = image.as_f32().ok_or_else(|| ImageFileError::Unsupported {
@@ -206,8 +208,8 @@ pub fn encode_exr(
     // each time (a bless rewrote unchanged goldens, an accept could not equal a bless).
     let encoding = Encoding {
         compression: match compression {
-            PngCompression::Fast => Compression::RLE,
-            PngCompression::Balanced | PngCompression::Smallest => Compression::ZIP16,
+            FileCompression::Fast => Compression::RLE,
+            FileCompression::Balanced | FileCompression::Smallest => Compression::ZIP16,
         },
         line_order: LineOrder::Increasing,
         ..Encoding::FAST_LOSSLESS
@@ -334,7 +336,7 @@ mod tests {
             ),
         };
         let path = dir.join("rgba.exr");
-        write_image(&rgba, &path, PngCompression::Fast).unwrap();
+        write_image(&rgba, &path, FileCompression::Fast).unwrap();
         let back = read_exr(&path).unwrap();
         assert_eq!(back.data, rgba.data);
         let depth = Image {
@@ -344,7 +346,7 @@ mod tests {
             data: ImageData::F32(vec![0.1234567, 1.0, 0.5, 0.999_999_9]),
         };
         let path = dir.join("depth.exr");
-        write_image(&depth, &path, PngCompression::Fast).unwrap();
+        write_image(&depth, &path, FileCompression::Fast).unwrap();
         assert_eq!(read_exr(&path).unwrap().data, depth.data);
         let _ = std::fs::remove_dir_all(&dir);
     }
@@ -365,9 +367,9 @@ mod tests {
             ),
         };
         let path = Path::new("same.exr");
-        let first = encode_exr(&image, path, PngCompression::Balanced).unwrap();
+        let first = encode_exr(&image, path, FileCompression::Balanced).unwrap();
         for _ in 0..8 {
-            assert!(encode_exr(&image, path, PngCompression::Balanced).unwrap() == first);
+            assert!(encode_exr(&image, path, FileCompression::Balanced).unwrap() == first);
         }
     }
 
@@ -381,7 +383,7 @@ mod tests {
             data: ImageData::U8(vec![1, 2, 3, 255, 250, 128, 0, 255]),
         };
         let path = dir.join("a.png");
-        write_image(&image, &path, PngCompression::Fast).unwrap();
+        write_image(&image, &path, FileCompression::Fast).unwrap();
         assert_eq!(read_png(&path).unwrap().data, image.data);
         let _ = std::fs::remove_dir_all(&dir);
     }

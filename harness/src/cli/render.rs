@@ -66,7 +66,7 @@ pub(crate) fn run(
             Some(dir) => dir.join(file),
             None => default_dir.join(file),
         };
-        harness::images::write_image(image, &path, harness::images::PngCompression::Fast)?;
+        harness::images::write_image(image, &path, harness::images::FileCompression::Fast)?;
         println!("{:<17} -> {}", target.to_string(), path.display());
     }
     for pass in &plan.passes {

@@ -327,7 +327,7 @@ impl GoldenStore {
         }
         let eight_bit = is_eight_bit(image);
         let path = self.path(scene, pass, eight_bit);
-        images::write_image(image, &path, images::PngCompression::Balanced)?;
+        images::write_image(image, &path, images::FileCompression::Balanced)?;
         // A pass changing kind (PNG <-> EXR) must not leave the old file behind.
         let stale = self.path(scene, pass, !eight_bit);
         if stale.exists() {

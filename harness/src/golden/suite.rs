@@ -16,7 +16,7 @@ use crate::golden::noise::{NoiseError, NoiseModel};
 use crate::golden::pass_kind::{pass_kind, rule_shape};
 use crate::golden::tolerance::{Rule, RuleError};
 use crate::golden::{self, GoldenStore, Outcome};
-use crate::images::{self, PngCompression};
+use crate::images::{self, FileCompression};
 
 /// The backend goldens are blessed from by default (the others are checked against them).
 pub const REFERENCE_BACKEND: BackendKind = BackendKind::Gl;
@@ -550,12 +550,12 @@ pub fn write_artifacts(
         "exr"
     };
     let actual_path = dir.join(format!("{pass}_actual.{extension}"));
-    if images::write_image(actual, &actual_path, PngCompression::Fast).is_ok() {
+    if images::write_image(actual, &actual_path, FileCompression::Fast).is_ok() {
         artifacts.actual = Some(actual_path);
     }
     if let Some(golden) = golden {
         let golden_path = dir.join(format!("{pass}_golden.png"));
-        if images::write_image(golden, &golden_path, PngCompression::Fast).is_ok() {
+        if images::write_image(golden, &golden_path, FileCompression::Fast).is_ok() {
             artifacts.golden = Some(golden_path);
         }
         let scale = if golden::is_eight_bit(actual) {
@@ -565,7 +565,7 @@ pub fn write_artifacts(
         };
         if let Some(diff) = golden::diff_heatmap(actual, golden, scale) {
             let diff_path = dir.join(format!("{pass}_diff.png"));
-            if images::write_image(&diff, &diff_path, PngCompression::Fast).is_ok() {
+            if images::write_image(&diff, &diff_path, FileCompression::Fast).is_ok() {
                 artifacts.diff = Some(diff_path);
             }
         }

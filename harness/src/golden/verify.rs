@@ -223,7 +223,7 @@ pub fn verify(
     let candidate_store = GoldenStore::new(&golden);
     for (pass, image) in candidates {
         let path = candidate_store.path(case.name(), *pass, super::is_eight_bit(image));
-        crate::images::write_image(image, &path, crate::images::PngCompression::Fast)
+        crate::images::write_image(image, &path, crate::images::FileCompression::Fast)
             .map_err(|e| e.to_string())?;
     }
     // The same candidates of the same scene verified before, under the same drivers and

@@ -85,7 +85,7 @@ fn data_uri(image: &Image) -> String {
     let png = images::encode_png(
         image,
         std::path::Path::new("preview.png"),
-        images::PngCompression::Fast,
+        images::FileCompression::Fast,
     )
     .unwrap_or_default();
     format!(

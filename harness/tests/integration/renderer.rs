@@ -19,7 +19,7 @@ fn save(name: &str, image: &Image) {
     let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("renderer");
     std::fs::create_dir_all(&out).unwrap();
     let path = out.join(format!("{name}.png"));
-    harness::images::write_image(image, &path, harness::images::PngCompression::Fast).unwrap();
+    harness::images::write_image(image, &path, harness::images::FileCompression::Fast).unwrap();
 }
 
 /// The lighting pass against the f64 reference on the same G-buffer, 99.9th-percentile
