@@ -100,6 +100,40 @@ fn ibl_specular_sampled(s: Surface, v: vec3<f32>, f0: vec3<f32>, samples: u32) -
     return sum / count;
 }
 
+// The split sum of an anisotropic pixel as taps of the prefiltered cube (IBL_ANISOTROPIC_TAPS;
+// docs/renderer.md has the sweep behind each choice): the lobe stretched along the axis with the
+// larger alpha `at` read as ANISOTROPIC_TAPS lookups at half vectors tilted along that axis by
+// the stratified quantiles of the GGX slope marginal (`x = spread q / sqrt(1 - q^2)`, q the
+// midpoints of -1..1), each lookup's own alpha covering a third of the stretch (so neighbouring
+// taps overlap) or the narrow axis's `ab` where that is wider, leaned towards N by Frostbite's
+// rule at that alpha, and weighted down where it reflects below the surface (the masking and
+// n.l that the true integral applies there; without it the rough taps read up to 2x too bright).
+fn ibl_anisotropic_taps(s: Surface, v: vec3<f32>) -> vec3<f32> {
+    let n = s.normal;
+    let alpha = s.roughness * s.roughness + 0.001;
+    let at = alpha * (1.0 + abs(s.anisotropy));
+    let ab = alpha * (1.0 - abs(s.anisotropy));
+    // `at` lies on the tangent when anisotropy > 0 (ibl_specular_sampled's frame).
+    let wide_axis = select(s.tangent, cross(n, s.tangent), s.anisotropy < 0.0);
+    let wide = safe_normalize(wide_axis - n * dot(n, wide_axis), wide_axis);
+    let stretch = sqrt(max(at * at - ab * ab, 0.0));
+    let alpha_tap = min(max(ab, 0.35 * stretch), 1.0);
+    let spread = sqrt(max(at * at - alpha_tap * alpha_tap, 0.0));
+    let keep = (1.0 - alpha_tap) * (sqrt(1.0 - alpha_tap) + alpha_tap);
+    var sum = vec3<f32>(0.0);
+    for (var i = 0u; i < ANISOTROPIC_TAPS; i++) {
+        let q = (f32(i) + 0.5) / f32(ANISOTROPIC_TAPS) * 2.0 - 1.0;
+        let h = normalize(n + wide * (spread * q / sqrt(1.0 - q * q)));
+        let r = reflect(-v, h);
+        let horizon = clamp(4.0 * dot(n, r) + 0.5, 0.0, 1.0);
+        sum += ibl_prefiltered(safe_normalize(mix(n, r, keep), r), sqrt(alpha_tap)) * horizon;
+    }
+    return sum / f32(ANISOTROPIC_TAPS);
+}
+
+// Lookups per anisotropic pixel of ibl_anisotropic_taps.
+const ANISOTROPIC_TAPS: u32 = 4u;
+
 // Split-sum IBL of the PBR model (unexposed; the caller scales by u.ibl.x); the specular part by
 // filtered importance sampling instead when IBL_SAMPLES > 0.
 fn pbr_ibl(s: Surface, v: vec3<f32>, occlusion: f32) -> vec3<f32> {
@@ -149,6 +183,10 @@ fn pbr_ibl(s: Surface, v: vec3<f32>, occlusion: f32) -> vec3<f32> {
     if samples > 0u
         && s.roughness * s.roughness >= 2.0 / f32(textureDimensions(ibl_specular).x) {
         specular = ibl_specular_sampled(s, v, f0, samples);
+    } else if IBL_ANISOTROPIC_TAPS && ANISOTROPY && s.anisotropy != 0.0
+        && s.roughness * s.roughness >= 2.0 / f32(textureDimensions(ibl_specular).x) {
+        // (The same lobe-width test: a lobe narrower than a texel is one lookup.)
+        specular = ibl_anisotropic_taps(s, v) * e;
     } else {
         specular = ibl_prefiltered(dominant, s.roughness) * e;
     }

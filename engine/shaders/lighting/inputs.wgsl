@@ -50,6 +50,9 @@ override IBL_FOOTPRINT: f32 = 1.0;
 override IBL_ANISOTROPIC_SAMPLES: u32 = 0u;
 // The split sum's dominant direction: Lagarde and de Rousiers' (true) or Filament's.
 override IBL_FROSTBITE_DOMINANT: bool = false;
+// The split sum reads anisotropic pixels by taps along the wide axis instead of one lookup about
+// a bent normal.
+override IBL_ANISOTROPIC_TAPS: bool = false;
 // Whether any surface of this model can have clearcoat or anisotropy: per-pixel values, so when
 // true the shader still branches on the pixel's value.
 override CLEARCOAT: bool = true;

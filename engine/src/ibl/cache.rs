@@ -98,6 +98,7 @@ pub fn key(image: &EnvironmentImage, settings: &IblSettings) -> Key {
         runtime_footprint: IblSettings::default().runtime_footprint,
         anisotropic_samples: 0,
         dominant_direction: super::DominantDirection::default(),
+        anisotropic_lookup: super::AnisotropicLookup::default(),
         sun_shadow: true,
         ..settings.clone()
     };

@@ -37,7 +37,9 @@ pub use cube::{CubeLevel, CubeMap};
 
 use crate::scene::EnvironmentImage;
 
-pub use crate::scene::{DominantDirection, Footprint, IblSettings, IrradianceMethod};
+pub use crate::scene::{
+    AnisotropicLookup, DominantDirection, Footprint, IblSettings, IrradianceMethod,
+};
 
 /// The settings' line in plans and reports (it names the precompute's own constants).
 impl IblSettings {
@@ -79,6 +81,10 @@ impl IblSettings {
             String::new()
         } + if self.dominant_direction == DominantDirection::Frostbite {
             "; Frostbite's dominant direction"
+        } else {
+            ""
+        } + if self.anisotropic_lookup == AnisotropicLookup::Taps {
+            "; anisotropic pixels by taps"
         } else {
             ""
         }

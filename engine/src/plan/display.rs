@@ -103,6 +103,9 @@ impl fmt::Display for LightingVariant {
         if self.ibl && self.ibl_dominant == crate::scene::DominantDirection::Frostbite {
             write!(f, ", ibl frostbite dominant direction")?;
         }
+        if self.ibl && self.ibl_anisotropic_taps {
+            write!(f, ", ibl anisotropic taps")?;
+        }
         if self.ibl && self.ibl_anisotropic_samples > 0 {
             write!(
                 f,

@@ -53,6 +53,9 @@ pub struct LightingVariant {
     /// The split sum's dominant direction (`IBL_FROSTBITE_DOMINANT`, from `[quality.ibl]
     /// dominant_direction`).
     pub ibl_dominant: crate::scene::DominantDirection,
+    /// The split sum reads anisotropic pixels by taps (`IBL_ANISOTROPIC_TAPS`, from
+    /// `[quality.ibl] anisotropic_lookup`).
+    pub ibl_anisotropic_taps: bool,
     /// Some surface of the model has clearcoat (`CLEARCOAT`; the shader still branches per
     /// pixel when true).
     pub clearcoat: bool,
@@ -88,6 +91,7 @@ impl LightingVariant {
         self.ibl_anisotropic_samples = 0;
         self.ibl_footprint = crate::scene::Footprint::ONE;
         self.ibl_dominant = crate::scene::DominantDirection::Filament;
+        self.ibl_anisotropic_taps = false;
     }
 
     /// The pipeline-overridable constants of `lighting.wgsl`, by name, for this variant.
@@ -131,6 +135,7 @@ impl LightingVariant {
                 "IBL_FROSTBITE_DOMINANT",
                 flag(self.ibl_dominant == crate::scene::DominantDirection::Frostbite),
             ),
+            ("IBL_ANISOTROPIC_TAPS", flag(self.ibl_anisotropic_taps)),
             ("CLEARCOAT", flag(self.clearcoat)),
             ("ANISOTROPY", flag(self.anisotropy)),
             ("POSITION_MODE", position),
@@ -325,6 +330,7 @@ pub(super) fn lighting_passes(
                 ibl_footprint: crate::scene::Footprint::ONE,
                 ibl_anisotropic_samples: 0,
                 ibl_dominant: crate::scene::DominantDirection::Filament,
+                ibl_anisotropic_taps: false,
                 clearcoat: pbr
                     && materials().any(|m| m.clearcoat != 0.0 || m.clearcoat_map.is_some()),
                 anisotropy: pbr && materials().any(|m| m.anisotropy != 0.0),
@@ -379,6 +385,10 @@ pub(super) fn lighting_passes(
                                 } else {
                                     crate::scene::DominantDirection::Filament
                                 },
+                                ibl_anisotropic_taps: pbr_ibl
+                                    && base.anisotropy
+                                    && knobs.anisotropic_lookup
+                                        == crate::scene::AnisotropicLookup::Taps,
                                 ..base
                             },
                         };

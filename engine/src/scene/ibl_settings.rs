@@ -36,6 +36,20 @@ pub enum DominantDirection {
     Frostbite,
 }
 
+/// How the split sum reads an anisotropic pixel's lobe.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AnisotropicLookup {
+    /// One lookup about a normal bent towards the anisotropic direction (Filament's
+    /// getReflectedVector).
+    #[default]
+    BentNormal,
+    /// Four lookups at half vectors spread along the axis with the larger alpha, each leaned by
+    /// Frostbite's rule and weighted down where it reflects below the surface (measured in
+    /// docs/renderer.md).
+    Taps,
+}
+
 /// How many times its own solid angle a filtered importance sample reads (`[quality.ibl]
 /// runtime_footprint`): a power of two from 1/16 to 64, kept as its exponent so that settings
 /// compare and hash exactly. Written and read in scene files as the number (`0.25`, `1`, `4`).
@@ -126,6 +140,9 @@ pub struct IblSettings {
     /// The split sum's dominant direction (`filament` or `frostbite`). It changes no
     /// precomputed map.
     pub dominant_direction: DominantDirection,
+    /// How the split sum reads anisotropic pixels (`bent-normal` or `taps`). It changes no
+    /// precomputed map.
+    pub anisotropic_lookup: AnisotropicLookup,
     /// Cut the environment's sun out of the maps and light it as a directional light instead
     /// ([`crate::ibl::sun`]).
     pub extract_sun: bool,
@@ -149,6 +166,7 @@ impl Default for IblSettings {
             runtime_footprint: Footprint::ONE,
             anisotropic_samples: 0,
             dominant_direction: DominantDirection::Filament,
+            anisotropic_lookup: AnisotropicLookup::BentNormal,
             extract_sun: false,
             sun_shadow: true,
         }

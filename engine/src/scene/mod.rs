@@ -20,7 +20,9 @@ mod material;
 mod quality;
 mod validate;
 
-pub use ibl_settings::{DominantDirection, Footprint, IblSettings, IrradianceMethod};
+pub use ibl_settings::{
+    AnisotropicLookup, DominantDirection, Footprint, IblSettings, IrradianceMethod,
+};
 pub use light::{Light, ShadowFilter, ShadowSettings};
 pub use material::{LightingModel, Material, TextureIndex};
 pub use quality::{

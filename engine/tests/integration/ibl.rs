@@ -62,6 +62,7 @@ fn uniform_environment_gives_uniform_maps() {
             runtime_footprint: ibl::Footprint::ONE,
             anisotropic_samples: 0,
             dominant_direction: ibl::DominantDirection::Filament,
+            anisotropic_lookup: ibl::AnisotropicLookup::BentNormal,
             extract_sun: false,
             sun_shadow: true,
         };

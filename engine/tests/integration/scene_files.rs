@@ -390,3 +390,24 @@ fn the_ibl_dominant_direction_is_one_of_two_rules() {
     assert!(e.starts_with("dir/bad.toml:6:"), "{e}");
     assert!(e.contains("filament") && e.contains("frostbite"), "{e}");
 }
+
+/// `[quality.ibl] anisotropic_lookup` names one of the two ways, the bent normal by default, and
+/// another name is an error naming the line and the choices.
+#[test]
+fn the_ibl_anisotropic_lookup_is_one_of_two_ways() {
+    let with = |way: &str| format!("{CAMERA}\n[quality.ibl]\nanisotropic_lookup = \"{way}\"\n");
+    for (name, way) in [
+        ("bent-normal", engine::scene::AnisotropicLookup::BentNormal),
+        ("taps", engine::scene::AnisotropicLookup::Taps),
+    ] {
+        let scene = scene_file::parse(Path::new("dir/ok.toml"), &with(name)).unwrap();
+        assert_eq!(scene.quality.ibl.unwrap().anisotropic_lookup, way);
+    }
+    assert_eq!(
+        engine::scene::IblSettings::default().anisotropic_lookup,
+        engine::scene::AnisotropicLookup::BentNormal
+    );
+    let e = parse_err(&with("bent"));
+    assert!(e.starts_with("dir/bad.toml:6:"), "{e}");
+    assert!(e.contains("bent-normal") && e.contains("taps"), "{e}");
+}

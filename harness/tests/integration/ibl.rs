@@ -375,19 +375,20 @@ fn extracted_sun_reflects_as_a_disc() {
     }
 }
 
-/// `anisotropic_samples` samples the anisotropic pixels and nothing else: on every backend the
-/// ibl scene's light buffer changes only where the G-buffer holds a non-zero anisotropy (the
-/// albedo target's alpha), and there it does change.
+/// `anisotropic_samples` and `anisotropic_lookup = "taps"` change the anisotropic pixels and
+/// nothing else: on every backend the ibl scene's light buffer changes only where the G-buffer
+/// holds a non-zero anisotropy (the albedo target's alpha), and there it does change.
 #[test]
-fn anisotropic_samples_change_only_the_anisotropic_pixels() {
+fn anisotropic_knobs_change_only_the_anisotropic_pixels() {
     harness::use_ibl_cache();
     let scene = harness::load_scene("ibl").unwrap().scene;
     let mut sampled = scene.clone();
     sampled.quality.ibl.anisotropic_samples = 16;
+    let mut tapped = scene.clone();
+    tapped.quality.ibl.anisotropic_lookup = engine::scene::AnisotropicLookup::Taps;
     for kind in common::available_backends() {
         let mut backend = engine::backend::create(kind).unwrap();
         let split_sum = render(backend.as_mut(), &scene);
-        let anisotropic = render(backend.as_mut(), &sampled);
         fn light(frame: &Frame) -> &[f32] {
             frame.output(TargetId::Light).unwrap().as_f32().unwrap()
         }
@@ -396,27 +397,30 @@ fn anisotropic_samples_change_only_the_anisotropic_pixels() {
             .unwrap()
             .as_f32()
             .unwrap();
-        let (mut changed_anisotropic, mut changed_other) = (0, 0);
-        for (i, (a, b)) in light(&split_sum)
-            .chunks_exact(4)
-            .zip(light(&anisotropic).chunks_exact(4))
-            .enumerate()
-        {
-            if a != b {
-                if albedo[i * 4 + 3] != 0.0 {
-                    changed_anisotropic += 1;
-                } else {
-                    changed_other += 1;
+        for (knob, variant) in [("samples", &sampled), ("taps", &tapped)] {
+            let anisotropic = render(backend.as_mut(), variant);
+            let (mut changed_anisotropic, mut changed_other) = (0, 0);
+            for (i, (a, b)) in light(&split_sum)
+                .chunks_exact(4)
+                .zip(light(&anisotropic).chunks_exact(4))
+                .enumerate()
+            {
+                if a != b {
+                    if albedo[i * 4 + 3] != 0.0 {
+                        changed_anisotropic += 1;
+                    } else {
+                        changed_other += 1;
+                    }
                 }
             }
+            assert_eq!(
+                changed_other, 0,
+                "{kind} {knob}: pixels without anisotropy changed"
+            );
+            assert!(
+                changed_anisotropic > 1000,
+                "{kind} {knob}: only {changed_anisotropic} anisotropic pixels changed"
+            );
         }
-        assert_eq!(
-            changed_other, 0,
-            "{kind}: pixels without anisotropy changed"
-        );
-        assert!(
-            changed_anisotropic > 1000,
-            "{kind}: only {changed_anisotropic} anisotropic pixels changed"
-        );
     }
 }
