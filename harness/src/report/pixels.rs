@@ -85,7 +85,7 @@ impl Blobs {
             return same;
         }
         use std::io::Write as _;
-        // zlib's fastest level: the default level was over half of a failing `check`'s CPU
+        // zlib's fastest level: the default level was about half of a failing `check`'s CPU
         // (arrow and chess on three backends: 6.2 -> 3.3 CPU-s) for a page 11% smaller.
         let mut encoder = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
         // Writing to a Vec cannot fail.
