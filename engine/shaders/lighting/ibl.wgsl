@@ -134,8 +134,17 @@ fn ibl_anisotropic_taps(s: Surface, v: vec3<f32>) -> vec3<f32> {
 // Lookups per anisotropic pixel of ibl_anisotropic_taps.
 const ANISOTROPIC_TAPS: u32 = 4u;
 
+// Whether the surface's lobe is wider than a texel of the prefiltered cube's level 0 (GGX alpha
+// against the texel's 2 / size radians): a narrower lobe is the single level-0 lookup of the
+// split sum, whatever else the variant does there (samples' solid-angle lod would blur the tail
+// samples' reads, and taps would all read the same texel).
+fn lobe_wider_than_a_texel(s: Surface) -> bool {
+    return s.roughness * s.roughness >= 2.0 / f32(textureDimensions(ibl_specular).x);
+}
+
 // Split-sum IBL of the PBR model (unexposed; the caller scales by u.ibl.x); the specular part by
-// filtered importance sampling instead when IBL_SAMPLES > 0.
+// filtered importance sampling instead when IBL_SAMPLES > 0 (or IBL_ANISOTROPIC_SAMPLES on the
+// anisotropic pixels), or by taps on the anisotropic pixels with IBL_ANISOTROPIC_TAPS.
 fn pbr_ibl(s: Surface, v: vec3<f32>, occlusion: f32) -> vec3<f32> {
     let n = s.normal;
     let n_dot_v = max(dot(n, v), MIN_N_DOT_V);
@@ -176,16 +185,10 @@ fn pbr_ibl(s: Surface, v: vec3<f32>, occlusion: f32) -> vec3<f32> {
     if samples == 0u && ANISOTROPY && s.anisotropy != 0.0 {
         samples = IBL_ANISOTROPIC_SAMPLES;
     }
-    // Sampling only where the lobe is wider than a texel of the prefiltered cube's level 0 (GGX
-    // alpha against the texel's 2 / size radians): a narrower lobe is the level 0 lookup the
-    // split sum makes, while its samples' solid-angle lod would blur the tail samples' reads.
-    // (`&&` short-circuits: a variant without samples makes no size query.)
-    if samples > 0u
-        && s.roughness * s.roughness >= 2.0 / f32(textureDimensions(ibl_specular).x) {
+    // (`&&` short-circuits: a variant without samples or taps makes no size query.)
+    if samples > 0u && lobe_wider_than_a_texel(s) {
         specular = ibl_specular_sampled(s, v, f0, samples);
-    } else if IBL_ANISOTROPIC_TAPS && ANISOTROPY && s.anisotropy != 0.0
-        && s.roughness * s.roughness >= 2.0 / f32(textureDimensions(ibl_specular).x) {
-        // (The same lobe-width test: a lobe narrower than a texel is one lookup.)
+    } else if IBL_ANISOTROPIC_TAPS && ANISOTROPY && s.anisotropy != 0.0 && lobe_wider_than_a_texel(s) {
         specular = ibl_anisotropic_taps(s, v) * e;
     } else {
         specular = ibl_prefiltered(dominant, s.roughness) * e;

@@ -91,17 +91,8 @@ pub fn key(image: &EnvironmentImage, settings: &IblSettings) -> Key {
             hash.update(c.to_bits().to_le_bytes());
         }
     }
-    // The render-time knobs (sample count, the sun's shadow) change no map: maps are shared
-    // across them.
-    let maps_settings = IblSettings {
-        runtime_samples: 0,
-        runtime_footprint: IblSettings::default().runtime_footprint,
-        anisotropic_samples: 0,
-        dominant_direction: super::DominantDirection::default(),
-        anisotropic_lookup: super::AnisotropicLookup::default(),
-        sun_shadow: true,
-        ..settings.clone()
-    };
+    // The render-time knobs change no map: maps are shared across them.
+    let maps_settings = settings.precomputed_part();
     hash.update(
         serde_json::to_vec(&maps_settings).expect("IBL settings serialise"), // plain struct
     );
@@ -111,6 +102,9 @@ pub fn key(image: &EnvironmentImage, settings: &IblSettings) -> Key {
 /// [`key`], remembered per image object while it lives (so a second frame of the same scene
 /// does not hash its texels again).
 pub fn key_of_shared(image: &Arc<EnvironmentImage>, settings: &IblSettings) -> Key {
+    // Keyed by the precomputed part: settings that differ only in render-time knobs have the
+    // same key, so the image is not hashed again for each of them.
+    let settings = &settings.precomputed_part();
     let mut known = KNOWN_KEYS.lock().unwrap_or_else(|e| e.into_inner());
     known.retain(|(weak, _, _)| weak.strong_count() > 0);
     if let Some((_, _, key)) = known.iter().find(|(weak, s, _)| {

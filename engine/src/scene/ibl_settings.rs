@@ -174,6 +174,23 @@ impl Default for IblSettings {
 }
 
 impl IblSettings {
+    /// These settings with every knob that changes no precomputed map (the ones read at render
+    /// time: samples, footprint, dominant direction, anisotropic lookup, the sun's shadow) at its
+    /// default: what the maps are a function of, so settings that differ only there share maps.
+    /// A new render-time field belongs here too.
+    pub fn precomputed_part(&self) -> IblSettings {
+        let d = IblSettings::default();
+        IblSettings {
+            runtime_samples: d.runtime_samples,
+            runtime_footprint: d.runtime_footprint,
+            anisotropic_samples: d.anisotropic_samples,
+            dominant_direction: d.dominant_direction,
+            anisotropic_lookup: d.anisotropic_lookup,
+            sun_shadow: d.sun_shadow,
+            ..self.clone()
+        }
+    }
+
     /// Why these settings cannot be used, if they cannot.
     pub fn problem(&self) -> Option<String> {
         let pow2 = |v: u32| v.is_power_of_two();
