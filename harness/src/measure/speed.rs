@@ -206,6 +206,80 @@ pub fn probe_in_child(
     }
 }
 
+/// One child's share of a probe: `scenes` (names or scene files) on one backend.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProbeJob {
+    /// The backend.
+    pub backend: BackendKind,
+    /// Scene names or files, as the command line takes them.
+    pub scenes: Vec<String>,
+}
+
+impl ProbeJob {
+    /// Each of `scenes` on each of `backends`, a job (a child) apiece: small jobs spread evenly
+    /// over the cores, and a child that loads one scene starts sooner than one that loads all.
+    pub fn each(scenes: &[String], backends: &[BackendKind]) -> Vec<ProbeJob> {
+        backends
+            .iter()
+            .flat_map(|&backend| {
+                scenes.iter().map(move |scene| ProbeJob {
+                    backend,
+                    scenes: vec![scene.clone()],
+                })
+            })
+            .collect()
+    }
+}
+
+/// Children the probes run in at once: one per core (each probe rasterizes on one thread), or
+/// `HARNESS_PROBE_JOBS` (at least 1).
+pub fn probe_workers() -> usize {
+    std::env::var("HARNESS_PROBE_JOBS")
+        .ok()
+        .and_then(|v| v.trim().parse::<usize>().ok())
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        .max(1)
+}
+
+/// Runs each job in its own child ([`probe_in_child`]), [`probe_workers`] at a time: a probe
+/// rasterizes on one thread, so on a machine of N cores N jobs are timed in the time of one,
+/// each beside at most the other probes (the timing-noise model, the goldens and the
+/// checks are all probed this way). Results in the jobs' order.
+pub fn probe_in_children(
+    exe: &std::path::Path,
+    jobs: &[ProbeJob],
+    rounds: usize,
+    variations: Variations,
+    env: &[(String, String)],
+) -> (Vec<SceneSpeed>, Vec<String>) {
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    type Probed = (Vec<SceneSpeed>, Vec<String>);
+    let done: std::sync::Mutex<Vec<Option<Probed>>> = std::sync::Mutex::new(vec![None; jobs.len()]);
+    std::thread::scope(|scope| {
+        for _ in 0..probe_workers().min(jobs.len()) {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(job) = jobs.get(i) else { break };
+                let result =
+                    probe_in_child(exe, &job.scenes, &[job.backend], rounds, variations, env);
+                done.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(result);
+            });
+        }
+    });
+    let (mut probes, mut errors) = (Vec::new(), Vec::new());
+    let done = done.into_inner().unwrap_or_else(|e| e.into_inner());
+    for (job, result) in jobs.iter().zip(done) {
+        match result {
+            Some((p, e)) => {
+                probes.extend(p);
+                errors.extend(e);
+            }
+            None => errors.push(format!("{}: the speed probe did not run", job.backend)),
+        }
+    }
+    (probes, errors)
+}
+
 /// A floor is timed at least this long (repeated in one submission), ms.
 pub const MIN_FLOOR_MS: f64 = 1.0;
 /// At most this many copies of a floor per sample.
@@ -319,6 +393,27 @@ mod tests {
         assert!(settled(&speed(&[2.0, 1.9, 2.1, 1.95], &floor)));
         assert!(!settled(&speed(&[2.0, 2.0, 2.0, 1.5], &floor)));
         assert!(!settled(&speed(&[2.0; 4], &[1.0, 1.0, 0.9, 1.0])));
+    }
+
+    #[test]
+    fn each_scene_and_backend_is_a_job_in_order() {
+        let scenes = ["arrow".to_owned(), "chess".to_owned()];
+        let jobs = ProbeJob::each(&scenes, &[BackendKind::Gl, BackendKind::WgpuVulkan]);
+        let order: Vec<(BackendKind, &str)> = jobs
+            .iter()
+            .map(|j| (j.backend, j.scenes.join(",")))
+            .map(|(b, s)| (b, if s == "arrow" { "arrow" } else { "chess" }))
+            .collect();
+        assert_eq!(
+            order,
+            [
+                (BackendKind::Gl, "arrow"),
+                (BackendKind::Gl, "chess"),
+                (BackendKind::WgpuVulkan, "arrow"),
+                (BackendKind::WgpuVulkan, "chess"),
+            ]
+        );
+        assert!(probe_workers() >= 1);
     }
 
     #[test]
