@@ -9,8 +9,8 @@
 //!
 //! The speed checks are tests too, `<scene>::speed::<pass>::<backend>`, the verdicts of
 //! `harness check`: every backend's scenes are probed once, as `check` probes them (a child
-//! process per scene and backend, the harness binary on one rasterizer thread, as many at once
-//! as there are cores), while no render of this process runs. `HARNESS_NO_SPEED=1`
+//! process per backend, the harness binary on one rasterizer thread, as many at once as there
+//! are idle cores), while no render of this process runs. `HARNESS_NO_SPEED=1`
 //! marks them ignored.
 
 use std::collections::HashMap;
@@ -61,7 +61,7 @@ impl Suite {
     }
 
     /// The speed checks of every scene on every available backend, probed once, as `harness
-    /// check` probes them (a child process per scene and backend, as many at once as there are
+    /// check` probes them (a child process per backend, as many at once as there are idle
     /// cores).
     fn probe(&self) -> &Probed {
         self.probes.get_or_init(|| {

@@ -227,12 +227,11 @@ pub(crate) fn speed(
         }
     }
     eprintln!(
-        "probing {} scene(s) on {} ({rounds} rounds, one rasterizer thread, {} at once) ...",
+        "probing {} scene(s) on {} ({rounds} rounds, one rasterizer thread, a child per idle core) ...",
         names.len(),
         harness::names(&available),
-        harness::measure::speed::probe_workers().min(available.len().max(1))
     );
-    let jobs = harness::measure::speed::ProbeJob::each(&names, &available);
+    let jobs = harness::measure::speed::ProbeJob::per_backend(&names, &available);
     let (results, errors) =
         harness::measure::speed::probe_in_children(&exe, &jobs, rounds, variations, &[]);
     for e in &errors {

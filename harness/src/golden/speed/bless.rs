@@ -94,7 +94,7 @@ pub fn bless_scenes(
     // Every backend probed as a check probes them (in children side by side), BLESS_PROBES
     // times.
     let kinds: Vec<BackendKind> = backends.iter().map(|(kind, _)| *kind).collect();
-    let jobs = ProbeJob::each(&arguments, &kinds);
+    let jobs = ProbeJob::per_backend(&arguments, &kinds);
     let mut probes: BTreeMap<(BackendKind, String), Vec<SceneSpeed>> = BTreeMap::new();
     for round in 1..=BLESS_PROBES {
         progress(&format!(

@@ -166,7 +166,7 @@ pub fn measure_timing(
         }
     }
     let mut worst: BTreeMap<(String, String, BackendKind, PassId), (Tier, f64)> = BTreeMap::new();
-    let jobs = crate::measure::speed::ProbeJob::each(&arguments, backends);
+    let jobs = crate::measure::speed::ProbeJob::per_backend(&arguments, backends);
     for source in sources {
         for probe_index in 1..=source.probes {
             progress(&format!(

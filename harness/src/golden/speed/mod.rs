@@ -152,8 +152,8 @@ impl SpeedRun {
 }
 
 /// Probes each of `scenes` (their command-line arguments, names or files) on each backend of
-/// `backends` (with its driver fingerprint) in child processes of `exe`, one per scene and
-/// backend and as many at once as there are cores ([`probe_in_children`]), and checks every pass against the
+/// `backends` (with its driver fingerprint) in child processes of `exe`, one per backend and as
+/// many at once as there are idle cores ([`probe_in_children`]), and checks every pass against the
 /// goldens under `root` and the timing-noise model there. A scene with a slower pass is probed
 /// once more and judged on the samples of both probes. `variations` are the
 /// slowdowns a self-test injects (none for a plain check); `env` is added to the children's.
@@ -178,14 +178,15 @@ pub fn check_scenes(
         .iter()
         .map(|(_, argument)| argument.clone())
         .collect();
-    // A child per scene and backend, as many at once as there are cores.
+    // A child per backend (one process start and each scene loaded once per backend), as many
+    // at once as there are idle cores.
     progress(&format!(
         "timing {} scene(s) on {}",
         scenes.len(),
         crate::names(&backends.iter().map(|(k, _)| *k).collect::<Vec<_>>())
     ));
     let kinds: Vec<BackendKind> = backends.iter().map(|(kind, _)| *kind).collect();
-    let jobs = ProbeJob::each(&arguments, &kinds);
+    let jobs = ProbeJob::per_backend(&arguments, &kinds);
     let (probes, errors) = probe_in_children(exe, &jobs, CHECK_ROUNDS, variations, env);
     run.errors.extend(errors);
     let mut judged = Vec::new();
