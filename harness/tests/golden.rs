@@ -8,9 +8,8 @@
 //! backend's outputs instead of checking them, and checks the other backends against those.
 //!
 //! The speed checks are tests too, `<scene>::speed::<pass>::<backend>`, the verdicts of
-//! `harness check`: every backend's scenes are probed once, as `check` probes them (a child
-//! process per backend, the harness binary on one rasterizer thread, as many at once as there
-//! are idle cores), while no render of this process runs. `HARNESS_NO_SPEED=1`
+//! `harness check`: each backend's scenes are probed once, in a child process (the harness
+//! binary, one rasterizer thread), while no render of this process runs. `HARNESS_NO_SPEED=1`
 //! marks them ignored.
 
 use std::collections::HashMap;
@@ -25,8 +24,7 @@ use harness::golden::{self, GoldenStore};
 use libtest_mimic::{Arguments, Failed, Trial};
 
 type Rendered = Arc<OnceLock<Result<Frame, String>>>;
-/// Each backend's speed checks, or why its probe failed.
-type Probed = HashMap<BackendKind, Result<Vec<harness::golden::speed::SpeedCheck>, String>>;
+type Probed = Arc<OnceLock<Result<Vec<harness::golden::speed::SpeedCheck>, String>>>;
 
 /// Held for reading by every render and for writing by every speed probe: a probe times its
 /// passes while this process renders nothing.
@@ -36,9 +34,7 @@ struct Suite {
     cases: Vec<Case>,
     store: GoldenStore,
     frames: Mutex<HashMap<(usize, BackendKind), Rendered>>,
-    /// The backends available here.
-    available: Vec<BackendKind>,
-    probes: OnceLock<Probed>,
+    probes: Mutex<HashMap<BackendKind, Probed>>,
     update: bool,
     /// Checks that did not pass, for the HTML report written at the end.
     failures: Mutex<Vec<harness::golden::suite::PassCheck>>,
@@ -60,23 +56,22 @@ impl Suite {
         cell
     }
 
-    /// The speed checks of every scene on every available backend, probed once, as `harness
-    /// check` probes them (a child process per backend, as many at once as there are idle
-    /// cores).
-    fn probe(&self) -> &Probed {
-        self.probes.get_or_init(|| {
+    /// The speed checks of every scene on one backend, probed once (one child process: one
+    /// start and one compile of each scene's pipelines for the backend).
+    fn probe(&self, kind: BackendKind) -> Probed {
+        let cell = self
+            .probes
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .entry(kind)
+            .or_default()
+            .clone();
+        cell.get_or_init(|| {
             let _quiet = QUIET.write().unwrap_or_else(|e| e.into_inner());
-            let backends: Vec<(BackendKind, String)> = self
-                .available
-                .iter()
-                .map(|&kind| {
-                    let driver = backend::probe(kind)
-                        .info
-                        .map(|info| golden::fingerprint(&info))
-                        .unwrap_or_default();
-                    (kind, driver)
-                })
-                .collect();
+            let driver = backend::probe(kind)
+                .info
+                .map(|info| golden::fingerprint(&info))
+                .unwrap_or_default();
             let scenes: Vec<(String, String)> = self
                 .cases
                 .iter()
@@ -86,36 +81,17 @@ impl Suite {
                 std::path::Path::new(env!("CARGO_BIN_EXE_harness")),
                 self.store.root(),
                 &scenes,
-                &backends,
+                &[(kind, driver)],
                 Default::default(),
                 &[],
                 |_| {},
             );
-            // An error names its backend first ("gl: ..."); one that names none is every
-            // backend's.
-            self.available
-                .iter()
-                .map(|&kind| {
-                    let prefix = format!("{kind}: ");
-                    let error = run.errors.iter().find(|e| {
-                        e.starts_with(&prefix)
-                            || !BackendKind::ALL
-                                .iter()
-                                .any(|k| e.starts_with(&format!("{k}: ")))
-                    });
-                    let result = match error {
-                        Some(e) => Err(e.clone()),
-                        None => Ok(run
-                            .checks
-                            .iter()
-                            .filter(|c| c.backend == kind)
-                            .cloned()
-                            .collect()),
-                    };
-                    (kind, result)
-                })
-                .collect()
-        })
+            match run.errors.first() {
+                Some(e) => Err(e.clone()),
+                None => Ok(run.checks),
+            }
+        });
+        cell
     }
 
     /// The speed checks of one scene on one backend.
@@ -124,15 +100,16 @@ impl Suite {
         case: usize,
         kind: BackendKind,
     ) -> Result<Vec<harness::golden::speed::SpeedCheck>, Failed> {
+        let probed = self.probe(kind);
         let scene = self.cases[case].name();
-        match self.probe().get(&kind) {
+        match probed.get() {
             Some(Ok(checks)) => Ok(checks
                 .iter()
                 .filter(|c| c.scene == scene)
                 .cloned()
                 .collect()),
             Some(Err(e)) => Err(format!("speed probe failed: {e}").into()),
-            None => Err(format!("{kind} was not probed").into()),
+            None => Err("speed probe did not run".into()),
         }
     }
 
@@ -305,8 +282,7 @@ fn main() {
         cases,
         store: GoldenStore::workspace(),
         frames: Mutex::default(),
-        available: available.clone(),
-        probes: OnceLock::new(),
+        probes: Mutex::default(),
         update: std::env::var("UPDATE_GOLDENS").is_ok_and(|v| v == "1"),
         failures: Mutex::default(),
     });

@@ -215,31 +215,31 @@ pub(crate) fn speed(
     let exe = std::env::current_exe()?;
     let names = scenes_or_canonical(scenes);
     let kinds = backends_or_all(backends);
+    let mut results = Vec::new();
     let mut failed = false;
-    let mut available = Vec::new();
     for kind in kinds {
         let status = engine::backend::probe(kind);
-        if status.available {
-            available.push(kind);
-        } else {
+        if !status.available {
             eprintln!("skipping {kind}: {}", status.reason.unwrap_or_default());
             failed |= !backends.is_empty();
+            continue;
         }
-    }
-    eprintln!(
-        "probing {} scene(s) on {} ({rounds} rounds, one rasterizer thread, a child per idle core) ...",
-        names.len(),
-        harness::names(&available),
-    );
-    let jobs = harness::measure::speed::ProbeJob::per_backend(&names, &available);
-    let (results, errors) =
-        harness::measure::speed::probe_in_children(&exe, &jobs, rounds, variations, &[]);
-    for e in &errors {
-        eprintln!("error: {e}");
-    }
-    failed |= !errors.is_empty();
-    if !json {
-        results.iter().for_each(print_speed);
+        eprintln!(
+            "probing {} scene(s) on {kind} ({rounds} rounds, one rasterizer thread) ...",
+            names.len()
+        );
+        let (probed, errors) =
+            harness::measure::speed::probe_in_child(&exe, &names, &[kind], rounds, variations, &[]);
+        for e in &errors {
+            eprintln!("error: {e}");
+        }
+        failed |= !errors.is_empty();
+        for result in probed {
+            if !json {
+                print_speed(&result);
+            }
+            results.push(result);
+        }
     }
     if json {
         println!("{}", serde_json::to_string_pretty(&results)?);

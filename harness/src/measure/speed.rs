@@ -206,109 +206,6 @@ pub fn probe_in_child(
     }
 }
 
-/// One child's share of a probe: `scenes` (names or scene files) on one backend.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ProbeJob {
-    /// The backend.
-    pub backend: BackendKind,
-    /// Scene names or files, as the command line takes them.
-    pub scenes: Vec<String>,
-}
-
-impl ProbeJob {
-    /// `scenes` on each of `backends`, a job (a child) per backend: one process start, and each
-    /// scene loaded once, per backend.
-    pub fn per_backend(scenes: &[String], backends: &[BackendKind]) -> Vec<ProbeJob> {
-        backends
-            .iter()
-            .map(|&backend| ProbeJob {
-                backend,
-                scenes: scenes.to_vec(),
-            })
-            .collect()
-    }
-}
-
-/// Children the probes run in at once: `HARNESS_PROBE_JOBS`, or one per idle core (each probe
-/// rasterizes on one thread), at least one. A core that something else keeps busy is left to
-/// it: two probes beside a busy neighbour on two cores would share a core by turns, which no
-/// fastest-of-several sample filters out (measured: ratios up to x2.2 above their goldens,
-/// against x1.3 for one probe beside the same neighbour).
-pub fn probe_workers() -> usize {
-    if let Some(jobs) = std::env::var("HARNESS_PROBE_JOBS")
-        .ok()
-        .and_then(|v| v.trim().parse::<usize>().ok())
-    {
-        return jobs.max(1);
-    }
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let idle = idle_cores(std::time::Duration::from_millis(200)).unwrap_or(cores as f64);
-    // A core counts as idle when at least three quarters of it is.
-    ((idle + 0.25).floor() as usize).clamp(1, cores)
-}
-
-/// How many cores' worth of time went idle over `window` (Linux: `/proc/stat`); `None` where
-/// it cannot be read.
-fn idle_cores(window: std::time::Duration) -> Option<f64> {
-    // (idle + iowait, every field) of the all-CPU line, in ticks.
-    fn ticks() -> Option<(u64, u64)> {
-        let stat = std::fs::read_to_string("/proc/stat").ok()?;
-        let line = stat.lines().find(|l| l.starts_with("cpu "))?;
-        let fields: Vec<u64> = line
-            .split_whitespace()
-            .skip(1)
-            .filter_map(|f| f.parse().ok())
-            .collect();
-        let idle = fields.get(3)? + fields.get(4).copied().unwrap_or(0);
-        Some((idle, fields.iter().take(8).sum()))
-    }
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
-    let (idle0, total0) = ticks()?;
-    std::thread::sleep(window);
-    let (idle1, total1) = ticks()?;
-    let total = total1.checked_sub(total0).filter(|&t| t > 0)?;
-    Some(cores * idle1.saturating_sub(idle0) as f64 / total as f64)
-}
-
-/// Runs each job in its own child ([`probe_in_child`]), [`probe_workers`] at a time: a probe
-/// rasterizes on one thread, so on a machine of N idle cores N jobs are timed in the time of
-/// one, each beside at most the other probes (the timing-noise model, the goldens and the
-/// checks are all probed this way). Results in the jobs' order.
-pub fn probe_in_children(
-    exe: &std::path::Path,
-    jobs: &[ProbeJob],
-    rounds: usize,
-    variations: Variations,
-    env: &[(String, String)],
-) -> (Vec<SceneSpeed>, Vec<String>) {
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    type Probed = (Vec<SceneSpeed>, Vec<String>);
-    let done: std::sync::Mutex<Vec<Option<Probed>>> = std::sync::Mutex::new(vec![None; jobs.len()]);
-    std::thread::scope(|scope| {
-        for _ in 0..probe_workers().min(jobs.len()).max(1) {
-            scope.spawn(|| loop {
-                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                let Some(job) = jobs.get(i) else { break };
-                let result =
-                    probe_in_child(exe, &job.scenes, &[job.backend], rounds, variations, env);
-                done.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(result);
-            });
-        }
-    });
-    let (mut probes, mut errors) = (Vec::new(), Vec::new());
-    let done = done.into_inner().unwrap_or_else(|e| e.into_inner());
-    for (job, result) in jobs.iter().zip(done) {
-        match result {
-            Some((p, e)) => {
-                probes.extend(p);
-                errors.extend(e);
-            }
-            None => errors.push(format!("{}: the speed probe did not run", job.backend)),
-        }
-    }
-    (probes, errors)
-}
-
 /// A floor is timed at least this long (repeated in one submission), ms.
 pub const MIN_FLOOR_MS: f64 = 1.0;
 /// At most this many copies of a floor per sample.
@@ -422,27 +319,6 @@ mod tests {
         assert!(settled(&speed(&[2.0, 1.9, 2.1, 1.95], &floor)));
         assert!(!settled(&speed(&[2.0, 2.0, 2.0, 1.5], &floor)));
         assert!(!settled(&speed(&[2.0; 4], &[1.0, 1.0, 0.9, 1.0])));
-    }
-
-    #[test]
-    fn a_job_per_backend_with_every_scene() {
-        let scenes = ["arrow".to_owned(), "chess".to_owned()];
-        let jobs = ProbeJob::per_backend(&scenes, &[BackendKind::Gl, BackendKind::WgpuVulkan]);
-        assert_eq!(jobs.len(), 2);
-        assert_eq!(
-            (jobs[0].backend, jobs[1].backend),
-            (BackendKind::Gl, BackendKind::WgpuVulkan)
-        );
-        assert!(jobs.iter().all(|j| j.scenes == scenes));
-        assert!(probe_workers() >= 1);
-    }
-
-    #[test]
-    fn idle_cores_are_between_none_and_all() {
-        let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
-        if let Some(idle) = idle_cores(std::time::Duration::from_millis(50)) {
-            assert!((0.0..=cores + 1e-9).contains(&idle), "{idle} of {cores}");
-        }
     }
 
     #[test]

@@ -12,7 +12,7 @@ use super::{
     check_speed, host_fingerprint, SpeedError, SpeedOutcome, TimingGoldens, TimingNoise,
     BLESS_PROBES, CHECK_ROUNDS,
 };
-use crate::measure::speed::{probe_in_children, PassSpeed, ProbeJob, SceneSpeed};
+use crate::measure::speed::{PassSpeed, SceneSpeed};
 
 /// Each pass's probe with the median ratio over `probes` of one scene and backend (the upper
 /// one of an even count).
@@ -75,7 +75,7 @@ impl std::fmt::Display for SpeedBlessed {
 }
 
 /// Probes `scenes` (name, command-line argument) on each of `backends` (with its driver
-/// fingerprint) [`BLESS_PROBES`] times in child processes of `exe`, as a check does, and rewrites the timing
+/// fingerprint) [`BLESS_PROBES`] times in child processes of `exe` and rewrites the timing
 /// goldens under `root` that moved beyond their limit or are missing (every one with
 /// `every_pass`; none with `dry_run`).
 pub fn bless_scenes(
@@ -91,35 +91,30 @@ pub fn bless_scenes(
     let arguments: Vec<String> = scenes.iter().map(|(_, a)| a.clone()).collect();
     let blessed = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string();
     let mut lines = Vec::new();
-    // Every backend probed as a check probes them (in children side by side), BLESS_PROBES
-    // times.
-    let kinds: Vec<BackendKind> = backends.iter().map(|(kind, _)| *kind).collect();
-    let jobs = ProbeJob::per_backend(&arguments, &kinds);
-    let mut probes: BTreeMap<(BackendKind, String), Vec<SceneSpeed>> = BTreeMap::new();
-    for round in 1..=BLESS_PROBES {
-        progress(&format!(
-            "timing on {}, probe {round} of {BLESS_PROBES}",
-            crate::names(&kinds)
-        ));
-        let (results, errors) =
-            probe_in_children(exe, &jobs, CHECK_ROUNDS, Default::default(), &[]);
-        if let Some(error) = errors.first() {
-            return Err(SpeedError::Probe(error.clone()));
-        }
-        for result in results {
-            probes
-                .entry((result.backend, result.scene.clone()))
-                .or_default()
-                .push(result);
-        }
-    }
     for (kind, driver) in backends {
         let host = host_fingerprint(driver);
+        let mut probes: BTreeMap<String, Vec<SceneSpeed>> = BTreeMap::new();
+        for round in 1..=BLESS_PROBES {
+            progress(&format!(
+                "timing on {kind}, probe {round} of {BLESS_PROBES}"
+            ));
+            let (results, errors) = crate::measure::speed::probe_in_child(
+                exe,
+                &arguments,
+                &[*kind],
+                CHECK_ROUNDS,
+                Default::default(),
+                &[],
+            );
+            if let Some(error) = errors.first() {
+                return Err(SpeedError::Probe(error.clone()));
+            }
+            for result in results {
+                probes.entry(result.scene.clone()).or_default().push(result);
+            }
+        }
         for (scene, _) in scenes {
-            let Some(probe) = probes
-                .get(&(*kind, scene.clone()))
-                .and_then(|p| median_probe(p))
-            else {
+            let Some(probe) = probes.get(scene).and_then(|p| median_probe(p)) else {
                 return Err(SpeedError::Probe(format!(
                     "{kind}: scene {scene} was not probed"
                 )));

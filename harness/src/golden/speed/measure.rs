@@ -166,42 +166,40 @@ pub fn measure_timing(
         }
     }
     let mut worst: BTreeMap<(String, String, BackendKind, PassId), (Tier, f64)> = BTreeMap::new();
-    let jobs = crate::measure::speed::ProbeJob::per_backend(&arguments, backends);
     for source in sources {
-        for probe_index in 1..=source.probes {
-            progress(&format!(
-                "{} on {}, probe {probe_index} of {}",
-                source.name,
-                crate::names(backends),
-                source.probes
-            ));
-            // Every backend at once, as a check probes them.
-            let _neighbour = source.busy.then(BusyNeighbour::start);
-            let (probes, failed) = crate::measure::speed::probe_in_children(
-                exe,
-                &jobs,
-                CHECK_ROUNDS,
-                Default::default(),
-                &source.env,
-            );
-            errors.extend(failed.into_iter().map(|e| format!("{}: {e}", source.name)));
-            for probe in probes {
-                let kind = probe.backend;
-                let Some(golden) = goldens
-                    .get(&probe.scene)
-                    .and_then(|g| g.backends.get(&kind))
-                else {
-                    continue;
-                };
-                for pass in &probe.passes {
-                    let (Some(ratio), Some(g)) = (pass.ratio(), golden.passes.get(&pass.pass))
+        for &kind in backends {
+            for probe_index in 1..=source.probes {
+                progress(&format!(
+                    "{} on {kind}, probe {probe_index} of {}",
+                    source.name, source.probes
+                ));
+                let _neighbour = source.busy.then(BusyNeighbour::start);
+                let (probes, failed) = crate::measure::speed::probe_in_child(
+                    exe,
+                    &arguments,
+                    &[kind],
+                    CHECK_ROUNDS,
+                    Default::default(),
+                    &source.env,
+                );
+                errors.extend(failed.into_iter().map(|e| format!("{}: {e}", source.name)));
+                for probe in probes {
+                    let Some(golden) = goldens
+                        .get(&probe.scene)
+                        .and_then(|g| g.backends.get(&kind))
                     else {
                         continue;
                     };
-                    let factor = ratio / g.ratio;
-                    let key = (source.name.clone(), probe.scene.clone(), kind, pass.pass);
-                    let entry = worst.entry(key).or_insert((source.tier, factor));
-                    entry.1 = entry.1.max(factor);
+                    for pass in &probe.passes {
+                        let (Some(ratio), Some(g)) = (pass.ratio(), golden.passes.get(&pass.pass))
+                        else {
+                            continue;
+                        };
+                        let factor = ratio / g.ratio;
+                        let key = (source.name.clone(), probe.scene.clone(), kind, pass.pass);
+                        let entry = worst.entry(key).or_insert((source.tier, factor));
+                        entry.1 = entry.1.max(factor);
+                    }
                 }
             }
         }

@@ -34,8 +34,6 @@ mod verdict;
 
 use engine::backend::BackendKind;
 
-use crate::measure::speed::{probe_in_children, ProbeJob};
-
 pub use bless::{bless_scenes, median_probe, SpeedBlessed};
 pub use goldens::{BackendTimings, PassTiming, TimingGoldens, TIMING_FILE};
 pub use model::{PassNoise, Tier, TimingNoise, TIMING_NOISE_FILE};
@@ -152,10 +150,9 @@ impl SpeedRun {
 }
 
 /// Probes each of `scenes` (their command-line arguments, names or files) on each backend of
-/// `backends` (with its driver fingerprint) in child processes of `exe`, one per backend and as
-/// many at once as there are idle cores ([`probe_in_children`]), and checks every pass against the
-/// goldens under `root` and the timing-noise model there. A scene with a slower pass is probed
-/// once more and judged on the samples of both probes. `variations` are the
+/// `backends` (with its driver fingerprint) in a child process of `exe`, and checks every pass
+/// against the goldens under `root` and the timing-noise model there. A scene with a slower
+/// pass is probed once more and judged on the samples of both probes. `variations` are the
 /// slowdowns a self-test injects (none for a plain check); `env` is added to the children's.
 pub fn check_scenes(
     exe: &std::path::Path,
@@ -178,66 +175,58 @@ pub fn check_scenes(
         .iter()
         .map(|(_, argument)| argument.clone())
         .collect();
-    // A child per backend (one process start and each scene loaded once per backend), as many
-    // at once as there are idle cores.
+    // One child for every backend: a process start and the scenes' loading once.
     progress(&format!(
         "timing {} scene(s) on {}",
         scenes.len(),
         crate::names(&backends.iter().map(|(k, _)| *k).collect::<Vec<_>>())
     ));
     let kinds: Vec<BackendKind> = backends.iter().map(|(kind, _)| *kind).collect();
-    let jobs = ProbeJob::per_backend(&arguments, &kinds);
-    let (probes, errors) = probe_in_children(exe, &jobs, CHECK_ROUNDS, variations, env);
+    let (probes, errors) = crate::measure::speed::probe_in_child(
+        exe,
+        &arguments,
+        &kinds,
+        CHECK_ROUNDS,
+        variations,
+        env,
+    );
     run.errors.extend(errors);
-    let mut judged = Vec::new();
     for probe in probes {
+        let kind = probe.backend;
         let driver = backends
             .iter()
-            .find(|(k, _)| *k == probe.backend)
+            .find(|(k, _)| *k == kind)
             .map_or("", |(_, d)| d.as_str());
         let host = host_fingerprint(driver);
-        match TimingGoldens::load(root, &probe.scene) {
-            Ok(goldens) => {
-                let checks = check_speed(&probe, &goldens, &noise, &host);
-                judged.push((probe, goldens, host, checks));
+        let goldens = match TimingGoldens::load(root, &probe.scene) {
+            Ok(goldens) => goldens,
+            Err(e) => {
+                run.errors.push(e.to_string());
+                continue;
             }
-            Err(e) => run.errors.push(e.to_string()),
-        }
-    }
-    // Confirm: probe each scene with a slower pass again and judge the samples of both. A real
-    // slowdown stays; a probe that met a noisy moment in every round of a pass does not.
-    let confirm: Vec<ProbeJob> = judged
-        .iter()
-        .filter(|(.., checks)| checks.iter().any(|c| c.outcome == SpeedOutcome::Slower))
-        .map(|(probe, ..)| ProbeJob {
-            backend: probe.backend,
-            scenes: vec![scenes
+        };
+        let mut checks = check_speed(&probe, &goldens, &noise, &host);
+        if checks.iter().any(|c| c.outcome == SpeedOutcome::Slower) {
+            // Confirm: probe the scene again and judge the samples of both. A real slowdown
+            // stays; a probe that met a noisy moment in every round of a pass does not.
+            let argument = scenes
                 .iter()
                 .find(|(name, _)| *name == probe.scene)
-                .map_or_else(|| probe.scene.clone(), |(_, a)| a.clone())],
-        })
-        .collect();
-    if !confirm.is_empty() {
-        progress(&format!(
-            "confirming {}",
-            confirm
-                .iter()
-                .map(|j| format!("{} on {}", j.scenes.join(", "), j.backend))
-                .collect::<Vec<_>>()
-                .join("; ")
-        ));
-        let (again, errors) = probe_in_children(exe, &confirm, CHECK_ROUNDS, variations, env);
-        run.errors.extend(errors);
-        for (probe, goldens, host, checks) in &mut judged {
-            if let Some(again) = again
-                .iter()
-                .find(|a| a.scene == probe.scene && a.backend == probe.backend)
-            {
-                *checks = check_speed(&probe.merged(again), goldens, &noise, host);
+                .map_or_else(|| probe.scene.clone(), |(_, a)| a.clone());
+            progress(&format!("confirming {} on {kind}", probe.scene));
+            let (again, errors) = crate::measure::speed::probe_in_child(
+                exe,
+                &[argument],
+                &[kind],
+                CHECK_ROUNDS,
+                variations,
+                env,
+            );
+            run.errors.extend(errors);
+            if let Some(again) = again.into_iter().find(|a| a.scene == probe.scene) {
+                checks = check_speed(&probe.merged(&again), &goldens, &noise, &host);
             }
         }
-    }
-    for (.., checks) in judged {
         run.checks.extend(checks);
     }
     run

@@ -47,9 +47,9 @@ impl Injection {
     }
 }
 
-/// Injects each slowdown of `factors` into each pass of each scene, on every backend at once,
-/// and checks it as `harness check` would (a child process per backend and injection, side by
-/// side; under the same-host limits: run this on the host that blessed). `passes` limits the passes slowed (all when empty).
+/// Injects each slowdown of `factors` into each pass of each scene on each backend and checks
+/// it (a child process per scene, backend and injection, under the same-host limits: run this
+/// on the host that blessed). `passes` limits the passes slowed (all when empty).
 pub fn run(
     exe: &std::path::Path,
     root: &std::path::Path,
@@ -61,33 +61,29 @@ pub fn run(
     let mut injections = Vec::new();
     let mut errors = Vec::new();
     for (scene, argument, passes) in scenes {
-        for &pass in passes {
-            for &factor in factors {
-                // The same slowdown on every backend at once: their probes run side by side,
-                // as a check's do.
-                progress(&format!("{scene}: {pass} x{factor}"));
-                let run = check_scenes(
-                    exe,
-                    root,
-                    &[(scene.clone(), argument.clone())],
-                    backends,
-                    Variations {
-                        slow_pass: Some(SlowPass { pass, factor }),
-                        ..Default::default()
-                    },
-                    &[],
-                    |_| {},
-                );
-                errors.extend(run.errors.iter().cloned());
-                for &(backend, _) in backends {
-                    let checks: Vec<&SpeedCheck> =
-                        run.checks.iter().filter(|c| c.backend == backend).collect();
-                    let own = checks.iter().find(|c| c.pass == pass).copied();
+        for backend in backends {
+            for &pass in passes {
+                for &factor in factors {
+                    progress(&format!("{scene} on {}: {pass} x{factor}", backend.0));
+                    let run = check_scenes(
+                        exe,
+                        root,
+                        &[(scene.clone(), argument.clone())],
+                        std::slice::from_ref(backend),
+                        Variations {
+                            slow_pass: Some(SlowPass { pass, factor }),
+                            ..Default::default()
+                        },
+                        &[],
+                        |_| {},
+                    );
+                    errors.extend(run.errors.iter().cloned());
+                    let own = run.checks.iter().find(|c| c.pass == pass);
                     let others: Vec<&SpeedCheck> =
-                        checks.iter().filter(|c| c.pass != pass).copied().collect();
+                        run.checks.iter().filter(|c| c.pass != pass).collect();
                     injections.push(Injection {
                         scene: scene.clone(),
-                        backend,
+                        backend: backend.0,
                         pass,
                         factor,
                         measured: own.and_then(SpeedCheck::slowdown),
