@@ -5,14 +5,18 @@ common with it.
 A row of five spheres lit only by an environment (no lights, no ambient) is rendered twice:
 
 - by the harness (`harness render --pass light`, the linear light buffer, exposure 1, on gl);
-- by Mitsuba 3 (scalar_rgb), direct environment light only (the `direct` integrator), each
+- by Mitsuba 3 (llvm_ad_rgb), direct environment light only (the `direct` integrator), each
   sphere alone in its own render, since the harness models neither light bouncing between
   spheres nor one sphere hiding part of the sky from another.
 
 Spheres, left to right: Lambert (albedo 0.8, the harness's `lambert` model), then white metals
 (base colour 1, so Fresnel is exactly 1 in both renderers) of GGX roughness 0.2, 0.5 and 0.8
-(Mitsuba `roughconductor`, alpha = roughness^2), and a mirror (roughness 0; Mitsuba
-`conductor`). Environments: the two the project ships (scenes/assets/sunset.exr and
+(alpha = roughness^2), and a mirror (roughness 0; Mitsuba `conductor`). The metals' BRDF on
+Mitsuba's side is the harness's own (`--metal filament`, the default): GGX D and the
+height-correlated Smith visibility of Filament, written here as a Mitsuba BSDF plugin. Mitsuba's
+`roughconductor` (`--metal roughconductor`) uses Smith's separable masking-shadowing instead,
+which is darker at grazing angles on rough metals (white furnace, alpha 0.64: 5-11% at N.V
+0.2-0.4); that difference is the BRDF's, not the image-based lighting's. Environments: the two the project ships (scenes/assets/sunset.exr and
 interior.exr), with negative texels clamped to 0 as the harness's precompute does (Mitsuba
 drops samples with negative values). Mitsuba's envmap needs to_world = rotate(Y, 180 +
 rotation) to match the harness's equirectangular convention.
@@ -22,10 +26,11 @@ Per sphere, over the pixels where both renders see the sphere away from its silh
 relative error |harness - mitsuba| / mitsuba (luminance). The per-pixel figures include
 Mitsuba's own noise, about 1/sqrt(spp) of the pixel value; the ratio of means does not.
 
-    pip install mitsuba          # 3.x; the scalar_rgb variant ships in the wheel
+    pip install mitsuba          # 3.x; llvm_ad_rgb needs libLLVM (Debian: libllvm15)
     python3 scripts/mitsuba_crosscheck.py [--spp 1024] [--out target/mitsuba] [--min-n-dot-v 0.3]
                                           [--harness target/debug/harness] [--rotation 0]
                                           [--ibl runtime_samples=256 --ibl specular_size=256]
+                                          [--metal filament|roughconductor] [--environment FILE]
 
 Not part of `cargo test`: it takes a few minutes and needs Mitsuba. The README's "IBL against a
 path tracer" section records its table.
@@ -108,13 +113,79 @@ def harness_scene(environment, rotation, ibl=()):
     return "\n".join(lines) + "\n"
 
 
-def mitsuba_sphere(environment_bitmap, rotation, spp, index, crop):
+def register_filament_ggx():
+    """Registers `filament_ggx`: a white GGX metal as the harness shades it (GGX D, Filament's
+    height-correlated Smith visibility, Fresnel 1), sampled by visible normals."""
+    import drjit as dr
+
+    class FilamentGGX(mi.BSDF):
+        def __init__(self, props):
+            mi.BSDF.__init__(self, props)
+            self.alpha = props["alpha"]
+            self.distribution = mi.MicrofacetDistribution(mi.MicrofacetType.GGX, self.alpha, True)
+            flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.FrontSide
+            self.m_components = [flags]
+            self.m_flags = flags
+
+        def f_cos(self, wi, wo):
+            """BRDF x cos(theta_o): D V n.l, V = 0.5 / (n.l sqrt(n.v^2 (1 - a^2) + a^2)
+            + n.v sqrt(n.l^2 (1 - a^2) + a^2)) (Filament's V_SmithGGXCorrelated)."""
+            a2 = self.alpha * self.alpha
+            nv, nl = mi.Frame3f.cos_theta(wi), mi.Frame3f.cos_theta(wo)
+            d = self.distribution.eval(dr.normalize(wi + wo))
+            vis = 0.5 / (nl * dr.sqrt(nv * nv * (1 - a2) + a2) + nv * dr.sqrt(nl * nl * (1 - a2) + a2))
+            return dr.select((nv > 0) & (nl > 0), d * vis * nl, 0.0)
+
+        def pdf_of(self, wi, wo):
+            h = dr.normalize(wi + wo)
+            wo_h = dr.dot(wo, h)
+            valid = (mi.Frame3f.cos_theta(wi) > 0) & (mi.Frame3f.cos_theta(wo) > 0) & (wo_h > 0)
+            return dr.select(valid, self.distribution.pdf(wi, h) / (4 * wo_h), 0.0)
+
+        def sample(self, ctx, si, sample1, sample2, active=True):
+            m, _ = self.distribution.sample(si.wi, sample2)
+            bs = mi.BSDFSample3f()
+            bs.wo = mi.reflect(si.wi, m)
+            bs.pdf = self.pdf_of(si.wi, bs.wo)
+            bs.eta = 1.0
+            bs.sampled_type = mi.UInt32(+mi.BSDFFlags.GlossyReflection)
+            bs.sampled_component = mi.UInt32(0)
+            ok = active & (bs.pdf > 0)
+            value = dr.select(ok, self.f_cos(si.wi, bs.wo) / dr.select(ok, bs.pdf, 1.0), 0.0)
+            return bs, mi.Spectrum(value)
+
+        def eval(self, ctx, si, wo, active=True):
+            return mi.Spectrum(dr.select(active, self.f_cos(si.wi, wo), 0.0))
+
+        def pdf(self, ctx, si, wo, active=True):
+            return dr.select(active, self.pdf_of(si.wi, wo), 0.0)
+
+        def eval_pdf(self, ctx, si, wo, active=True):
+            return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
+
+        def traverse(self, callback):
+            pass
+
+        def parameters_changed(self, keys):
+            pass
+
+        def to_string(self):
+            return f"FilamentGGX[alpha={self.alpha}]"
+
+    mi.register_bsdf("filament_ggx", lambda props: FilamentGGX(props))
+
+
+def mitsuba_sphere(environment_bitmap, rotation, spp, index, crop, metal):
     """Mitsuba's render of sphere `index` alone (the harness does not model one sphere hiding
-    the sky from another), over the pixel rectangle `crop` = (x, y, width, height)."""
+    the sky from another), over the pixel rectangle `crop` = (x, y, width, height); the metals
+    with the BSDF `metal` (`filament` or `roughconductor`)."""
     label, material, bsdf = SPHERES[index]
     if bsdf is None:
         alpha = material["roughness"] ** 2
-        bsdf = {"type": "roughconductor", "distribution": "ggx", "alpha": alpha, "material": "none"}
+        if metal == "filament":
+            bsdf = {"type": "filament_ggx", "alpha": alpha}
+        else:
+            bsdf = {"type": "roughconductor", "distribution": "ggx", "alpha": alpha, "material": "none"}
     x, y, w, h = crop
     scene = {
         "type": "scene",
@@ -153,13 +224,15 @@ def mitsuba_sphere(environment_bitmap, rotation, spp, index, crop):
     return np.array(mi.render(mi.load_dict(scene)), dtype=np.float64)[..., :3]
 
 
-def mitsuba_render(environment_bitmap, rotation, spp, masks):
+def mitsuba_render(environment_bitmap, rotation, spp, masks, metal):
     """The five spheres' pixels from Mitsuba, each sphere rendered alone; zero elsewhere."""
     image = np.zeros((HEIGHT, WIDTH, 3))
     for index, mask in enumerate(masks):
         ys, xs = np.nonzero(mask)
         x0, y0, x1, y1 = xs.min(), ys.min(), xs.max() + 1, ys.max() + 1
-        crop = mitsuba_sphere(environment_bitmap, rotation, spp, index, (int(x0), int(y0), int(x1 - x0), int(y1 - y0)))
+        crop = mitsuba_sphere(
+            environment_bitmap, rotation, spp, index, (int(x0), int(y0), int(x1 - x0), int(y1 - y0)), metal
+        )
         image[y0:y1, x0:x1] = crop
     return image
 
@@ -231,14 +304,31 @@ def main():
         help="environment rotation about +Y in degrees, in both renderers (default 0); the camera "
         "looks down -Z, so this turns which part of the sky each sphere reflects",
     )
+    parser.add_argument(
+        "--environment", action="append", default=[], metavar="FILE",
+        help="an equirectangular EXR to light the spheres with (repeatable; default: the two "
+        "shipped skies, scenes/assets/sunset.exr and interior.exr)",
+    )
+    parser.add_argument(
+        "--metal", choices=["filament", "roughconductor"], default="filament",
+        help="Mitsuba's BSDF for the metals: the harness's own (GGX, height-correlated Smith; "
+        "default) or Mitsuba's roughconductor (separable Smith)",
+    )
     args = parser.parse_args()
-    mi.set_variant("scalar_rgb")
+    try:
+        mi.set_variant("llvm_ad_rgb")
+    except Exception as e:  # pragma: no cover
+        sys.exit(f"error: Mitsuba's llvm_ad_rgb variant does not start ({e}); it needs libLLVM")
+    register_filament_ggx()
     os.makedirs(args.out, exist_ok=True)
     masks, n_dot_vs = sphere_pixels(args.min_n_dot_v)
     rows = []
     bands = []
-    for environment in ENVIRONMENTS:
-        source = os.path.join(ROOT, "scenes", "assets", environment)
+    sources = args.environment or [os.path.join(ROOT, "scenes", "assets", e) for e in ENVIRONMENTS]
+    for source in sources:
+        if not os.path.isfile(source):
+            sys.exit(f"error: {source}: no such environment file")
+        environment = os.path.basename(source)
         work = os.path.join(args.out, os.path.splitext(environment)[0])
         os.makedirs(work, exist_ok=True)
         shutil.copyfile(source, os.path.join(work, environment))
@@ -249,8 +339,8 @@ def main():
         harness = run_harness(scene_path, os.path.join(work, "light.exr"), args.harness)
         texels = np.array(mi.Bitmap(source), dtype=np.float32)[..., :3]
         clamped = mi.Bitmap(np.ascontiguousarray(np.maximum(texels, 0.0)))
-        print(f"{environment}: Mitsuba, {args.spp} spp ...", file=sys.stderr)
-        reference = mitsuba_render(clamped, args.rotation, args.spp, masks)
+        print(f"{environment}: Mitsuba, {args.spp} spp, metals {args.metal} ...", file=sys.stderr)
+        reference = mitsuba_render(clamped, args.rotation, args.spp, masks, args.metal)
         mi.Bitmap(reference.astype(np.float32)).write(os.path.join(work, "mitsuba.exr"))
         for (label, _, _), mask, n_dot_v in zip(SPHERES, masks, n_dot_vs):
             h = luminance(harness[mask])
