@@ -11,6 +11,7 @@ pub mod desc;
 pub mod gl;
 mod pool;
 mod scope;
+mod serialized;
 pub mod wgpu;
 
 use std::collections::BTreeMap;
@@ -305,13 +306,16 @@ impl<'a> dyn Backend + 'a {
     }
 }
 
-/// Creates a backend by kind, or says why it cannot run here.
+/// Creates a backend by kind, or says why it cannot run here. The GL backends (`gl`,
+/// `wgpu-gl`) come wrapped so that one thread at a time drives Mesa's GL driver in this
+/// process (see `backend/serialized.rs`: Mesa 22.3's llvmpipe crashes otherwise).
 pub fn create(kind: BackendKind) -> Result<Box<dyn Backend>> {
     match kind {
-        BackendKind::Gl => Ok(Box::new(gl::GlBackend::new()?)),
-        BackendKind::WgpuVulkan | BackendKind::WgpuGl => {
-            Ok(Box::new(wgpu::WgpuBackend::new(kind)?))
+        BackendKind::Gl => serialized::Serialized::create(|| Ok(Box::new(gl::GlBackend::new()?))),
+        BackendKind::WgpuGl => {
+            serialized::Serialized::create(|| Ok(Box::new(wgpu::WgpuBackend::new(kind)?)))
         }
+        BackendKind::WgpuVulkan => Ok(Box::new(wgpu::WgpuBackend::new(kind)?)),
     }
 }
 
