@@ -16,9 +16,10 @@ Mitsuba's side is the harness's own (`--metal filament`, the default): GGX D and
 height-correlated Smith visibility of Filament, written here as a Mitsuba BSDF plugin. Mitsuba's
 `roughconductor` (`--metal roughconductor`) uses Smith's separable masking-shadowing instead,
 which is darker at grazing angles on rough metals (white furnace, alpha 0.64: 5-11% at N.V
-0.2-0.4); that difference is the BRDF's, not the image-based lighting's. Environments: the two the project ships (scenes/assets/sunset.exr and
-interior.exr), with negative texels clamped to 0 as the harness's precompute does (Mitsuba
-drops samples with negative values). Mitsuba's envmap needs to_world = rotate(Y, 180 +
+0.2-0.4); that difference is the BRDF's, not the image-based lighting's. Environments: the two
+the project ships (scenes/assets/sunset.exr and interior.exr) or `--environment FILE`, with
+negative texels clamped to 0 as the harness's precompute does (Mitsuba drops samples with
+negative values). Mitsuba's envmap needs to_world = rotate(Y, 180 +
 rotation) to match the harness's equirectangular convention.
 
 Per sphere, over the pixels where both renders see the sphere away from its silhouette (N.V >=
@@ -26,21 +27,40 @@ Per sphere, over the pixels where both renders see the sphere away from its silh
 relative error |harness - mitsuba| / mitsuba (luminance). The per-pixel figures include
 Mitsuba's own noise, about 1/sqrt(spp) of the pixel value; the ratio of means does not.
 
-    pip install mitsuba          # 3.x; llvm_ad_rgb needs libLLVM (Debian: libllvm15)
+    pip install mitsuba          # 3.x
+    apt-get install libllvm19    # llvm_ad_rgb needs a libLLVM newer than Debian 12's 15; the
+                                 # newest one found is used unless DRJIT_LIBLLVM_PATH is set
     python3 scripts/mitsuba_crosscheck.py [--spp 1024] [--out target/mitsuba] [--min-n-dot-v 0.3]
                                           [--harness target/debug/harness] [--rotation 0]
                                           [--ibl runtime_samples=256 --ibl specular_size=256]
                                           [--metal filament|roughconductor] [--environment FILE]
 
-Not part of `cargo test`: it takes a few minutes and needs Mitsuba. The README's "IBL against a
+Not part of `cargo test`: it needs Mitsuba and a recent libLLVM (about 10 s for both skies). The README's "IBL against a
 path tracer" section records its table.
 """
 
 import argparse
+import glob
 import os
+import re
 import shutil
 import subprocess
 import sys
+
+
+def newest_libllvm():
+    """The newest libLLVM of major version 16 or later on this machine, or None (Dr.Jit's LLVM
+    back end fails to select some intrinsics on LLVM 15, Debian 12's default)."""
+    found = []
+    for path in glob.glob("/usr/lib/*/libLLVM*.so*") + glob.glob("/usr/lib/llvm-*/lib/libLLVM*.so*"):
+        match = re.search(r"libLLVM[-.](?:so\.)?(\d+)", os.path.basename(path))
+        if match and int(match.group(1)) >= 16:
+            found.append((int(match.group(1)), path))
+    return max(found)[1] if found else None
+
+
+if "DRJIT_LIBLLVM_PATH" not in os.environ and newest_libllvm():
+    os.environ["DRJIT_LIBLLVM_PATH"] = newest_libllvm()
 
 try:
     import numpy as np
@@ -318,7 +338,13 @@ def main():
     try:
         mi.set_variant("llvm_ad_rgb")
     except Exception as e:  # pragma: no cover
-        sys.exit(f"error: Mitsuba's llvm_ad_rgb variant does not start ({e}); it needs libLLVM")
+        sys.exit(
+            f"error: Mitsuba's llvm_ad_rgb variant does not start ({e}): install libllvm19 (or any "
+            "libLLVM 16+) or point DRJIT_LIBLLVM_PATH at one"
+        )
+    if "DRJIT_LIBLLVM_PATH" not in os.environ:
+        print("warning: no libLLVM 16+ found; Dr.Jit may abort on Debian 12's LLVM 15 "
+              "(install libllvm19)", file=sys.stderr)
     register_filament_ggx()
     os.makedirs(args.out, exist_ok=True)
     masks, n_dot_vs = sphere_pixels(args.min_n_dot_v)
