@@ -59,8 +59,10 @@ def newest_libllvm():
     return max(found)[1] if found else None
 
 
-if "DRJIT_LIBLLVM_PATH" not in os.environ and newest_libllvm():
-    os.environ["DRJIT_LIBLLVM_PATH"] = newest_libllvm()
+if "DRJIT_LIBLLVM_PATH" not in os.environ:
+    LIBLLVM = newest_libllvm()
+    if LIBLLVM:
+        os.environ["DRJIT_LIBLLVM_PATH"] = LIBLLVM
 
 try:
     import numpy as np

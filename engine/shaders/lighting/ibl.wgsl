@@ -119,16 +119,21 @@ fn ibl_anisotropic_taps(s: Surface, v: vec3<f32>) -> vec3<f32> {
     let stretch = sqrt(max(at * at - ab * ab, 0.0));
     let alpha_tap = min(max(ab, 0.35 * stretch), 1.0);
     let spread = sqrt(max(at * at - alpha_tap * alpha_tap, 0.0));
-    let keep = (1.0 - alpha_tap) * (sqrt(1.0 - alpha_tap) + alpha_tap);
     var sum = vec3<f32>(0.0);
     for (var i = 0u; i < ANISOTROPIC_TAPS; i++) {
         let q = (f32(i) + 0.5) / f32(ANISOTROPIC_TAPS) * 2.0 - 1.0;
         let h = normalize(n + wide * (spread * q / sqrt(1.0 - q * q)));
         let r = reflect(-v, h);
         let horizon = clamp(4.0 * dot(n, r) + 0.5, 0.0, 1.0);
-        sum += ibl_prefiltered(safe_normalize(mix(n, r, keep), r), sqrt(alpha_tap)) * horizon;
+        sum += ibl_prefiltered(frostbite_dominant(n, r, alpha_tap), sqrt(alpha_tap)) * horizon;
     }
     return sum / f32(ANISOTROPIC_TAPS);
+}
+
+// Lagarde and de Rousiers' dominant direction of a GGX lobe of alpha `a` about normal `n` with
+// mirror direction `r`: (1 - a)(sqrt(1 - a) + a) of the way from `n` to `r`.
+fn frostbite_dominant(n: vec3<f32>, r: vec3<f32>, a: f32) -> vec3<f32> {
+    return safe_normalize(mix(n, r, (1.0 - a) * (sqrt(1.0 - a) + a)), r);
 }
 
 // Lookups per anisotropic pixel of ibl_anisotropic_taps.
@@ -173,8 +178,7 @@ fn pbr_ibl(s: Surface, v: vec3<f32>, occlusion: f32) -> vec3<f32> {
     let r = reflect(-v, bent);
     var dominant: vec3<f32>;
     if IBL_FROSTBITE_DOMINANT {
-        let a = s.roughness * s.roughness;
-        dominant = safe_normalize(mix(bent, r, (1.0 - a) * (sqrt(1.0 - a) + a)), r);
+        dominant = frostbite_dominant(bent, r, s.roughness * s.roughness);
     } else {
         dominant = safe_normalize(mix(r, bent, s.roughness * s.roughness * s.roughness * s.roughness), r);
     }

@@ -79,17 +79,10 @@ fn read(folder: &Path, key: &Key, len: usize) -> Option<Vec<f32>> {
     })
 }
 
-/// Writes the map of `key` into `folder` (whole or not at all).
+/// Writes the map of `key` into `folder` (whole or not at all; the folder is made if missing).
 fn write(folder: &Path, key: &Key, map: &[f32]) -> Result<(), crate::images::ImageFileError> {
-    let path = file(folder, key);
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|error| crate::images::ImageFileError::Io {
-            path: dir.to_owned(),
-            error,
-        })?;
-    }
     let bytes: Vec<u8> = map.iter().flat_map(|v| v.to_le_bytes()).collect();
-    crate::images::write_atomically(&path, &bytes)
+    crate::images::write_atomically(&file(folder, key), &bytes)
 }
 
 /// Adds a map to this process's memory, dropping the oldest beyond [`KEPT_IN_MEMORY`].
