@@ -21,7 +21,7 @@ use crate::scene::EnvironmentImage;
 
 /// Bump when the entry layout changes (an algorithm change already changes the key through
 /// [`ALGORITHM_SOURCES`]).
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 
 /// The source of every file of the IBL precompute (this folder), part of every key: the maps
 /// are a function of the image, the settings and this code. A test checks the list covers the
@@ -191,16 +191,15 @@ pub fn encode(key: &Key, maps: &IblMaps) -> Vec<u8> {
         payload.extend_from_slice(&t[0].to_le_bytes());
         payload.extend_from_slice(&t[1].to_le_bytes());
     }
-    // The extracted sun: a texel count (0: none), then direction, irradiance and solid angle.
-    match &maps.sun {
-        None => payload.extend_from_slice(&0u32.to_le_bytes()),
-        Some(sun) => {
-            payload.extend_from_slice(&(sun.texels as u32).to_le_bytes());
-            let d = sun.direction;
-            let [r, g, b] = sun.irradiance;
-            for v in [d.x, d.y, d.z, r, g, b, sun.solid_angle] {
-                payload.extend_from_slice(&v.to_le_bytes());
-            }
+    // The extracted suns: how many, then each one's texel count, direction, irradiance and
+    // solid angle.
+    payload.extend_from_slice(&(maps.suns.len() as u32).to_le_bytes());
+    for sun in &maps.suns {
+        payload.extend_from_slice(&(sun.texels as u32).to_le_bytes());
+        let d = sun.direction;
+        let [r, g, b] = sun.irradiance;
+        for v in [d.x, d.y, d.z, r, g, b, sun.solid_angle] {
+            payload.extend_from_slice(&v.to_le_bytes());
         }
     }
     let mut out = Vec::with_capacity(payload.len() + 84);
@@ -304,15 +303,21 @@ pub fn decode(key: &Key, bytes: &[u8]) -> Result<IblMaps, String> {
     let dfg = (0..dfg_len)
         .map(|_| Ok([p.f32()?, p.f32()?]))
         .collect::<Result<_, String>>()?;
-    let sun = match p.u32()? as usize {
-        0 => None,
-        texels => Some(super::sun::Sun {
-            direction: glam::Vec3::new(p.f32()?, p.f32()?, p.f32()?),
-            irradiance: [p.f32()?, p.f32()?, p.f32()?],
-            solid_angle: p.f32()?,
-            texels,
-        }),
-    };
+    let count = p.u32()?;
+    if count > crate::scene::MAX_EXTRACTED_LIGHTS {
+        return Err(format!("{count} suns, more than extraction makes"));
+    }
+    let suns = (0..count)
+        .map(|_| {
+            let texels = p.u32()? as usize;
+            Ok(super::sun::Sun {
+                direction: glam::Vec3::new(p.f32()?, p.f32()?, p.f32()?),
+                irradiance: [p.f32()?, p.f32()?, p.f32()?],
+                solid_angle: p.f32()?,
+                texels,
+            })
+        })
+        .collect::<Result<_, String>>()?;
     if !p.0.is_empty() {
         return Err("trailing bytes in the payload".into());
     }
@@ -321,7 +326,7 @@ pub fn decode(key: &Key, bytes: &[u8]) -> Result<IblMaps, String> {
         irradiance,
         dfg,
         radiance,
-        sun,
+        suns,
     })
 }
 

@@ -59,10 +59,15 @@ impl IblSettings {
             format!(", seed {}", self.seed)
         } else {
             String::new()
-        } + if self.extract_sun {
-            "; sun extracted into a directional light"
+        } + &if self.extract_sun && self.extracted_lights > 1 {
+            format!(
+                "; up to {} suns extracted into directional lights",
+                self.extracted_lights
+            )
+        } else if self.extract_sun {
+            "; sun extracted into a directional light".to_owned()
         } else {
-            ""
+            String::new()
         } + &if self.runtime_samples != 0 {
             format!(
                 "; specular by {} filtered importance samples per pixel",
@@ -103,16 +108,20 @@ pub struct IblMaps {
     /// The environment cube the prefilter reads (`source_size` faces), box-filtered down to
     /// 1 x 1: what filtered importance samples read.
     pub radiance: CubeMap,
-    /// With `extract_sun`: the sun cut out of the maps, to be lit as a directional light.
-    pub sun: Option<sun::Sun>,
+    /// With `extract_sun`: the suns cut out of the maps (at most `extracted_lights`, brightest
+    /// first), each to be lit as a directional light.
+    pub suns: Vec<sun::Sun>,
 }
 
 /// Builds the maps (the whole precompute, no caches).
 pub fn build(image: &EnvironmentImage, settings: &IblSettings) -> IblMaps {
-    let (residual, sun) = if settings.extract_sun {
-        sun::extract(image).map_or((None, None), |(residual, sun)| (Some(residual), Some(sun)))
+    let (residual, suns) = if settings.extract_sun {
+        sun::extract_several(image, settings.extracted_lights)
+            .map_or((None, Vec::new()), |(residual, suns)| {
+                (Some(residual), suns)
+            })
     } else {
-        (None, None)
+        (None, Vec::new())
     };
     let base = cube::cube_from_equirect(residual.as_ref().unwrap_or(image), settings.source_size);
     let source = CubeMap::with_mips(base, 1);
@@ -121,7 +130,7 @@ pub fn build(image: &EnvironmentImage, settings: &IblSettings) -> IblMaps {
         irradiance: irradiance::irradiance(&source, settings.irradiance_size, settings.irradiance),
         dfg: dfg_table().as_ref().clone(),
         radiance: source,
-        sun,
+        suns,
     }
 }
 

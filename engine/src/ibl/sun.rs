@@ -12,6 +12,13 @@
 //! The sun is the 8-connected region around the brightest texel (by luminance) of texels
 //! brighter than `max(1% of the peak, 100 x the median)`; there is none when the peak is under
 //! 1000 x the median, or the region covers more than 1% of the image (a sky, not a sun).
+//!
+//! An interior has several: interior.exr's two lamps are two such regions (11 and 16 texels,
+//! together a third of its flux), and a bright patch of 105 texels a third. With
+//! `[quality.ibl] extracted_lights = N` the rule is applied again to what each extraction leaves,
+//! up to N times, and every region found becomes a light of its own ([`extract_several`]):
+//! what filtered importance samples alias (a lamp a sample's footprint catches once, twice or
+//! not at all) is then lit exactly.
 
 use glam::{DVec3, Vec3};
 
@@ -133,13 +140,35 @@ fn sun_region(image: &EnvironmentImage) -> Option<(Vec<usize>, [f32; 3])> {
 /// The image's sun, if it has one (see the module documentation), and the image without it:
 /// its texels replaced by the sky around it.
 pub fn extract(image: &EnvironmentImage) -> Option<(EnvironmentImage, Sun)> {
-    let (region, sky) = sun_region(image)?;
-    let (w, h) = (image.width, image.height);
+    let (residual, mut suns) = extract_several(image, 1)?;
+    Some((residual, suns.remove(0)))
+}
+
+/// Up to `count` suns, brightest first, and the image without them: [`extract`] again on what
+/// each leaves, for as long as what is left has a sun (an interior's lamps after its brightest).
+/// `None` when the image has no sun at all.
+pub fn extract_several(
+    image: &EnvironmentImage,
+    count: u32,
+) -> Option<(EnvironmentImage, Vec<Sun>)> {
     let mut residual = image.clone();
+    let mut suns = Vec::new();
+    while suns.len() < count as usize {
+        let Some((region, sky)) = sun_region(&residual) else {
+            break;
+        };
+        suns.push(cut_out(&mut residual, &region, sky));
+    }
+    (!suns.is_empty()).then_some((residual, suns))
+}
+
+/// The sun of `region` (texel indices), its texels in `image` replaced by `sky`.
+fn cut_out(image: &mut EnvironmentImage, region: &[usize], sky: [f32; 3]) -> Sun {
+    let (w, h) = (image.width, image.height);
     let mut irradiance = [0.0f64; 3];
     let mut weighted = DVec3::ZERO;
     let mut solid_angle = 0.0;
-    for &i in &region {
+    for &i in region {
         let (x, y) = ((i % w as usize) as u32, (i / w as usize) as u32);
         let omega = texel_solid_angle(y, w, h);
         let t = image.texels[i];
@@ -151,15 +180,14 @@ pub fn extract(image: &EnvironmentImage) -> Option<(EnvironmentImage, Sun)> {
         }
         weighted += texel_direction(x, y, w, h) * excess;
         solid_angle += omega;
-        residual.texels[i] = [sky[0], sky[1], sky[2], t[3]];
+        image.texels[i] = [sky[0], sky[1], sky[2], t[3]];
     }
-    let sun = Sun {
+    Sun {
         direction: weighted.normalize_or_zero().as_vec3(),
         irradiance: irradiance.map(|e| e as f32),
         solid_angle: solid_angle as f32,
         texels: region.len(),
-    };
-    Some((residual, sun))
+    }
 }
 
 /// Angular radius of the disc with the sun's solid angle: `omega = 2 pi (1 - cos radius)`.
@@ -193,14 +221,22 @@ pub fn light(
     })
 }
 
-/// The scene as the renderer draws it: with the sun that `maps` (built with `extract_sun`) cut
-/// out of the environment added as a directional light, with a shadow unless
-/// `[quality.ibl] sun_shadow` is off; `None` when there is none, the scene as it is.
+/// The scene as the renderer draws it: with the suns that `maps` (built with `extract_sun`)
+/// cut out of the environment added as directional lights, each with a shadow unless
+/// `[quality.ibl] sun_shadow` is off; `None` when there are none, the scene as it is.
 pub fn scene_with_sun(scene: &Scene, maps: Option<&IblMaps>) -> Option<Scene> {
     let shadow = scene.quality.ibl.sun_shadow.then(ShadowSettings::default);
-    let light = light(scene.environment.as_ref()?, maps?.sun.as_ref()?, shadow)?;
+    let environment = scene.environment.as_ref()?;
+    let lights: Vec<Light> = maps?
+        .suns
+        .iter()
+        .filter_map(|sun| light(environment, sun, shadow))
+        .collect();
+    if lights.is_empty() {
+        return None;
+    }
     let mut with_sun = scene.clone();
-    with_sun.lights.push(light);
+    with_sun.lights.extend(lights);
     Some(with_sun)
 }
 
@@ -252,5 +288,24 @@ mod tests {
     #[test]
     fn an_even_sky_has_no_sun() {
         assert!(extract(&sky_with_sun(None)).is_none());
+        assert!(extract_several(&sky_with_sun(None), 3).is_none());
+    }
+
+    #[test]
+    fn several_suns_are_cut_out_one_after_another_and_no_more_than_there_are() {
+        // Two suns: the one with the brightest texel first, whatever their flux.
+        let mut image = sky_with_sun(Some((40, 10, 1e4)));
+        for (dx, dy) in [(0, 0), (1, 0), (2, 0), (0, 1), (1, 1), (2, 1)] {
+            image.texels[((20 + dy) * 64 + 8 + dx) as usize] = [3e3, 3e3, 3e3, 1.0];
+        }
+        let (residual, suns) = extract_several(&image, 3).expect("two suns");
+        assert_eq!(suns.iter().map(|s| s.texels).collect::<Vec<_>>(), [4, 6]);
+        assert!(residual.texels.iter().all(|t| t[0] < 1.0));
+        // The first is what `extract` finds alone, and one asked for is that one.
+        let (_, first) = extract(&image).unwrap();
+        assert_eq!(suns[0], first);
+        let (one_left, one) = extract_several(&image, 1).unwrap();
+        assert_eq!(one, [first]);
+        assert!(one_left.texels.iter().any(|t| t[0] == 3e3));
     }
 }

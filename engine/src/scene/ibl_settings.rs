@@ -102,6 +102,9 @@ impl std::fmt::Display for Footprint {
     }
 }
 
+/// The most compact bright sources `extracted_lights` may cut out of an environment.
+pub const MAX_EXTRACTED_LIGHTS: u32 = 8;
+
 /// The IBL quality knobs (`[quality.ibl]` in scene files).
 #[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -146,6 +149,11 @@ pub struct IblSettings {
     /// Cut the environment's sun out of the maps and light it as a directional light instead
     /// ([`crate::ibl::sun`]).
     pub extract_sun: bool,
+    /// With `extract_sun`: how many suns to cut out, one after another (each time the region
+    /// around the brightest texel left), each lit as a directional light of its own (1, the
+    /// default: the sun alone; an interior's lamps need more). A region is taken only while it
+    /// is a sun by [`crate::ibl::sun`]'s rule, so an image with fewer gives fewer lights.
+    pub extracted_lights: u32,
     /// Whether the extracted sun casts a shadow (with the default [`ShadowSettings`]). It
     /// changes no precomputed map.
     ///
@@ -168,6 +176,7 @@ impl Default for IblSettings {
             dominant_direction: DominantDirection::Filament,
             anisotropic_lookup: AnisotropicLookup::BentNormal,
             extract_sun: false,
+            extracted_lights: 1,
             sun_shadow: true,
         }
     }
@@ -225,6 +234,12 @@ impl IblSettings {
             return Some(format!(
                 "ibl runtime_samples {} must be at most 1024",
                 self.runtime_samples
+            ));
+        }
+        if !(1..=MAX_EXTRACTED_LIGHTS).contains(&self.extracted_lights) {
+            return Some(format!(
+                "ibl extracted_lights {} must be in 1..{MAX_EXTRACTED_LIGHTS}",
+                self.extracted_lights
             ));
         }
         if !(1..=256).contains(&self.irradiance_size) {

@@ -22,6 +22,7 @@ mod validate;
 
 pub use ibl_settings::{
     AnisotropicLookup, DominantDirection, Footprint, IblSettings, IrradianceMethod,
+    MAX_EXTRACTED_LIGHTS,
 };
 pub use light::{Light, ShadowFilter, ShadowSettings};
 pub use material::{LightingModel, Material, TextureIndex};

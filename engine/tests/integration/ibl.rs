@@ -64,6 +64,7 @@ fn uniform_environment_gives_uniform_maps() {
             dominant_direction: ibl::DominantDirection::Filament,
             anisotropic_lookup: ibl::AnisotropicLookup::BentNormal,
             extract_sun: false,
+            extracted_lights: 1,
             sun_shadow: true,
         };
         let maps = ibl::build(&uniform(1.0), &settings);
@@ -324,8 +325,8 @@ fn prepare_uses_memory_then_disk() {
     ibl::cache::set_directory(None);
 }
 
-/// With `extract_sun`, the maps carry the sun they were built without (and the cache keeps it):
-/// the sun's flux is in `maps.sun`, not in the irradiance map.
+/// With `extract_sun`, the maps carry the suns they were built without (and the cache keeps
+/// them): the suns' flux is in `maps.suns`, not in the irradiance map.
 #[test]
 fn an_extracted_sun_travels_with_the_maps_and_through_the_cache() {
     let mut image = uniform(0.5);
@@ -341,7 +342,7 @@ fn an_extracted_sun_travels_with_the_maps_and_through_the_cache() {
         ..IblSettings::default()
     };
     let maps = ibl::build(&image, &settings);
-    let sun = maps.sun.clone().expect("the sun was extracted");
+    let sun = maps.suns.first().cloned().expect("the sun was extracted");
     assert_eq!(sun.texels, 4);
     // Without the sun the environment is uniform 0.5 again, and so is the irradiance map.
     assert!((max_of(&maps.irradiance) - 0.5).abs() < 1e-3);
@@ -352,8 +353,27 @@ fn an_extracted_sun_travels_with_the_maps_and_through_the_cache() {
             ..settings.clone()
         },
     );
-    assert!(kept.sun.is_none() && max_of(&kept.irradiance) > 1.0);
+    assert!(kept.suns.is_empty() && max_of(&kept.irradiance) > 1.0);
     let key = ibl::cache::key(&image, &settings);
+    let decoded = ibl::cache::decode(&key, &ibl::cache::encode(&key, &maps)).unwrap();
+    assert_eq!(decoded, maps);
+    // A second, dimmer sun: one light more with `extracted_lights = 2`, and both through the
+    // cache; the first asked for alone is the same sun.
+    for (x, y) in [(10, 20), (11, 20), (12, 20)] {
+        image.texels[y * 64 + x] = [5e3, 5e3, 5e3, 1.0];
+    }
+    let two = IblSettings {
+        extracted_lights: 2,
+        ..settings.clone()
+    };
+    let maps = ibl::build(&image, &two);
+    assert_eq!(
+        maps.suns.iter().map(|s| s.texels).collect::<Vec<_>>(),
+        [4, 3]
+    );
+    assert_eq!(maps.suns[0], sun);
+    assert!((max_of(&maps.irradiance) - 0.5).abs() < 1e-3);
+    let key = ibl::cache::key(&image, &two);
     let decoded = ibl::cache::decode(&key, &ibl::cache::encode(&key, &maps)).unwrap();
     assert_eq!(decoded, maps);
 }

@@ -411,3 +411,31 @@ fn the_ibl_anisotropic_lookup_is_one_of_two_ways() {
     assert!(e.starts_with("dir/bad.toml:6:"), "{e}");
     assert!(e.contains("bent-normal") && e.contains("taps"), "{e}");
 }
+
+/// `[quality.ibl] extracted_lights` reads as a count, 1 by default (the sun alone), and a count
+/// outside 1..8 is a problem naming the key (reported with the scene file's name when the scene
+/// has an environment to light).
+#[test]
+fn the_ibl_extracted_lights_are_a_count_from_one_to_eight() {
+    let with = |count: &str| {
+        format!("{CAMERA}\n[quality.ibl]\nextract_sun = true\nextracted_lights = {count}\n")
+    };
+    for count in [1, 3, 8] {
+        let scene = scene_file::parse(Path::new("dir/ok.toml"), &with(&count.to_string()))
+            .unwrap_or_else(|e| panic!("{count}: {e}"));
+        assert_eq!(scene.quality.ibl.unwrap().extracted_lights, count);
+    }
+    assert_eq!(engine::scene::IblSettings::default().extracted_lights, 1);
+    for bad in [0, 9] {
+        let settings = engine::scene::IblSettings {
+            extract_sun: true,
+            extracted_lights: bad,
+            ..Default::default()
+        };
+        let problem = settings.problem().expect("out of range");
+        assert!(
+            problem.contains("extracted_lights") && problem.contains(&bad.to_string()),
+            "{problem}"
+        );
+    }
+}
