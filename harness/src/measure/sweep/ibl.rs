@@ -240,15 +240,21 @@ pub fn ibl_sampling_settings() -> Vec<(String, engine::ibl::IblSettings)> {
             },
         ));
     }
-    for samples in [8, 12, 16] {
+    // Candidates for a cheaper default: the same suns with the split sum, Frostbite's lean and
+    // a few samples on the anisotropic pixels only, at two footprints.
+    for (samples, log2) in [(8, 0), (8, -2), (12, 0)] {
+        let Some(footprint) = engine::ibl::Footprint::from_log2(log2) else {
+            continue;
+        };
         rows.push((
-            format!("3 suns + frostbite + aniso fis {samples}"),
+            format!("3 suns + frostbite + aniso fis {samples} footprint {footprint}"),
             engine::ibl::IblSettings {
                 extract_sun: true,
                 extracted_lights: 3,
                 sun_shadow: false,
                 dominant_direction: frostbite,
                 anisotropic_samples: samples,
+                runtime_footprint: footprint,
                 ..d.clone()
             },
         ));
