@@ -205,7 +205,8 @@ enum Command {
         /// Backend.
         #[arg(long, default_value = "gl")]
         backend: BackendKind,
-        /// Renders per setting (timings are their median).
+        /// Timed renders per setting, their median kept (the IBL sweep renders every setting in
+        /// turn, this many rounds).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
         /// Light the scene with this environment (EXR or .hdr) instead of its own, keeping its

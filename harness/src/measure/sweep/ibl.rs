@@ -2,7 +2,7 @@
 //! and lighting pass) and measured against the Monte Carlo reference per roughness.
 
 use engine::backend::BackendKind;
-use engine::renderer::{self, Readback};
+use engine::renderer::{self, Frame, PreparedFrame, Readback};
 use engine::scene::Scene;
 
 use super::{lighting, pareto_front_n, pass_ms, stats, SweepError};
@@ -274,6 +274,30 @@ pub fn specular_mib(settings: &engine::ibl::IblSettings) -> f64 {
     bytes as f64 / f64::from(1u32 << 20)
 }
 
+/// The lighting pass's median GPU time of each of `frames`, rendered `repeats` times in rounds
+/// (each round renders every frame once, in order), ms.
+fn interleaved_lighting_ms(
+    backend: &mut dyn engine::backend::Backend,
+    frames: &[PreparedFrame],
+    repeats: usize,
+    progress: &mut impl FnMut(&str),
+) -> Result<Vec<Option<f64>>, SweepError> {
+    let mut rendered: Vec<Vec<Frame>> = frames.iter().map(|_| Vec::new()).collect();
+    for round in 0..repeats.max(1) {
+        progress(&format!("timing round {} of {}", round + 1, repeats.max(1)));
+        for (frame, times) in frames.iter().zip(&mut rendered) {
+            // Nothing read back: the timestamps are all a timing round needs.
+            let timed = renderer::render_prepared(backend, frame, Readback::Only(&[]))
+                .map_err(|e| SweepError::Render(e.to_string()))?;
+            times.push(timed);
+        }
+    }
+    Ok(rendered
+        .iter()
+        .map(|frames| pass_ms(frames, lighting))
+        .collect())
+}
+
 /// Reference pixels and directions per strategy of the IBL sweep's Monte Carlo reference.
 pub const IBL_REFERENCE_PIXELS: usize = 576;
 /// Directions per strategy and pixel (three or four strategies).
@@ -292,8 +316,8 @@ pub enum MapSource {
 }
 
 /// Runs the IBL sweep on one backend: per setting, the precompute time, the lighting pass's GPU
-/// time (median of `repeats` renders) and the error against the Monte Carlo reference per
-/// roughness. The reference is computed once, from the default render's G-buffer (the
+/// time (median of `repeats` rounds over every setting in turn) and the error against the
+/// Monte Carlo reference per roughness. The reference is computed once, from the default render's G-buffer (the
 /// G-buffer does not depend on IBL settings).
 pub fn ibl_sweep(
     scene: &Scene,
@@ -321,6 +345,7 @@ pub fn ibl_sweep_with(
     let mut rows = Vec::new();
     let mut references = None;
     let mut built: Vec<(engine::ibl::cache::Key, f64)> = Vec::new();
+    let mut prepared = Vec::new();
     let mut settings_list = ibl_settings();
     if maps == MapSource::Timed {
         settings_list.extend(ibl_size_settings());
@@ -348,12 +373,14 @@ pub fn ibl_sweep_with(
         };
         let mut variant = scene.clone();
         variant.quality.ibl = settings.clone();
-        let mut frames = Vec::new();
-        for _ in 0..repeats.max(1) {
-            frames.push(
-                renderer::render(backend.as_mut(), &variant, Readback::All)
-                    .map_err(|e| SweepError::Render(e.to_string()))?,
-            );
+        let render_error = |e: engine::renderer::RenderError| SweepError::Render(e.to_string());
+        let frame = PreparedFrame::new(&variant).map_err(render_error)?;
+        let frames = [
+            renderer::render_prepared(backend.as_mut(), &frame, Readback::All)
+                .map_err(render_error)?,
+        ];
+        if maps == MapSource::Timed {
+            prepared.push(frame);
         }
         if references.is_none() {
             progress("Monte Carlo reference");
@@ -392,6 +419,13 @@ pub fn ibl_sweep_with(
     }
     if maps == MapSource::Cached {
         return Ok(rows);
+    }
+    // The lighting times: `repeats` rounds over every setting in turn, so that a drift of the
+    // host over the minutes the sweep takes reaches every row alike (renders of one setting
+    // back to back put a setting at 16.4 ms that took 10.3 ms interleaved with the default).
+    let times = interleaved_lighting_ms(backend.as_mut(), &prepared, repeats, &mut progress)?;
+    for (row, ms) in rows.iter_mut().zip(times) {
+        row.lighting_ms = ms;
     }
     // Two costs: the precompute (once per environment and settings) and the lighting pass (every
     // frame; the filtered importance sampling settings spend it there).
