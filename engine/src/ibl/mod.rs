@@ -108,8 +108,8 @@ pub struct IblMaps {
     /// The environment cube the prefilter reads (`source_size` faces), box-filtered down to
     /// 1 x 1: what filtered importance samples read.
     pub radiance: CubeMap,
-    /// With `extract_sun`: the suns cut out of the maps (at most `extracted_lights`, brightest
-    /// first), each to be lit as a directional light.
+    /// With `extract_sun`: the suns cut out of the maps (at most `extracted_lights`, in the
+    /// order they were cut out), each to be lit as a directional light.
     pub suns: Vec<sun::Sun>,
 }
 

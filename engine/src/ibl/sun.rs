@@ -144,8 +144,8 @@ pub fn extract(image: &EnvironmentImage) -> Option<(EnvironmentImage, Sun)> {
     Some((residual, suns.remove(0)))
 }
 
-/// Up to `count` suns, brightest first, and the image without them: [`extract`] again on what
-/// each leaves, for as long as what is left has a sun (an interior's lamps after its brightest).
+/// Up to `count` suns, the brightest texel's first, and the image without them: [`extract`]
+/// again on what each leaves, for as long as what is left has a sun (an interior's lamps after its brightest).
 /// `None` when the image has no sun at all.
 pub fn extract_several(
     image: &EnvironmentImage,

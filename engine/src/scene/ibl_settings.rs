@@ -102,7 +102,7 @@ impl std::fmt::Display for Footprint {
     }
 }
 
-/// The most compact bright sources `extracted_lights` may cut out of an environment.
+/// The most suns `extracted_lights` may ask for.
 pub const MAX_EXTRACTED_LIGHTS: u32 = 8;
 
 /// The IBL quality knobs (`[quality.ibl]` in scene files).

@@ -169,9 +169,9 @@ pub fn ibl_size_settings() -> Vec<(String, engine::ibl::IblSettings)> {
 /// default reads once a sample's solid angle; Krivanek and Colbert read 4 times), Frostbite's
 /// dominant direction for the split sum, the split sum's anisotropic taps (alone and with that
 /// direction), samples on the anisotropic pixels only (alone and with that direction),
-/// sampling over a 256² specular cube, whose level 0 the sharpest lobes still read, and the
-/// three brightest compact sources extracted as lights, with sampling and with the cheaper
-/// Frostbite and anisotropic samples.
+/// sampling over a 256² specular cube, whose level 0 the sharpest lobes still read, and three
+/// suns extracted with Frostbite's direction and a few samples on the anisotropic pixels
+/// (candidates for a cheaper default).
 pub fn ibl_sampling_settings() -> Vec<(String, engine::ibl::IblSettings)> {
     let d = engine::ibl::IblSettings::default();
     let mut rows: Vec<_> = [64, 256]
@@ -317,8 +317,8 @@ pub enum MapSource {
 
 /// Runs the IBL sweep on one backend: per setting, the precompute time, the lighting pass's GPU
 /// time (median of `repeats` rounds over every setting in turn) and the error against the
-/// Monte Carlo reference per roughness. The reference is computed once, from the default render's G-buffer (the
-/// G-buffer does not depend on IBL settings).
+/// Monte Carlo reference per roughness. The reference is computed once, from the default
+/// render's G-buffer (the G-buffer does not depend on IBL settings).
 pub fn ibl_sweep(
     scene: &Scene,
     kind: BackendKind,
@@ -328,7 +328,8 @@ pub fn ibl_sweep(
     ibl_sweep_with(scene, kind, repeats, MapSource::Timed, progress)
 }
 
-/// [`ibl_sweep`] with its maps from `maps`.
+/// [`ibl_sweep`] with its maps from `maps`. With [`MapSource::Cached`] each setting renders
+/// once, and its lighting time is that render's (`repeats` is not used).
 pub fn ibl_sweep_with(
     scene: &Scene,
     kind: BackendKind,
