@@ -205,8 +205,8 @@ enum Command {
         /// Backend.
         #[arg(long, default_value = "gl")]
         backend: BackendKind,
-        /// Timed renders per setting, their median kept (the IBL sweep renders every setting in
-        /// turn, this many rounds).
+        /// Timed renders per setting, their median kept (the shadow and IBL sweeps render every
+        /// setting in turn, this many rounds).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
         /// Light the scene with this environment (EXR or .hdr) instead of its own, keeping its

@@ -32,7 +32,7 @@ pub(crate) fn run(
             println!("{text}");
         } else {
             println!(
-                "ibl sweep of {} on {kind} ({repeats} renders per setting, median GPU time; error = mean relative error of r+g+b against the Monte Carlo reference, {} pixels, {} directions per strategy)",
+                "ibl sweep of {} on {kind} ({repeats} rounds over every setting, median GPU time; error = mean relative error of r+g+b against the Monte Carlo reference, {} pixels, {} directions per strategy)",
                 loaded.scene.name,
                 harness::measure::sweep::IBL_REFERENCE_PIXELS,
                 harness::measure::sweep::IBL_REFERENCE_SAMPLES
@@ -67,7 +67,7 @@ pub(crate) fn run(
         println!("{text}");
     } else {
         println!(
-            "shadow sweep of {} on {kind} ({repeats} renders per setting, median GPU time)",
+            "shadow sweep of {} on {kind} ({repeats} rounds over every setting, median GPU time)",
             loaded.scene.name
         );
         print!("{}", harness::measure::sweep::table(&rows));

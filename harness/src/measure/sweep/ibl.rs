@@ -2,10 +2,10 @@
 //! and lighting pass) and measured against the Monte Carlo reference per roughness.
 
 use engine::backend::BackendKind;
-use engine::renderer::{self, Frame, PreparedFrame, Readback};
+use engine::renderer::{self, PreparedFrame, Readback};
 use engine::scene::Scene;
 
-use super::{lighting, pareto_front_n, pass_ms, stats, SweepError};
+use super::{lighting, pareto_front_n, pass_ms, stats, timing_rounds, SweepError};
 
 /// One setting of the IBL sweep.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -274,30 +274,6 @@ pub fn specular_mib(settings: &engine::ibl::IblSettings) -> f64 {
     bytes as f64 / f64::from(1u32 << 20)
 }
 
-/// The lighting pass's median GPU time of each of `frames`, rendered `repeats` times in rounds
-/// (each round renders every frame once, in order), ms.
-fn interleaved_lighting_ms(
-    backend: &mut dyn engine::backend::Backend,
-    frames: &[PreparedFrame],
-    repeats: usize,
-    progress: &mut impl FnMut(&str),
-) -> Result<Vec<Option<f64>>, SweepError> {
-    let mut rendered: Vec<Vec<Frame>> = frames.iter().map(|_| Vec::new()).collect();
-    for round in 0..repeats.max(1) {
-        progress(&format!("timing round {} of {}", round + 1, repeats.max(1)));
-        for (frame, times) in frames.iter().zip(&mut rendered) {
-            // Nothing read back: the timestamps are all a timing round needs.
-            let timed = renderer::render_prepared(backend, frame, Readback::Only(&[]))
-                .map_err(|e| SweepError::Render(e.to_string()))?;
-            times.push(timed);
-        }
-    }
-    Ok(rendered
-        .iter()
-        .map(|frames| pass_ms(frames, lighting))
-        .collect())
-}
-
 /// Reference pixels and directions per strategy of the IBL sweep's Monte Carlo reference.
 pub const IBL_REFERENCE_PIXELS: usize = 576;
 /// Directions per strategy and pixel (three or four strategies).
@@ -421,12 +397,10 @@ pub fn ibl_sweep_with(
     if maps == MapSource::Cached {
         return Ok(rows);
     }
-    // The lighting times: `repeats` rounds over every setting in turn, so that a drift of the
-    // host over the minutes the sweep takes reaches every row alike (renders of one setting
-    // back to back put a setting at 16.4 ms that took 10.3 ms interleaved with the default).
-    let times = interleaved_lighting_ms(backend.as_mut(), &prepared, repeats, &mut progress)?;
-    for (row, ms) in rows.iter_mut().zip(times) {
-        row.lighting_ms = ms;
+    // The lighting times: `repeats` rounds over every setting in turn.
+    let rounds = timing_rounds(backend.as_mut(), &prepared, repeats, &mut progress)?;
+    for (row, frames) in rows.iter_mut().zip(&rounds) {
+        row.lighting_ms = pass_ms(frames, lighting);
     }
     // Two costs: the precompute (once per environment and settings) and the lighting pass (every
     // frame; the filtered importance sampling settings spend it there).

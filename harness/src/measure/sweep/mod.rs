@@ -6,7 +6,8 @@
 //!
 //! `harness sweep --scene chess --knob shadow` renders
 //! the scene once per setting (shadow filter x map size), times the passes from GPU timestamps
-//! (median of several renders), and measures the error of the shadow term against
+//! (median of several rounds, each rendering every setting once), and measures the error of the
+//! shadow term against
 //!
 //! - exact hard visibility by ray casting ([`crate::reference::shadows`]): the fraction of
 //!   lit-surface pixels whose term is on the wrong side of 0.5, and the mean absolute difference;
@@ -34,7 +35,7 @@ pub use tables::{
 };
 
 use engine::plan::PassId;
-use engine::renderer::Frame;
+use engine::renderer::{self, Frame, PreparedFrame, Readback};
 use engine::stats::median;
 
 /// Why a sweep failed.
@@ -72,6 +73,30 @@ fn pass_ms(frames: &[Frame], of: impl Fn(PassId) -> bool) -> Option<f64> {
             })
             .collect(),
     )
+}
+
+/// `repeats` timed renders of each of `frames`, in rounds: each round renders every frame once,
+/// in order, reading nothing back (the timestamps are all a timing needs). A sweep takes
+/// minutes, and a host drifts over minutes: renders of one setting back to back put the drift on
+/// some settings only (one IBL sweep read a setting at 16.4 ms that took 10.3 ms rendered in
+/// turn with the default), rounds spread it over all of them.
+fn timing_rounds(
+    backend: &mut dyn engine::backend::Backend,
+    frames: &[PreparedFrame],
+    repeats: usize,
+    progress: &mut impl FnMut(&str),
+) -> Result<Vec<Vec<Frame>>, SweepError> {
+    let rounds = repeats.max(1);
+    let mut rendered: Vec<Vec<Frame>> = frames.iter().map(|_| Vec::new()).collect();
+    for round in 0..rounds {
+        progress(&format!("timing round {} of {rounds}", round + 1));
+        for (frame, times) in frames.iter().zip(&mut rendered) {
+            let timed = renderer::render_prepared(backend, frame, Readback::Only(&[]))
+                .map_err(|e| SweepError::Render(e.to_string()))?;
+            times.push(timed);
+        }
+    }
+    Ok(rendered)
 }
 
 /// The shadow maps' passes (casters and VSM blurs, not the shadow-term outputs).

@@ -7,7 +7,7 @@ use engine::renderer::PreparedFrame;
 use engine::renderer::{self, Frame, Readback};
 use engine::scene::{Light, Scene, ShadowFilter};
 
-use super::{lighting, pareto_front, pass_ms, shadow_map, stats, SweepError};
+use super::{lighting, pareto_front, pass_ms, shadow_map, stats, timing_rounds, SweepError};
 use crate::reference::shadows;
 
 /// One setting of the sweep.
@@ -79,7 +79,8 @@ pub enum ShadowSweepCost {
     Untimed,
 }
 
-/// Runs the shadow sweep on one backend. `repeats` renders per setting for the timing median.
+/// Runs the shadow sweep on one backend. `repeats` rounds of timed renders, each rendering every
+/// setting once, for the timing medians.
 pub fn shadow_sweep(
     scene: &Scene,
     kind: BackendKind,
@@ -133,16 +134,16 @@ pub fn shadow_sweep_with(
     } else {
         Readback::Needed(&wanted)
     };
-    let mut render = |scene: &Scene| {
-        renderer::render(backend.as_mut(), scene, readback)
-            .map_err(|e| SweepError::Render(e.to_string()))
-    };
+    let render_error = |e: engine::renderer::RenderError| SweepError::Render(e.to_string());
     let mut rows = Vec::new();
+    // With timing: each setting's frame, for the timing rounds after the loop.
+    let mut prepared = Vec::new();
     let mut ray_cast: Option<shadows::RayCastVisibility> = None;
     for map_size in [512u32, 1024, 2048] {
         progress(&format!("soft reference at {map_size}"));
         let reference_scene = with_shadow(scene, ShadowFilter::SoftReference, map_size);
-        let reference = render(&reference_scene)?;
+        let reference =
+            renderer::render(backend.as_mut(), &reference_scene, readback).map_err(render_error)?;
         for (filter, samples) in [
             (ShadowFilter::Hard, None),
             (ShadowFilter::Pcf3, None),
@@ -164,11 +165,12 @@ pub fn shadow_sweep_with(
             };
             progress(&format!("{label} at {map_size}"));
             let mutated = with_shadow_samples(scene, filter, map_size, samples);
-            let repeats = if timed { repeats.max(1) } else { 1 };
-            let frames = (0..repeats)
-                .map(|_| render(&mutated))
-                .collect::<Result<Vec<_>, _>>()?;
-            let frame = &frames[0];
+            let prepared_frame = PreparedFrame::new(&mutated).map_err(render_error)?;
+            let frame = &renderer::render_prepared(backend.as_mut(), &prepared_frame, readback)
+                .map_err(render_error)?;
+            if timed {
+                prepared.push(prepared_frame);
+            }
             // Shadow settings change no geometry: one ray cast serves every setting whose
             // G-buffer is the same (checked, bit for bit).
             let cast = match ray_cast.take() {
@@ -195,8 +197,8 @@ pub fn shadow_sweep_with(
                 filter: label,
                 map_size,
                 fetches: filter.fetches(samples.unwrap_or(64)),
-                shadow_ms: timed.then(|| pass_ms(&frames, shadow_map)).flatten(),
-                lighting_ms: timed.then(|| pass_ms(&frames, lighting)).flatten(),
+                shadow_ms: None,
+                lighting_ms: None,
                 misclassified: visibility.fraction,
                 error_vs_soft_reference: soft.map(|s| s.0),
                 soft_reference_p99_max: soft.map(|s| (s.1, s.2)),
@@ -207,6 +209,12 @@ pub fn shadow_sweep_with(
     }
     if !timed {
         return Ok(rows);
+    }
+    // The times: `repeats` rounds over every setting in turn.
+    let rounds = timing_rounds(backend.as_mut(), &prepared, repeats, &mut progress)?;
+    for (row, frames) in rows.iter_mut().zip(&rounds) {
+        row.shadow_ms = pass_ms(frames, shadow_map);
+        row.lighting_ms = pass_ms(frames, lighting);
     }
     let points: Vec<(f64, f64)> = rows
         .iter()
