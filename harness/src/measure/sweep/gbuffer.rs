@@ -93,8 +93,7 @@ pub fn gbuffer_sweep(
         crate::faults::create_backend(kind).map_err(|e| SweepError::Render(e.to_string()))?;
     let wanted = [TargetId::Light, TargetId::Mask(0)];
     let mut render = |scene: &Scene| {
-        renderer::render(backend.as_mut(), scene, Readback::Only(&wanted))
-            .map_err(|e| SweepError::Render(e.to_string()))
+        renderer::render(backend.as_mut(), scene, Readback::Only(&wanted)).map_err(SweepError::from)
     };
     let mut base = scene.clone();
     base.quality.gbuffer = engine::scene::GbufferSettings::default();

@@ -350,12 +350,12 @@ pub fn ibl_sweep_with(
         };
         let mut variant = scene.clone();
         variant.quality.ibl = settings.clone();
-        let render_error = |e: engine::renderer::RenderError| SweepError::Render(e.to_string());
-        let frame = PreparedFrame::new(&variant).map_err(render_error)?;
-        let frames = [
-            renderer::render_prepared(backend.as_mut(), &frame, Readback::All)
-                .map_err(render_error)?,
-        ];
+        let frame = PreparedFrame::new(&variant)?;
+        let frames = [renderer::render_prepared(
+            backend.as_mut(),
+            &frame,
+            Readback::All,
+        )?];
         if maps == MapSource::Timed {
             prepared.push(frame);
         }

@@ -55,6 +55,12 @@ pub enum SweepError {
     Reference(#[from] crate::reference::ReferenceError),
 }
 
+impl From<engine::renderer::RenderError> for SweepError {
+    fn from(e: engine::renderer::RenderError) -> Self {
+        SweepError::Render(e.to_string())
+    }
+}
+
 /// Median over frames of the GPU ms of every pass `of` selects (summed in each frame).
 fn pass_ms(frames: &[Frame], of: impl Fn(PassId) -> bool) -> Option<f64> {
     median(
@@ -91,8 +97,7 @@ fn timing_rounds(
     for round in 0..rounds {
         progress(&format!("timing round {} of {rounds}", round + 1));
         for (frame, times) in frames.iter().zip(&mut rendered) {
-            let timed = renderer::render_prepared(backend, frame, Readback::Only(&[]))
-                .map_err(|e| SweepError::Render(e.to_string()))?;
+            let timed = renderer::render_prepared(backend, frame, Readback::Only(&[]))?;
             times.push(timed);
         }
     }

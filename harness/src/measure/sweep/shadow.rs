@@ -125,8 +125,7 @@ pub fn shadow_sweep_with(
         crate::faults::create_backend(kind).map_err(|e| SweepError::Render(e.to_string()))?;
     let term_name = TargetId::ShadowTerm { light };
     // What the ray-cast comparison reads (shadow settings change no target but the maps').
-    let hard = PreparedFrame::new(&with_shadow(scene, ShadowFilter::Hard, 512))
-        .map_err(|e| SweepError::Render(e.to_string()))?;
+    let hard = PreparedFrame::new(&with_shadow(scene, ShadowFilter::Hard, 512))?;
     let wanted = shadows::visibility_targets(hard.plan(), light);
     let timed = cost == ShadowSweepCost::Timed;
     let readback = if timed {
@@ -134,7 +133,6 @@ pub fn shadow_sweep_with(
     } else {
         Readback::Needed(&wanted)
     };
-    let render_error = |e: engine::renderer::RenderError| SweepError::Render(e.to_string());
     let mut rows = Vec::new();
     // With timing: each setting's frame, for the timing rounds after the loop.
     let mut prepared = Vec::new();
@@ -142,8 +140,7 @@ pub fn shadow_sweep_with(
     for map_size in [512u32, 1024, 2048] {
         progress(&format!("soft reference at {map_size}"));
         let reference_scene = with_shadow(scene, ShadowFilter::SoftReference, map_size);
-        let reference =
-            renderer::render(backend.as_mut(), &reference_scene, readback).map_err(render_error)?;
+        let reference = renderer::render(backend.as_mut(), &reference_scene, readback)?;
         for (filter, samples) in [
             (ShadowFilter::Hard, None),
             (ShadowFilter::Pcf3, None),
@@ -165,9 +162,8 @@ pub fn shadow_sweep_with(
             };
             progress(&format!("{label} at {map_size}"));
             let mutated = with_shadow_samples(scene, filter, map_size, samples);
-            let prepared_frame = PreparedFrame::new(&mutated).map_err(render_error)?;
-            let frame = &renderer::render_prepared(backend.as_mut(), &prepared_frame, readback)
-                .map_err(render_error)?;
+            let prepared_frame = PreparedFrame::new(&mutated)?;
+            let frame = &renderer::render_prepared(backend.as_mut(), &prepared_frame, readback)?;
             if timed {
                 prepared.push(prepared_frame);
             }
