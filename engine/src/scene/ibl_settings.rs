@@ -184,12 +184,18 @@ impl Default for IblSettings {
 
 impl IblSettings {
     /// These settings with every knob that changes no precomputed map (the ones read at render
-    /// time: samples, footprint, dominant direction, anisotropic lookup, the sun's shadow) at its
-    /// default: what the maps are a function of, so settings that differ only there share maps.
-    /// A new render-time field belongs here too.
+    /// time: samples, footprint, dominant direction, anisotropic lookup, the sun's shadow; and
+    /// the count of suns when none is extracted) at its default: what the maps are a function
+    /// of, so settings that differ only there share maps. A new render-time field belongs here
+    /// too.
     pub fn precomputed_part(&self) -> IblSettings {
         let d = IblSettings::default();
         IblSettings {
+            extracted_lights: if self.extract_sun {
+                self.extracted_lights
+            } else {
+                d.extracted_lights
+            },
             runtime_samples: d.runtime_samples,
             runtime_footprint: d.runtime_footprint,
             anisotropic_samples: d.anisotropic_samples,

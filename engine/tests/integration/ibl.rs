@@ -255,6 +255,21 @@ fn disk_cache_round_trips_and_rebuilds_corrupt_entries() {
         ..settings.clone()
     };
     assert_eq!(ibl::cache::key(&image, &footprint), key);
+    // A count of suns changes the maps only when suns are extracted.
+    let suns = |extract_sun| IblSettings {
+        extract_sun,
+        extracted_lights: 3,
+        ..settings.clone()
+    };
+    assert_eq!(ibl::cache::key(&image, &suns(false)), key);
+    let one_sun = IblSettings {
+        extract_sun: true,
+        ..settings.clone()
+    };
+    assert_ne!(
+        ibl::cache::key(&image, &suns(true)),
+        ibl::cache::key(&image, &one_sun)
+    );
     let finer = IblSettings {
         specular_samples: 32,
         ..settings.clone()
