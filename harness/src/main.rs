@@ -288,9 +288,17 @@ enum Command {
     },
 }
 
+/// The log filter when `RUST_LOG` is unset: warnings and errors, less those of wgpu's EGL
+/// display probing, which logs an error for every display it tries and cannot use (`DRI2:
+/// failed to load driver` on a machine without a GPU) before it finds llvmpipe's, on runs that
+/// then pass. Whether a backend is usable, and why not, is what `harness backends` reports;
+/// `RUST_LOG=warn` shows the probing again.
+const DEFAULT_LOG_FILTER: &str = "warn,wgpu_hal::gles::egl=off";
+
 fn main() -> ExitCode {
     cli::private_runtime_dir();
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(DEFAULT_LOG_FILTER))
+        .init();
     let args = Cli::parse();
     harness::use_ibl_cache();
     let command = args.command.unwrap_or(Command::Check {

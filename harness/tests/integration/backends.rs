@@ -311,6 +311,24 @@ fn harness_backends_json(envs: &[(&str, &str)]) -> Vec<serde_json::Value> {
 }
 
 #[test]
+fn probing_the_backends_logs_no_error_where_every_backend_is_available() {
+    // wgpu's GL backend logs an error for each EGL display it tries and cannot use before it
+    // finds llvmpipe's; the harness leaves those out unless RUST_LOG asks for them.
+    let available = common::available_backends();
+    let output = common::harness_command()
+        .arg("backends")
+        .env_remove("RUST_LOG")
+        .output()
+        .expect("run harness");
+    assert!(output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let errors: Vec<&str> = stderr.lines().filter(|l| l.contains(" ERROR ")).collect();
+    if available.len() == BackendKind::ALL.len() {
+        assert!(errors.is_empty(), "errors logged: {errors:?}");
+    }
+}
+
+#[test]
 fn backends_json_reports_every_backend_with_fingerprints() {
     let available = common::available_backends();
     let statuses = harness_backends_json(&[]);
