@@ -116,7 +116,7 @@ pub struct IblMaps {
 /// Builds the maps (the whole precompute, no caches).
 pub fn build(image: &EnvironmentImage, settings: &IblSettings) -> IblMaps {
     let (residual, suns) = if settings.extract_sun {
-        sun::extract_several(image, settings.extracted_lights)
+        sun::extract(image, settings.extracted_lights)
             .map_or((None, Vec::new()), |(residual, suns)| {
                 (Some(residual), suns)
             })

@@ -16,7 +16,7 @@
 //! An interior has several: interior.exr's two lamps are two such regions (11 and 16 texels,
 //! together a third of its flux), and a bright patch of 105 texels a third. With
 //! `[quality.ibl] extracted_lights = N` the rule is applied again to what each extraction leaves,
-//! up to N times, and every region found becomes a light of its own ([`extract_several`]):
+//! up to N times, and every region found becomes a light of its own ([`extract`]):
 //! what filtered importance samples alias (a lamp a sample's footprint catches once, twice or
 //! not at all) is then lit exactly.
 
@@ -137,20 +137,11 @@ fn sun_region(image: &EnvironmentImage) -> Option<(Vec<usize>, [f32; 3])> {
     Some((region, sky))
 }
 
-/// The image's sun, if it has one (see the module documentation), and the image without it:
-/// its texels replaced by the sky around it.
-pub fn extract(image: &EnvironmentImage) -> Option<(EnvironmentImage, Sun)> {
-    let (residual, mut suns) = extract_several(image, 1)?;
-    Some((residual, suns.remove(0)))
-}
-
-/// Up to `count` suns, the brightest texel's first, and the image without them: [`extract`]
-/// again on what each leaves, for as long as what is left has a sun (an interior's lamps after its brightest).
-/// `None` when the image has no sun at all.
-pub fn extract_several(
-    image: &EnvironmentImage,
-    count: u32,
-) -> Option<(EnvironmentImage, Vec<Sun>)> {
+/// Up to `count` of the image's suns (see the module documentation), the brightest texel's
+/// first, and the image without them: each sun's texels replaced by the sky around it, and the
+/// rule applied again to what is left, for as long as that has a sun (an interior's lamps after
+/// its brightest). `None` when the image has no sun at all.
+pub fn extract(image: &EnvironmentImage, count: u32) -> Option<(EnvironmentImage, Vec<Sun>)> {
     let mut residual = image.clone();
     let mut suns = Vec::new();
     while suns.len() < count as usize {
@@ -263,7 +254,9 @@ mod tests {
     #[test]
     fn a_sun_carries_its_excess_flux_towards_its_texels() {
         let image = sky_with_sun(Some((40, 10, 1e4)));
-        let (residual, sun) = extract(&image).expect("a sun");
+        let (residual, suns) = extract(&image, 1).expect("a sun");
+        let sun = suns[0].clone();
+        assert_eq!(suns.len(), 1);
         assert_eq!(sun.texels, 4);
         // Excess radiance over the sky, times the four texels' solid angle.
         let omega: f64 = [10, 11]
@@ -287,8 +280,8 @@ mod tests {
 
     #[test]
     fn an_even_sky_has_no_sun() {
-        assert!(extract(&sky_with_sun(None)).is_none());
-        assert!(extract_several(&sky_with_sun(None), 3).is_none());
+        assert!(extract(&sky_with_sun(None), 1).is_none());
+        assert!(extract(&sky_with_sun(None), 3).is_none());
     }
 
     #[test]
@@ -298,14 +291,12 @@ mod tests {
         for (dx, dy) in [(0, 0), (1, 0), (2, 0), (0, 1), (1, 1), (2, 1)] {
             image.texels[((20 + dy) * 64 + 8 + dx) as usize] = [3e3, 3e3, 3e3, 1.0];
         }
-        let (residual, suns) = extract_several(&image, 3).expect("two suns");
+        let (residual, suns) = extract(&image, 3).expect("two suns");
         assert_eq!(suns.iter().map(|s| s.texels).collect::<Vec<_>>(), [4, 6]);
         assert!(residual.texels.iter().all(|t| t[0] < 1.0));
-        // The first is what `extract` finds alone, and one asked for is that one.
-        let (_, first) = extract(&image).unwrap();
-        assert_eq!(suns[0], first);
-        let (one_left, one) = extract_several(&image, 1).unwrap();
-        assert_eq!(one, [first]);
+        // One asked for is the first, and the second stays in the image.
+        let (one_left, one) = extract(&image, 1).unwrap();
+        assert_eq!(one[..], suns[..1]);
         assert!(one_left.texels.iter().any(|t| t[0] == 3e3));
     }
 }
