@@ -351,11 +351,7 @@ pub fn ibl_sweep_with(
         let mut variant = scene.clone();
         variant.quality.ibl = settings.clone();
         let frame = PreparedFrame::new(&variant)?;
-        let frames = [renderer::render_prepared(
-            backend.as_mut(),
-            &frame,
-            Readback::All,
-        )?];
+        let rendered = renderer::render_prepared(backend.as_mut(), &frame, Readback::All)?;
         if maps == MapSource::Timed {
             prepared.push(frame);
         }
@@ -363,15 +359,15 @@ pub fn ibl_sweep_with(
             progress("Monte Carlo reference");
             references = Some(crate::reference::ibl::reference_pixels(
                 scene,
-                &frames[0],
+                &rendered,
                 IBL_REFERENCE_PIXELS,
                 IBL_REFERENCE_SAMPLES,
             )?);
         }
         let references = references.as_deref().unwrap_or_default();
-        let by_roughness = crate::reference::ibl::error_by_roughness(&frames[0], references);
-        let by_family = crate::reference::ibl::error_by_family(&frames[0], references);
-        let (_, p99, max) = stats(crate::reference::ibl::pixel_errors(&frames[0], references));
+        let by_roughness = crate::reference::ibl::error_by_roughness(&rendered, references);
+        let by_family = crate::reference::ibl::error_by_family(&rendered, references);
+        let (_, p99, max) = stats(crate::reference::ibl::pixel_errors(&rendered, references));
         let total: usize = by_roughness.iter().map(|r| r.pixels).sum();
         let mean_relative = by_roughness
             .iter()
@@ -384,7 +380,7 @@ pub fn ibl_sweep_with(
             setting: name,
             settings,
             precompute_s,
-            lighting_ms: pass_ms(&frames, lighting),
+            lighting_ms: pass_ms(std::slice::from_ref(&rendered), lighting),
             specular_mib,
             by_roughness,
             mean_relative,
