@@ -93,20 +93,3 @@ pub fn backend_or_dash<S: serde::Serializer>(
 ) -> Result<S::Ok, S::Error> {
     s.serialize_str(backend.map_or("-", engine::backend::BackendKind::name))
 }
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn error_text_says_each_cause_once() {
-        let missing = std::path::Path::new("/nonexistent/albedo.png");
-        let asset =
-            engine::assets::load_texture(missing, engine::assets::ColorSpace::Srgb).unwrap_err();
-        let error = anyhow::Error::new(asset).context("loading scene `x`");
-        let text = super::error_text(error.as_ref());
-        assert_eq!(
-            text,
-            "loading scene `x`: /nonexistent/albedo.png: cannot read file: No such file or \
-             directory (os error 2)"
-        );
-    }
-}

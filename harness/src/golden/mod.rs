@@ -15,7 +15,7 @@ pub mod pass_kind;
 pub mod portability;
 pub mod selftest;
 pub mod speed;
-mod store;
+pub mod store;
 pub mod suite;
 pub mod tolerance;
 pub mod verify;

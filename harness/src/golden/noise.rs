@@ -179,16 +179,3 @@ pub fn round_up(x: f64) -> f64 {
     let scale = 10f64.powi(2 - x.log10().floor() as i32);
     (x * scale).ceil() / scale
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn limits_round_up_to_three_digits() {
-        assert_eq!(round_up(1.14441e-4), 1.15e-4);
-        assert_eq!(round_up(0.0207), 0.0207);
-        assert_eq!(round_up(0.0), 0.0);
-        assert!(round_up(3.0 * 3.814_697_265_625e-5) >= 3.0 * 3.814_697_265_625e-5);
-    }
-}

@@ -209,10 +209,10 @@ pub fn probe_in_child(
 /// A floor is timed at least this long (repeated in one submission), ms.
 pub const MIN_FLOOR_MS: f64 = 1.0;
 /// At most this many copies of a floor per sample.
-const MAX_FLOOR_COPIES: usize = 16;
+pub const MAX_FLOOR_COPIES: usize = 16;
 
 /// Copies of a floor whose one submission took `floor_ms` that last at least [`MIN_FLOOR_MS`].
-fn floor_copies(floor_ms: f64) -> usize {
+pub fn floor_copies(floor_ms: f64) -> usize {
     if floor_ms <= 0.0 {
         return MAX_FLOOR_COPIES;
     }
@@ -289,7 +289,7 @@ const SETTLE_TOLERANCE: f64 = 0.01;
 /// Whether a pass needs no more rounds: [`MIN_ROUNDS`] taken, and the last [`SETTLE_ROUNDS`]
 /// found nothing faster by more than [`SETTLE_TOLERANCE`] (a busy neighbour keeps a pass
 /// sampling until it gets a quiet moment or the rounds run out).
-fn settled(speed: &PassSpeed) -> bool {
+pub fn settled(speed: &PassSpeed) -> bool {
     let n = speed.pass_ms.len();
     if n < MIN_ROUNDS {
         return false;
@@ -301,65 +301,4 @@ fn settled(speed: &PassSpeed) -> bool {
         best_last >= best_before * (1.0 - SETTLE_TOLERANCE)
     };
     still(&speed.pass_ms) && still(&speed.floor_ms)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_pass_settles_once_its_last_rounds_find_nothing_faster() {
-        let speed = |pass_ms: &[f64], floor_ms: &[f64]| PassSpeed {
-            pass: PassId::ToneMap,
-            pass_ms: pass_ms.to_vec(),
-            floor_ms: floor_ms.to_vec(),
-        };
-        let floor = [1.0; 4];
-        assert!(!settled(&speed(&[2.0, 2.0, 2.0], &floor[..3])));
-        assert!(settled(&speed(&[2.0, 1.9, 2.1, 1.95], &floor)));
-        assert!(!settled(&speed(&[2.0, 2.0, 2.0, 1.5], &floor)));
-        assert!(!settled(&speed(&[2.0; 4], &[1.0, 1.0, 0.9, 1.0])));
-    }
-
-    #[test]
-    fn short_floors_are_repeated_to_a_millisecond() {
-        assert_eq!(floor_copies(2.0), 1);
-        assert_eq!(floor_copies(0.3), 4);
-        assert_eq!(floor_copies(0.01), MAX_FLOOR_COPIES);
-        assert_eq!(floor_copies(0.0), MAX_FLOOR_COPIES);
-    }
-
-    #[test]
-    fn merged_probes_keep_every_sample() {
-        let probe = |pass_ms: f64| SceneSpeed {
-            scene: "s".to_owned(),
-            backend: BackendKind::Gl,
-            rounds: 4,
-            passes: vec![PassSpeed {
-                pass: PassId::ToneMap,
-                pass_ms: vec![pass_ms],
-                floor_ms: vec![1.0],
-            }],
-        };
-        let merged = probe(3.0).merged(&probe(2.0));
-        assert_eq!(merged.rounds, 8);
-        assert_eq!(merged.passes[0].pass_ms, vec![3.0, 2.0]);
-        assert_eq!(merged.passes[0].ratio(), Some(2.0));
-    }
-
-    #[test]
-    fn the_ratio_is_fastest_over_fastest() {
-        let speed = PassSpeed {
-            pass: PassId::ToneMap,
-            pass_ms: vec![3.0, 2.0, 9.0],
-            floor_ms: vec![1.0, 4.0, 0.5],
-        };
-        assert_eq!(speed.ratio(), Some(4.0));
-        let empty = PassSpeed {
-            pass: PassId::ToneMap,
-            pass_ms: vec![],
-            floor_ms: vec![],
-        };
-        assert_eq!(empty.ratio(), None);
-    }
 }

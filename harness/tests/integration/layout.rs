@@ -87,6 +87,40 @@ fn relative_links(text: &str) -> Vec<&str> {
         .collect()
 }
 
+/// The harness library's test target is off (`[lib] test = false`: `cargo test` would compile
+/// the library a second time in test mode), so it holds no tests, which would never run there:
+/// they are in `tests/integration/units/`. Its binaries (`src/bin/`, `src/main.rs`) keep theirs.
+/// (The engine keeps its unit tests: most test private modules, which the engine's public API
+/// should not grow for, and its second compile is 13 CPU-s.)
+#[test]
+fn the_harness_library_holds_no_unit_tests() {
+    let harness = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let manifest = std::fs::read_to_string(harness.join("Cargo.toml")).unwrap();
+    assert!(
+        manifest.contains("[lib]\ntest = false"),
+        "harness/Cargo.toml no longer turns the library's tests off: move them back or keep this rule"
+    );
+    let mut files = Vec::new();
+    files_with_extensions(&harness.join("src"), &["rs"], &mut files);
+    let in_library = |path: &&PathBuf| {
+        !path.ends_with("main.rs") && !path.components().any(|c| c.as_os_str() == "bin")
+    };
+    let with_tests: Vec<String> = files
+        .iter()
+        .filter(in_library)
+        .filter(|path| {
+            let text = std::fs::read_to_string(path).unwrap();
+            text.contains("#[test]") || text.contains("#[cfg(test)]")
+        })
+        .map(|path| path.display().to_string())
+        .collect();
+    assert!(
+        with_tests.is_empty(),
+        "tests in the harness library, where `cargo test` does not run them (move them to \
+         harness/tests/integration/units/): {with_tests:?}"
+    );
+}
+
 /// The README's two commands share one build: every crate that `cargo run -p harness` builds is
 /// built by `cargo test --workspace` with the same features (the dev-dependencies turn some on;
 /// harness/Cargo.toml names those, or the tests would build engine and harness a second time).

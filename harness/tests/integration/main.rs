@@ -36,4 +36,5 @@ mod selftest;
 mod shadows;
 mod speed;
 mod sweeps;
+mod units;
 mod verify_cache;

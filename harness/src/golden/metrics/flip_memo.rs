@@ -20,20 +20,14 @@ use sha2::{Digest, Sha256};
 const KEPT_IN_MEMORY: usize = 8;
 
 /// The key of a FLIP map: what it was computed from, hashed.
-type Key = [u8; 32];
+pub type Key = [u8; 32];
 
 /// Maps computed in this process, the newest last.
 static MEMORY: Mutex<VecDeque<(Key, Arc<Vec<f32>>)>> = Mutex::new(VecDeque::new());
 
 /// The key of FLIP of `test` against `reference` (RGB bytes, `width` x `height`) at
 /// `pixels_per_degree`.
-pub(super) fn key(
-    reference: &[u8],
-    test: &[u8],
-    width: u32,
-    height: u32,
-    pixels_per_degree: f32,
-) -> Key {
+pub fn key(reference: &[u8], test: &[u8], width: u32, height: u32, pixels_per_degree: f32) -> Key {
     let mut hash = Sha256::new();
     // The implementation's name: a FLIP of another version would be another function.
     hash.update(b"nv-flip 0.1 LDR");
@@ -69,7 +63,7 @@ pub(super) fn put(key: Key, map: Arc<Vec<f32>>) {
 }
 
 /// The map of `key` in `folder`, if a whole one of `len` values is there.
-fn read(folder: &Path, key: &Key, len: usize) -> Option<Vec<f32>> {
+pub fn read(folder: &Path, key: &Key, len: usize) -> Option<Vec<f32>> {
     let bytes = std::fs::read(file(folder, key)).ok()?;
     (bytes.len() == len * 4).then(|| {
         bytes
@@ -80,7 +74,7 @@ fn read(folder: &Path, key: &Key, len: usize) -> Option<Vec<f32>> {
 }
 
 /// Writes the map of `key` into `folder` (whole or not at all; the folder is made if missing).
-fn write(folder: &Path, key: &Key, map: &[f32]) -> Result<(), crate::images::ImageFileError> {
+pub fn write(folder: &Path, key: &Key, map: &[f32]) -> Result<(), crate::images::ImageFileError> {
     let bytes: Vec<u8> = map.iter().flat_map(|v| v.to_le_bytes()).collect();
     crate::images::write_atomically(&file(folder, key), &bytes)
 }
@@ -104,31 +98,7 @@ fn shared_folder() -> Option<PathBuf> {
 }
 
 /// The file of `key` in `folder`.
-fn file(folder: &Path, key: &Key) -> PathBuf {
+pub fn file(folder: &Path, key: &Key) -> PathBuf {
     let hex: String = key.iter().map(|b| format!("{b:02x}")).collect();
     folder.join(format!("{hex}.f32"))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_kept_map_is_read_back_whole_or_not_at_all() {
-        let dir = tempfile::tempdir().unwrap();
-        let key = key(&[1, 2, 3], &[4, 5, 6], 1, 1, 67.0);
-        let other = key_of_other();
-        assert_ne!(key, other, "the key covers the images");
-        write(dir.path(), &key, &[0.25]).unwrap();
-        assert_eq!(read(dir.path(), &key, 1), Some(vec![0.25]));
-        assert_eq!(read(dir.path(), &other, 1), None);
-        // A file of another length (cut short, another size) is not a map of this one.
-        assert_eq!(read(dir.path(), &key, 2), None);
-        std::fs::write(file(dir.path(), &key), [0u8; 3]).unwrap();
-        assert_eq!(read(dir.path(), &key, 1), None);
-    }
-
-    fn key_of_other() -> Key {
-        key(&[1, 2, 3], &[4, 5, 7], 1, 1, 67.0)
-    }
 }

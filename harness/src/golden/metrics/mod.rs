@@ -25,7 +25,7 @@
 use std::borrow::Cow;
 
 pub mod compare;
-mod flip_memo;
+pub mod flip_memo;
 
 use engine::{Image, ImageData};
 
@@ -425,6 +425,3 @@ pub fn flip_stats(map: &[f32], percentile: f64) -> (f64, f64) {
         engine::stats::percentile_of_sorted(&sorted, percentile),
     )
 }
-
-#[cfg(test)]
-mod tests;

@@ -11,10 +11,10 @@
 //! renders under them, `rounding.rs` is the synthetic host rounding, and `model.rs` turns the
 //! measurements into the noise model and the table of ratios.
 
-mod measuring;
-mod model;
-mod rounding;
-mod sources;
+pub mod measuring;
+pub mod model;
+pub mod rounding;
+pub mod sources;
 
 pub use measuring::{
     known_driver_crash, measure, measure_environment, measure_recorded, measure_synthetic,

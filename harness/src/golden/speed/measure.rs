@@ -281,37 +281,3 @@ pub fn scores(
         })
         .collect()
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_model_keeps_each_tiers_worst_source_and_scores_stay_at_half_the_limit() {
-        let m = |source: &str, tier, factor| TimingMeasurement {
-            source: source.to_owned(),
-            tier,
-            scene: "s".to_owned(),
-            backend: BackendKind::Gl,
-            pass: PassId::ToneMap,
-            factor,
-        };
-        let measurements = vec![
-            m("runs", Tier::SameHost, 1.1),
-            m("busy-neighbour", Tier::SameHost, 1.2),
-            m("cpu-avx", Tier::OtherHost, 1.3),
-            m("cpu-sse4.1", Tier::OtherHost, 0.9),
-        ];
-        let (sources, _) = timing_sources();
-        let model = model_from(&measurements, &sources, 2.0);
-        let noise = &model.scenes["s"][&BackendKind::Gl][&PassId::ToneMap];
-        assert_eq!(
-            (noise.host, noise.host_at.as_str()),
-            (1.2, "busy-neighbour")
-        );
-        assert_eq!((noise.drivers, noise.drivers_at.as_str()), (1.3, "cpu-avx"));
-        for (m, _, score) in scores(&model, &measurements) {
-            assert!(score <= 0.5 + 1e-9, "{m:?}: {score}");
-        }
-    }
-}

@@ -24,13 +24,13 @@
 //! ratio then does not depend on the host's core count, and a busy neighbour on a two-core
 //! machine leaves the rasterizer a core of its own.
 
-mod bless;
-mod goldens;
+pub mod bless;
+pub mod goldens;
 pub mod history;
 pub mod measure;
-mod model;
+pub mod model;
 pub mod selftest;
-mod verdict;
+pub mod verdict;
 
 use engine::backend::BackendKind;
 

@@ -100,7 +100,7 @@ pub(super) fn time_frames(
 }
 
 /// Renders `prepared` once (nothing read back): its pass times and wall ms.
-pub(super) fn time_frame(
+pub fn time_frame(
     backend: &mut dyn Backend,
     prepared: &PreparedFrame,
 ) -> Result<(PassTimes, f64), BenchError> {
@@ -122,7 +122,7 @@ pub(super) fn median_pass_ms(timings: &[PassTimes], pass: PassId) -> Option<f64>
 }
 
 /// The `p` percentile (nearest rank) over frames of plan pass `pass`'s GPU ms.
-pub(super) fn percentile_pass_ms(timings: &[PassTimes], pass: PassId, p: f64) -> Option<f64> {
+pub fn percentile_pass_ms(timings: &[PassTimes], pass: PassId, p: f64) -> Option<f64> {
     percentile(
         timings
             .iter()

@@ -15,7 +15,7 @@
 //!   (directional lights only): mean absolute difference.
 
 mod gbuffer;
-mod ibl;
+pub mod ibl;
 mod pareto;
 mod report;
 mod shadow;
@@ -62,7 +62,7 @@ impl From<engine::renderer::RenderError> for SweepError {
 }
 
 /// Median over frames of the GPU ms of every pass `of` selects (summed in each frame).
-fn pass_ms(frames: &[Frame], of: impl Fn(PassId) -> bool) -> Option<f64> {
+pub fn pass_ms(frames: &[Frame], of: impl Fn(PassId) -> bool) -> Option<f64> {
     median(
         frames
             .iter()

@@ -1,7 +1,9 @@
-//! Tests of the metrics on synthetic images with known answers.
+//! Tests of `harness::golden::metrics`.
 
-use super::*;
+use engine::{Image, ImageData};
+
 use engine::backend::TextureFormat;
+use harness::golden::metrics::*;
 
 fn u8_image(width: u32, height: u32, f: impl Fn(u32, u32) -> [u8; 4]) -> Image {
     let mut data = Vec::new();

@@ -1,0 +1,117 @@
+//! Tests of `harness::golden::speed::verdict`.
+
+use engine::backend::BackendKind;
+use engine::plan::PassId;
+use harness::golden::speed::verdict::*;
+use harness::golden::speed::PassNoise;
+use harness::golden::speed::{Tier, TimingGoldens, TimingNoise};
+use harness::measure::speed::PassSpeed;
+use harness::measure::speed::SceneSpeed;
+
+fn probe(tonemap_ms: f64, geometry_ms: f64) -> SceneSpeed {
+    SceneSpeed {
+        scene: "s".to_owned(),
+        backend: BackendKind::Gl,
+        rounds: 1,
+        passes: vec![
+            PassSpeed {
+                pass: PassId::ToneMap,
+                pass_ms: vec![tonemap_ms],
+                floor_ms: vec![0.5],
+            },
+            PassSpeed {
+                pass: PassId::Geometry,
+                pass_ms: vec![geometry_ms],
+                floor_ms: vec![1.0],
+            },
+        ],
+    }
+}
+
+fn model() -> TimingNoise {
+    let mut model = TimingNoise::default();
+    let figures = |host: f64, drivers: f64| PassNoise {
+        host,
+        host_at: "busy".to_owned(),
+        drivers,
+        drivers_at: "cpu-sse4.1".to_owned(),
+    };
+    model.scenes.entry("s".to_owned()).or_default().insert(
+        BackendKind::Gl,
+        [
+            (PassId::ToneMap, figures(1.1, 1.2)),
+            (PassId::Geometry, figures(1.1, 1.5)),
+        ]
+        .into_iter()
+        .collect(),
+    );
+    model
+}
+
+#[test]
+fn a_slower_pass_fails_a_faster_one_is_a_note_and_noise_decides_what_is_timed() {
+    // Tone mapping takes 3 ms (its floor 0.5 ms), geometry 4 ms (its floor 1 ms).
+    let mut goldens = TimingGoldens::default();
+    goldens.record(&probe(3.0, 4.0), &[], "here", "t");
+    let noise = model();
+    let verdict = |p: &SceneSpeed, host: &str, pass: PassId| {
+        check_speed(p, &goldens, &noise, host)
+            .into_iter()
+            .find(|c| c.pass == pass)
+            .unwrap()
+    };
+    let same = verdict(&probe(3.0, 4.0), "here", PassId::ToneMap);
+    assert_eq!(
+        (same.outcome.clone(), same.tier),
+        (SpeedOutcome::Passed, Tier::SameHost)
+    );
+    assert_eq!(same.score(), Some(0.0));
+    // Limit 1.2^2 (the noise floor) = 1.44 here: x1.5 fails, x1.3 passes, x0.65 (geometry)
+    // is a note.
+    assert_eq!(
+        verdict(&probe(4.5, 4.0), "here", PassId::ToneMap).outcome,
+        SpeedOutcome::Slower
+    );
+    let within = verdict(&probe(3.9, 4.0), "here", PassId::ToneMap);
+    assert_eq!(within.outcome, SpeedOutcome::Passed);
+    let limit = harness::golden::speed::MIN_NOISE.powi(2);
+    assert!((within.score().unwrap() - 1.3f64.ln() / limit.ln()).abs() < 1e-9);
+    assert_eq!(
+        verdict(&probe(3.0, 2.6), "here", PassId::Geometry).outcome,
+        SpeedOutcome::Faster
+    );
+    // Another host: geometry's drivers figure (1.5, limit 2.25) leaves it untimed there.
+    let other = verdict(&probe(3.9, 4.0), "there", PassId::ToneMap);
+    assert_eq!(
+        (other.outcome, other.tier),
+        (SpeedOutcome::Passed, Tier::OtherHost)
+    );
+    let noisy = verdict(&probe(3.0, 8.0), "there", PassId::Geometry);
+    assert!(
+        matches!(&noisy.outcome, SpeedOutcome::Untimed(why) if why.contains("x1.50 (cpu-sse4.1)")),
+        "{noisy:?}"
+    );
+    assert!(!noisy.failed());
+    assert_eq!(
+        verdict(&probe(3.0, 8.0), "here", PassId::Geometry).outcome,
+        SpeedOutcome::Slower
+    );
+    // A short pass (under 2 ms) has a noise floor of 1.3: limit 1.69 even here.
+    let mut short_goldens = TimingGoldens::default();
+    short_goldens.record(&probe(1.0, 4.0), &[], "here", "t");
+    let short_pass = |ms: f64| {
+        check_speed(&probe(ms, 4.0), &short_goldens, &noise, "here")
+            .into_iter()
+            .find(|c| c.pass == PassId::ToneMap)
+            .unwrap()
+    };
+    assert_eq!(short_pass(1.6).outcome, SpeedOutcome::Passed);
+    assert_eq!(short_pass(1.8).outcome, SpeedOutcome::Slower);
+    // Too short, and no golden.
+    let short = verdict(&probe(0.1, 4.0), "here", PassId::ToneMap);
+    assert!(matches!(short.outcome, SpeedOutcome::Untimed(ref why) if why.contains("too short")));
+    let missing = check_speed(&probe(1.0, 4.0), &TimingGoldens::default(), &noise, "here");
+    assert!(missing
+        .iter()
+        .all(|c| c.outcome == SpeedOutcome::MissingGolden && c.failed()));
+}

@@ -1,0 +1,115 @@
+//! Tests of `harness::golden::store`.
+
+use engine::backend::BackendKind;
+use engine::backend::TextureFormat;
+use engine::plan::TargetId;
+use engine::{Image, ImageData};
+use harness::golden::store::*;
+
+fn temp_store(name: &str) -> GoldenStore {
+    let dir = std::env::temp_dir().join(format!("golden-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    GoldenStore::new(dir)
+}
+
+/// A golden is decoded once while its file is unchanged, also for a clone of the store
+/// (which shares the decoded goldens), and again once rewritten.
+#[test]
+fn a_rewritten_golden_is_decoded_again() {
+    let store = temp_store("decoded");
+    let image = |value: f32| Image {
+        width: 1,
+        height: 1,
+        format: TextureFormat::Rgba16Float,
+        data: ImageData::F32(vec![value, 0.0, 0.0, 1.0]),
+    };
+    let bless = |store: &GoldenStore, value: f32| {
+        let lock = store.lock_scene("s", |_| {}).unwrap();
+        let provenance = Provenance {
+            backend: BackendKind::Gl,
+            driver: "llvmpipe",
+            previous: "new",
+            unverified: false,
+        };
+        store
+            .bless(&lock, TargetId::Light, &image(value), provenance)
+            .unwrap();
+    };
+    bless(&store, 1.0);
+    let clone = store.clone();
+    let load = |store: &GoldenStore| store.load("s", TargetId::Light, false).unwrap().unwrap();
+    let decodes = || store.decodes();
+    assert_eq!(load(&store).data, image(1.0).data);
+    assert_eq!(load(&store).data, image(1.0).data);
+    assert_eq!(load(&clone).data, image(1.0).data);
+    assert_eq!(decodes(), 1);
+    bless(&clone, 2.0);
+    assert_eq!(load(&store).data, image(2.0).data);
+    assert_eq!(load(&clone).data, image(2.0).data);
+    assert_eq!(decodes(), 2);
+    let _ = std::fs::remove_dir_all(store.root());
+}
+
+#[test]
+fn bless_writes_the_golden_and_the_record_and_refuses_nan() {
+    let store = temp_store("bless");
+    let image = Image {
+        width: 1,
+        height: 1,
+        format: TextureFormat::Rgba16Float,
+        data: ImageData::F32(vec![1.0, 2.0, 3.0, 1.0]),
+    };
+    let lock = store.lock_scene("s", |_| {}).unwrap();
+    let path = store
+        .bless(
+            &lock,
+            TargetId::Light,
+            &image,
+            Provenance {
+                backend: BackendKind::Gl,
+                driver: "llvmpipe",
+                previous: "new",
+                unverified: false,
+            },
+        )
+        .unwrap();
+    assert!(path.ends_with("s/light.exr"));
+    assert_eq!(
+        store
+            .load("s", TargetId::Light, false)
+            .unwrap()
+            .unwrap()
+            .data,
+        image.data
+    );
+    let records = store.records("s").unwrap();
+    assert_eq!(records["light"].backend, BackendKind::Gl);
+    let bad = Image {
+        data: ImageData::F32(vec![f32::NAN, 0.0, 0.0, 1.0]),
+        ..image.clone()
+    };
+    let err = store
+        .bless(
+            &lock,
+            TargetId::Light,
+            &bad,
+            Provenance {
+                backend: BackendKind::Gl,
+                driver: "llvmpipe",
+                previous: "new",
+                unverified: false,
+            },
+        )
+        .unwrap_err();
+    assert!(err.to_string().contains("NaN/Inf"), "{err}");
+    // The refused bless left the old golden untouched.
+    assert_eq!(
+        store
+            .load("s", TargetId::Light, false)
+            .unwrap()
+            .unwrap()
+            .data,
+        image.data
+    );
+    let _ = std::fs::remove_dir_all(store.root());
+}
