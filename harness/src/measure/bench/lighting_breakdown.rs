@@ -112,7 +112,7 @@ pub struct VariantFrames {
 
 /// One part of the lighting passes' work to take away: the row's label, the part, and whether
 /// the row is part of the sum.
-type Removal = (String, LightingFeature, bool);
+pub type Removal = (String, LightingFeature, bool);
 
 /// The parts of the lighting passes' work to take away one at a time, in row order: the input
 /// floor, the per-pixel setup, IBL, what IBL and the lights share, each light, then the parts
