@@ -77,13 +77,18 @@ impl Suite {
                 .iter()
                 .map(|c| (c.name().to_owned(), c.argument()))
                 .collect();
-            let run = harness::golden::speed::check_scenes(
+            let started = harness::golden::speed::start_check(
                 std::path::Path::new(env!("CARGO_BIN_EXE_harness")),
+                &scenes,
+                &[kind],
+                Default::default(),
+                &[],
+            );
+            let run = harness::golden::speed::check_scenes(
+                started,
                 self.store.root(),
                 &scenes,
                 &[(kind, driver)],
-                Default::default(),
-                &[],
                 |_| {},
             );
             match run.errors.first() {

@@ -174,23 +174,46 @@ fn save_bench_json(dir: &Path, name: &str, text: &str) -> anyhow::Result<()> {
 }
 
 /// `harness speed --in-process`: the probe in this process, as JSON (or a table); exits 1 when
-/// a backend asked for is missing or a scene fails.
+/// a backend asked for is missing or a scene fails. Every probe is prepared first (started,
+/// recorded, warmed up), then each takes its timed rounds in turn; with `wait_for_go`, only
+/// once a line (or the end) comes on stdin.
 pub(crate) fn speed_in_process(
     scenes: &[String],
     backends: &[BackendKind],
     rounds: usize,
     variations: engine::renderer::Variations,
     json: bool,
+    wait_for_go: bool,
 ) -> anyhow::Result<ExitCode> {
     let loaded = load_scenes(scenes)?;
-    let (results, failed) = each_scene_and_backend(&loaded, backends, |scene, kind| {
-        eprintln!("probing {} on {kind} ({rounds} rounds) ...", scene.name);
-        let result = harness::measure::speed::probe(scene, kind, rounds, variations)?;
-        if !json {
-            print_speed(&result);
-        }
-        Ok(result)
+    let (prepared, mut failed) = each_scene_and_backend(&loaded, backends, |scene, kind| {
+        eprintln!("preparing {} on {kind} ...", scene.name);
+        harness::measure::speed::PreparedProbe::new(scene, kind, variations)
     });
+    if wait_for_go {
+        let mut line = String::new();
+        std::io::stdin().read_line(&mut line)?;
+    }
+    let mut results = Vec::new();
+    for probe in prepared {
+        eprintln!(
+            "probing {} on {} ({rounds} rounds) ...",
+            probe.scene(),
+            probe.backend()
+        );
+        match probe.sample(rounds) {
+            Ok(result) => {
+                if !json {
+                    print_speed(&result);
+                }
+                results.push(result);
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                failed = true;
+            }
+        }
+    }
     if json {
         println!("{}", serde_json::to_string_pretty(&results)?);
     }
@@ -295,6 +318,10 @@ pub(crate) struct SpeedArgs {
     /// each backend is probed in a child process on one rasterizer thread.
     #[arg(long, hide = true)]
     pub in_process: bool,
+    /// With --in-process: prepare every probe, then wait for a line on stdin before the timed
+    /// rounds (how `check` lets its probe child prepare while it renders the images).
+    #[arg(long, hide = true, requires = "in_process")]
+    pub wait_for_go: bool,
 }
 
 /// `harness speed`: parses the slowdown asked for and probes, in child processes (or in this
@@ -326,6 +353,7 @@ pub(crate) fn speed_command(args: SpeedArgs) -> anyhow::Result<ExitCode> {
             args.rounds,
             variations,
             args.json,
+            args.wait_for_go,
         )
     } else {
         speed(

@@ -54,6 +54,13 @@ pub(crate) fn run(
         }
     }
     let store = harness::golden::GoldenStore::workspace();
+    let exe = std::env::current_exe()?;
+    // The speed probes' child starts now and prepares them (starting its backends, recording
+    // and warming up the frames) on the core the image renders leave idle; their timed rounds
+    // wait until the renders are done.
+    let speed = options.speed.then(|| {
+        harness::golden::speed::start_check(&exe, &speed_scenes, backends, variations, &[])
+    });
     let bar = indicatif::ProgressBar::new(0).with_style(
         indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} renders  {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
@@ -71,14 +78,13 @@ pub(crate) fn run(
         // would look like the origin).
         run.diagnoses.clear();
     }
-    let exe = std::env::current_exe()?;
     if options.verify {
         run.verifications =
             harness::golden::verify::verify_failing(&exe, &store, &cases, &run, &outputs, |what| {
                 bar.set_message(what.to_owned())
             });
     }
-    if options.speed {
+    if let Some(started) = speed {
         let available: Vec<(BackendKind, String)> = run
             .backends
             .iter()
@@ -86,12 +92,10 @@ pub(crate) fn run(
             .map(|b| (b.backend, b.fingerprint.clone().unwrap_or_default()))
             .collect();
         run.speed = harness::golden::speed::check_scenes(
-            &exe,
+            started,
             store.root(),
             &speed_scenes,
             &available,
-            variations,
-            &[],
             |what| bar.set_message(what.to_owned()),
         );
         harness::golden::speed::append_history(out, &run.speed, &available);

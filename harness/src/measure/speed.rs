@@ -90,48 +90,147 @@ impl SceneSpeed {
 /// Probes `scene` on `kind` for at most `rounds` rounds with `variations` applied to the frame (a
 /// [`SlowPass`](engine::renderer::SlowPass) injected by the speed self-test, the unspecialised
 /// lighting of `--debug-unspecialised-lighting`); the floors are never varied. A backend
-/// without timestamps gives no passes.
+/// without timestamps gives no passes. [`PreparedProbe::new`], then [`PreparedProbe::sample`].
 pub fn probe(
     scene: &Scene,
     kind: BackendKind,
     rounds: usize,
     variations: Variations,
 ) -> Result<SceneSpeed, BenchError> {
-    let backend_error = |e: backend::BackendError| BenchError::Backend {
-        backend: kind,
-        message: e.to_string(),
-    };
-    let render_error = |e: engine::renderer::RenderError| BenchError::Render {
-        scene: scene.name.clone(),
-        backend: kind,
-        message: e.to_string(),
-    };
-    let mut backend = crate::faults::create_backend(kind).map_err(backend_error)?;
-    let prepared = PreparedFrame::new(scene)
-        .map_err(render_error)?
-        .with_variations(variations);
-    let floors = Floors::new(backend.as_mut(), prepared.plan()).map_err(backend_error)?;
-    let recorded = match RecordedFrame::record(backend.as_mut(), &prepared) {
-        Ok(recorded) => recorded,
-        Err(e) => {
-            floors.destroy(backend.as_mut());
-            return Err(render_error(e));
+    PreparedProbe::new(scene, kind, variations)?.sample(rounds)
+}
+
+/// The untimed part of a probe: `scene`'s frame and its floors on a backend of their own,
+/// recorded and submitted once (every pipeline compiled, every target touched, each floor
+/// once). It may run while the machine is busy (`harness check` prepares its probes while it
+/// renders the images); [`PreparedProbe::sample`] takes the timed rounds, which may not.
+pub struct PreparedProbe {
+    scene: String,
+    kind: BackendKind,
+    backend: Box<dyn backend::Backend>,
+    recorded: RecordedFrame,
+    floors: Floors,
+    passes: Vec<PassId>,
+}
+
+impl PreparedProbe {
+    /// Starts a backend of `kind`, records `scene`'s frame with `variations` and the floors of
+    /// its passes, and submits each once.
+    pub fn new(
+        scene: &Scene,
+        kind: BackendKind,
+        variations: Variations,
+    ) -> Result<Self, BenchError> {
+        let backend_error = |e: backend::BackendError| BenchError::Backend {
+            backend: kind,
+            message: e.to_string(),
+        };
+        let render_error = |e: engine::renderer::RenderError| BenchError::Render {
+            scene: scene.name.clone(),
+            backend: kind,
+            message: e.to_string(),
+        };
+        let mut backend = crate::faults::create_backend(kind).map_err(backend_error)?;
+        let prepared = PreparedFrame::new(scene)
+            .map_err(render_error)?
+            .with_variations(variations);
+        let floors = Floors::new(backend.as_mut(), prepared.plan()).map_err(backend_error)?;
+        let recorded = match RecordedFrame::record(backend.as_mut(), &prepared) {
+            Ok(recorded) => recorded,
+            Err(e) => {
+                floors.destroy(backend.as_mut());
+                return Err(render_error(e));
+            }
+        };
+        let mut probe = Self {
+            scene: scene.name.clone(),
+            kind,
+            backend,
+            recorded,
+            floors,
+            passes: prepared.plan().passes.iter().map(|p| p.id).collect(),
+        };
+        match probe.warm_up() {
+            Ok(()) => Ok(probe),
+            Err(e) => Err(probe.fail(e)),
         }
-    };
-    let ids: Vec<PassId> = prepared.plan().passes.iter().map(|p| p.id).collect();
-    let result = sample(backend.as_mut(), &recorded, &floors, &ids, rounds.max(1));
-    recorded.destroy(backend.as_mut());
-    floors.destroy(backend.as_mut());
-    let passes = result.map_err(|e| match e {
-        SampleError::Render(e) => render_error(e),
-        SampleError::Backend(e) => backend_error(e),
-    })?;
-    Ok(SceneSpeed {
-        scene: scene.name.clone(),
-        backend: kind,
-        rounds: rounds.max(1),
-        passes,
-    })
+    }
+
+    /// The scene's name.
+    pub fn scene(&self) -> &str {
+        &self.scene
+    }
+
+    /// The backend.
+    pub fn backend(&self) -> BackendKind {
+        self.kind
+    }
+
+    /// The whole frame once and every floor once: the first submissions compile their shaders
+    /// and first touch their targets (3 to 5 ms for a 0.4 ms floor), so none of it is timed.
+    fn warm_up(&mut self) -> Result<(), SampleError> {
+        let backend = self.backend.as_mut();
+        self.recorded.submit(backend).map_err(SampleError::Render)?;
+        for &id in &self.passes {
+            self.floors
+                .time(backend, id)
+                .map_err(SampleError::Backend)?;
+        }
+        Ok(())
+    }
+
+    /// The timed rounds ([`sample`]), at most `rounds` (at least one); frees the probe's
+    /// resources.
+    pub fn sample(mut self, rounds: usize) -> Result<SceneSpeed, BenchError> {
+        let rounds = rounds.max(1);
+        match sample(
+            self.backend.as_mut(),
+            &self.recorded,
+            &self.floors,
+            &self.passes,
+            rounds,
+        ) {
+            Ok(passes) => {
+                let (scene, kind) = (self.scene.clone(), self.kind);
+                self.destroy();
+                Ok(SceneSpeed {
+                    scene,
+                    backend: kind,
+                    rounds,
+                    passes,
+                })
+            }
+            Err(e) => Err(self.fail(e)),
+        }
+    }
+
+    /// Frees the probe's resources and names `error` by scene and backend.
+    fn fail(self, error: SampleError) -> BenchError {
+        let (scene, backend) = (self.scene.clone(), self.kind);
+        self.destroy();
+        match error {
+            SampleError::Render(e) => BenchError::Render {
+                scene,
+                backend,
+                message: e.to_string(),
+            },
+            SampleError::Backend(e) => BenchError::Backend {
+                backend,
+                message: e.to_string(),
+            },
+        }
+    }
+
+    fn destroy(self) {
+        let Self {
+            mut backend,
+            recorded,
+            floors,
+            ..
+        } = self;
+        recorded.destroy(backend.as_mut());
+        floors.destroy(backend.as_mut());
+    }
 }
 
 /// The environment every speed probe runs under, on top of the caller's: one rasterizer
@@ -139,12 +238,8 @@ pub fn probe(
 pub const PROBE_ENV: [(&str, &str); 1] = [crate::golden::speed::PROBE_THREADS];
 
 /// Runs the probe of `scenes` (names or scene files) on `backends` (one after the other) in one
-/// child process, `exe speed --in-process --json` (the harness binary), under [`PROBE_ENV`] and
-/// `env`: one
-/// rasterizer thread, which a process cannot choose for itself once its drivers have started.
-/// `variations` may hold a slowed pass and the unspecialised lighting (the ones `harness speed`
-/// takes); the others are not passed on. The scenes that were probed, and an error per scene
-/// or backend that failed.
+/// child process of `exe` ([`ProbeChild`]) and waits for it: the scenes that were probed, and an
+/// error per scene or backend that failed.
 pub fn probe_in_child(
     exe: &std::path::Path,
     scenes: &[String],
@@ -153,55 +248,123 @@ pub fn probe_in_child(
     variations: Variations,
     env: &[(String, String)],
 ) -> (Vec<SceneSpeed>, Vec<String>) {
-    let mut command = std::process::Command::new(exe);
-    command
-        .args(["speed", "--in-process", "--json"])
-        .args(["--rounds", &rounds.to_string()]);
-    for backend in backends {
-        command.args(["--backend", backend.name()]);
-    }
-    let backend = crate::names(backends);
-    for scene in scenes {
-        command.args(["--scene", scene]);
-    }
-    if let Some(slow) = variations.slow_pass {
+    ProbeChild::start(exe, scenes, backends, rounds, variations, env).finish()
+}
+
+/// The probe of some scenes on some backends in a child process, `exe speed --in-process --json
+/// --wait-for-go` (the harness binary), under [`PROBE_ENV`] and the caller's environment: one
+/// rasterizer thread, which a process cannot choose for itself once its drivers have started.
+/// The child prepares every probe ([`PreparedProbe::new`]) as soon as it starts, and takes the
+/// timed rounds only once [`ProbeChild::finish`] tells it to: `harness check` starts it before
+/// rendering the images, so the preparing runs on a core the renders leave idle, and finishes
+/// it after them, on a quiet machine. Every probe goes this way, so goldens, the noise model and
+/// checks are measured alike. Dropped unfinished, the child is killed.
+pub struct ProbeChild {
+    child: Result<std::process::Child, String>,
+    /// The backends' names, for its errors.
+    label: String,
+}
+
+impl ProbeChild {
+    /// Starts the child for `scenes` on `backends` (every available one when empty), at most
+    /// `rounds` rounds each. `variations` may hold a slowed pass and the unspecialised lighting
+    /// (the ones `harness speed` takes); the others are not passed on.
+    pub fn start(
+        exe: &std::path::Path,
+        scenes: &[String],
+        backends: &[BackendKind],
+        rounds: usize,
+        variations: Variations,
+        env: &[(String, String)],
+    ) -> Self {
+        let mut command = std::process::Command::new(exe);
         command
-            .args(["--slow-pass", &slow.pass.to_string()])
-            .args(["--slowdown", &slow.factor.to_string()]);
-    }
-    if variations.unspecialised_lighting {
-        command.arg("--debug-unspecialised-lighting");
-    }
-    command.envs(PROBE_ENV.iter().map(|(k, v)| (*k, *v)));
-    command.envs(env.iter().map(|(k, v)| (k, v)));
-    let output = match command.output() {
-        Ok(output) => output,
-        Err(e) => {
-            return (
-                Vec::new(),
-                vec![format!("cannot run {}: {e}", exe.display())],
-            )
+            .args(["speed", "--in-process", "--json", "--wait-for-go"])
+            .args(["--rounds", &rounds.to_string()]);
+        for backend in backends {
+            command.args(["--backend", backend.name()]);
         }
-    };
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    let mut errors: Vec<String> = stderr
-        .lines()
-        .filter_map(|l| l.strip_prefix("error: "))
-        .map(|l| format!("{backend}: {l}"))
-        .collect();
-    match serde_json::from_slice::<Vec<SceneSpeed>>(&output.stdout) {
-        Ok(results) => (results, errors),
-        Err(_) => {
-            let tail: Vec<&str> = stderr
-                .lines()
-                .filter(|l| !l.contains("XDG_RUNTIME_DIR") && !l.contains("eglInitialize"))
-                .collect();
-            errors.push(format!(
-                "{backend}: the speed probe died ({}): {}",
-                output.status,
-                tail[tail.len().saturating_sub(3)..].join(" / ")
-            ));
-            (Vec::new(), errors)
+        for scene in scenes {
+            command.args(["--scene", scene]);
+        }
+        if let Some(slow) = variations.slow_pass {
+            command
+                .args(["--slow-pass", &slow.pass.to_string()])
+                .args(["--slowdown", &slow.factor.to_string()]);
+        }
+        if variations.unspecialised_lighting {
+            command.arg("--debug-unspecialised-lighting");
+        }
+        command.envs(PROBE_ENV.iter().map(|(k, v)| (*k, *v)));
+        command.envs(env.iter().map(|(k, v)| (k, v)));
+        command
+            .stdin(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped());
+        let label = if backends.is_empty() {
+            "every backend".to_owned()
+        } else {
+            crate::names(backends)
+        };
+        Self {
+            child: command
+                .spawn()
+                .map_err(|e| format!("{label}: cannot run {}: {e}", exe.display())),
+            label,
+        }
+    }
+
+    /// Lets the child take its timed rounds and waits for them: the scenes that were probed,
+    /// and an error per scene or backend that failed.
+    pub fn finish(mut self) -> (Vec<SceneSpeed>, Vec<String>) {
+        let placeholder = Err(String::new());
+        let mut child = match std::mem::replace(&mut self.child, placeholder) {
+            Ok(child) => child,
+            Err(e) => return (Vec::new(), vec![e]),
+        };
+        if let Some(mut stdin) = child.stdin.take() {
+            // A child that died already does not read it; its output says why.
+            let _ = std::io::Write::write_all(&mut stdin, b"go\n");
+        }
+        let output = match child.wait_with_output() {
+            Ok(output) => output,
+            Err(e) => {
+                return (
+                    Vec::new(),
+                    vec![format!("{}: the speed probe was lost: {e}", self.label)],
+                )
+            }
+        };
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        let mut errors: Vec<String> = stderr
+            .lines()
+            .filter_map(|l| l.strip_prefix("error: "))
+            .map(|l| format!("{}: {l}", self.label))
+            .collect();
+        match serde_json::from_slice::<Vec<SceneSpeed>>(&output.stdout) {
+            Ok(results) => (results, errors),
+            Err(_) => {
+                let tail: Vec<&str> = stderr
+                    .lines()
+                    .filter(|l| !l.contains("XDG_RUNTIME_DIR") && !l.contains("eglInitialize"))
+                    .collect();
+                errors.push(format!(
+                    "{}: the speed probe died ({}): {}",
+                    self.label,
+                    output.status,
+                    tail[tail.len().saturating_sub(3)..].join(" / ")
+                ));
+                (Vec::new(), errors)
+            }
+        }
+    }
+}
+
+impl Drop for ProbeChild {
+    fn drop(&mut self) {
+        if let Ok(child) = &mut self.child {
+            let _ = child.kill();
+            let _ = child.wait();
         }
     }
 }
@@ -224,10 +387,9 @@ enum SampleError {
     Backend(backend::BackendError),
 }
 
-/// The rounds: the whole frame once (every pass warm), every floor twice (warm, then sizing its
-/// repeats),
-/// then round after round each pass that has not settled alone and its floor, until every pass
-/// has settled ([`settled`]) or `rounds` rounds were taken.
+/// The timed part of a probe warmed up by [`PreparedProbe::new`]: every floor once more, sizing
+/// its repeats, then round after round each pass that has not settled alone and its floor,
+/// until every pass has settled ([`settled`]) or `rounds` rounds were taken.
 fn sample(
     backend: &mut dyn backend::Backend,
     recorded: &RecordedFrame,
@@ -235,14 +397,11 @@ fn sample(
     ids: &[PassId],
     rounds: usize,
 ) -> Result<Vec<PassSpeed>, SampleError> {
-    recorded.submit(backend).map_err(SampleError::Render)?;
     let mut passes: Vec<PassSpeed> = Vec::new();
     let mut copies = Vec::new();
     for &id in ids {
-        // The first submission of a floor compiles its shaders and first touches its targets
-        // (3 to 5 ms for a 0.4 ms floor): sized from it, no floor was ever repeated. Sized from
-        // the second.
-        floors.time(backend, id).map_err(SampleError::Backend)?;
+        // Sized from the floor's second submission: the first (the warm-up's) compiled its
+        // shaders and first touched its targets, so sized from it no floor was ever repeated.
         if let Some(floor_ns) = floors.time(backend, id).map_err(SampleError::Backend)? {
             passes.push(PassSpeed {
                 pass: id,

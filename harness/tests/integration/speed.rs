@@ -4,7 +4,7 @@
 use engine::backend::BackendKind;
 use engine::plan::PassId;
 use engine::renderer::{SlowPass, Variations};
-use harness::golden::speed::{check_scenes, SpeedOutcome};
+use harness::golden::speed::{check_scenes, start_check, SpeedOutcome};
 
 use crate::common;
 
@@ -21,11 +21,11 @@ fn a_slowed_pass_fails_its_own_speed_check_and_no_other() {
         .info
         .map(|info| harness::golden::fingerprint(&info))
         .unwrap_or_default();
-    let run = check_scenes(
+    let scenes = [("chess".to_owned(), "chess".to_owned())];
+    let started = start_check(
         std::path::Path::new(env!("CARGO_BIN_EXE_harness")),
-        store.root(),
-        &[("chess".to_owned(), "chess".to_owned())],
-        &[(BackendKind::Gl, driver)],
+        &scenes,
+        &[BackendKind::Gl],
         Variations {
             slow_pass: Some(SlowPass {
                 pass: PassId::ToneMap,
@@ -34,6 +34,12 @@ fn a_slowed_pass_fails_its_own_speed_check_and_no_other() {
             ..Default::default()
         },
         &[],
+    );
+    let run = check_scenes(
+        started,
+        store.root(),
+        &scenes,
+        &[(BackendKind::Gl, driver)],
         |_| {},
     );
     assert!(run.errors.is_empty(), "{:?}", run.errors);

@@ -149,18 +149,55 @@ impl SpeedRun {
     }
 }
 
-/// Probes each of `scenes` (their command-line arguments, names or files) on each backend of
-/// `backends` (with its driver fingerprint) in a child process of `exe`, and checks every pass
-/// against the goldens under `root` and the timing-noise model there. A scene with a slower
-/// pass is probed once more and judged on the samples of both probes. `variations` are the
+/// A speed check under way: its probe child ([`ProbeChild`](crate::measure::speed::ProbeChild)),
+/// preparing while the caller does other work, and what a second probe of a scene needs.
+pub struct StartedCheck {
+    probe: crate::measure::speed::ProbeChild,
+    exe: std::path::PathBuf,
+    variations: engine::renderer::Variations,
+    env: Vec<(String, String)>,
+}
+
+/// Starts the speed check of `scenes` (names and their command-line arguments, names or files)
+/// on `kinds` (every available backend when empty) in a child process of `exe`: it prepares
+/// its probes at once and takes the timed rounds in [`check_scenes`]. `variations` are the
 /// slowdowns a self-test injects (none for a plain check); `env` is added to the children's.
-pub fn check_scenes(
+pub fn start_check(
     exe: &std::path::Path,
+    scenes: &[(String, String)],
+    kinds: &[BackendKind],
+    variations: engine::renderer::Variations,
+    env: &[(String, String)],
+) -> StartedCheck {
+    let arguments: Vec<String> = scenes
+        .iter()
+        .map(|(_, argument)| argument.clone())
+        .collect();
+    // One child for every backend: a process start and the scenes' loading once.
+    StartedCheck {
+        probe: crate::measure::speed::ProbeChild::start(
+            exe,
+            &arguments,
+            kinds,
+            CHECK_ROUNDS,
+            variations,
+            env,
+        ),
+        exe: exe.to_owned(),
+        variations,
+        env: env.to_vec(),
+    }
+}
+
+/// Finishes `started` (the timed rounds of its probes) and checks every pass of `scenes` on
+/// each of `backends` (with its driver fingerprint) against the goldens under `root` and the
+/// timing-noise model there. A scene with a slower pass is probed once more and judged on the
+/// samples of both probes.
+pub fn check_scenes(
+    started: StartedCheck,
     root: &std::path::Path,
     scenes: &[(String, String)],
     backends: &[(BackendKind, String)],
-    variations: engine::renderer::Variations,
-    env: &[(String, String)],
     mut progress: impl FnMut(&str),
 ) -> SpeedRun {
     let mut run = SpeedRun::default();
@@ -171,32 +208,29 @@ pub fn check_scenes(
             return run;
         }
     };
-    let arguments: Vec<String> = scenes
-        .iter()
-        .map(|(_, argument)| argument.clone())
-        .collect();
-    // One child for every backend: a process start and the scenes' loading once.
     progress(&format!(
         "timing {} scene(s) on {}",
         scenes.len(),
         crate::names(&backends.iter().map(|(k, _)| *k).collect::<Vec<_>>())
     ));
-    let kinds: Vec<BackendKind> = backends.iter().map(|(kind, _)| *kind).collect();
-    let (probes, errors) = crate::measure::speed::probe_in_child(
+    let StartedCheck {
+        probe,
         exe,
-        &arguments,
-        &kinds,
-        CHECK_ROUNDS,
         variations,
         env,
-    );
+    } = started;
+    let (probes, errors) = probe.finish();
     run.errors.extend(errors);
     for probe in probes {
         let kind = probe.backend;
-        let driver = backends
+        // A backend the caller found unavailable is not checked (the child skips it too).
+        let Some(driver) = backends
             .iter()
             .find(|(k, _)| *k == kind)
-            .map_or("", |(_, d)| d.as_str());
+            .map(|(_, d)| d.as_str())
+        else {
+            continue;
+        };
         let host = host_fingerprint(driver);
         let goldens = match TimingGoldens::load(root, &probe.scene) {
             Ok(goldens) => goldens,
@@ -215,12 +249,12 @@ pub fn check_scenes(
                 .map_or_else(|| probe.scene.clone(), |(_, a)| a.clone());
             progress(&format!("confirming {} on {kind}", probe.scene));
             let (again, errors) = crate::measure::speed::probe_in_child(
-                exe,
+                &exe,
                 &[argument],
                 &[kind],
                 CHECK_ROUNDS,
                 variations,
-                env,
+                &env,
             );
             run.errors.extend(errors);
             if let Some(again) = again.into_iter().find(|a| a.scene == probe.scene) {

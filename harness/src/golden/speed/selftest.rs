@@ -7,7 +7,7 @@ use engine::backend::BackendKind;
 use engine::plan::PassId;
 use engine::renderer::{SlowPass, Variations};
 
-use super::{check_scenes, SpeedCheck, SpeedOutcome};
+use super::{check_scenes, start_check, SpeedCheck, SpeedOutcome};
 
 /// The slowdowns injected.
 pub const INJECTED: [f32; 2] = [1.5, 2.0];
@@ -65,16 +65,17 @@ pub fn run(
             for &pass in passes {
                 for &factor in factors {
                     progress(&format!("{scene} on {}: {pass} x{factor}", backend.0));
+                    let scenes = [(scene.clone(), argument.clone())];
+                    let variations = Variations {
+                        slow_pass: Some(SlowPass { pass, factor }),
+                        ..Default::default()
+                    };
+                    let started = start_check(exe, &scenes, &[backend.0], variations, &[]);
                     let run = check_scenes(
-                        exe,
+                        started,
                         root,
-                        &[(scene.clone(), argument.clone())],
+                        &scenes,
                         std::slice::from_ref(backend),
-                        Variations {
-                            slow_pass: Some(SlowPass { pass, factor }),
-                            ..Default::default()
-                        },
-                        &[],
                         |_| {},
                     );
                     errors.extend(run.errors.iter().cloned());
