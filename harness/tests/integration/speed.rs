@@ -1,5 +1,6 @@
 //! The speed checks end to end: a pass slowed down fails its own speed check and no other, the
-//! verdict `harness check` and the golden tests give.
+//! verdict `harness check` and the golden tests give; and the probe child takes no timed round
+//! before it is told to (what lets `check` prepare it while it renders the images).
 
 use engine::backend::BackendKind;
 use engine::plan::PassId;
@@ -59,4 +60,67 @@ fn a_slowed_pass_fails_its_own_speed_check_and_no_other() {
         assert!(!other.failed(), "{}: {}", other.pass, other.describe());
     }
     assert!(!run.passed());
+}
+
+/// The probe child (`speed --in-process --wait-for-go`) prepares its probes, then takes no timed
+/// round until a line comes on its stdin, and then probes as it would have.
+#[test]
+fn the_probe_child_takes_no_timed_round_before_it_is_told_to() {
+    use std::io::{BufRead, Read, Write};
+    use std::time::Duration;
+    if !common::gl_available() {
+        return;
+    }
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_harness"))
+        .args(["speed", "--in-process", "--json", "--wait-for-go"])
+        .args(["--scene", "arrow", "--backend", "gl", "--rounds", "4"])
+        .envs(harness::measure::speed::PROBE_ENV)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let (sender, lines) = std::sync::mpsc::channel::<String>();
+    let reader = std::thread::spawn(move || {
+        for line in stderr.lines().map_while(Result::ok) {
+            let _ = sender.send(line);
+        }
+    });
+    let prepared = lines
+        .iter()
+        .find(|line| line.starts_with("preparing arrow on gl"));
+    assert!(prepared.is_some(), "the child never said it was preparing");
+    // Told nothing, it stays put (preparing the one probe takes well under a second here; a
+    // child that did not wait would say `probing` within milliseconds of it).
+    let early: Vec<String> =
+        std::iter::from_fn(|| lines.recv_timeout(Duration::from_secs(2)).ok()).collect();
+    assert!(
+        !early.iter().any(|line| line.starts_with("probing")),
+        "a timed round before the go: {early:?}"
+    );
+    child.stdin.take().unwrap().write_all(b"go\n").unwrap();
+    let mut json = String::new();
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut json)
+        .unwrap();
+    assert!(child.wait().unwrap().success());
+    reader.join().unwrap();
+    let after: Vec<String> = lines.try_iter().collect();
+    assert!(
+        after
+            .iter()
+            .any(|line| line.starts_with("probing arrow on gl")),
+        "{after:?}"
+    );
+    let probes: Vec<harness::measure::speed::SceneSpeed> = serde_json::from_str(&json).unwrap();
+    assert_eq!(probes.len(), 1);
+    assert_eq!(
+        (probes[0].scene.as_str(), probes[0].backend),
+        ("arrow", BackendKind::Gl)
+    );
+    assert!(probes[0].passes.len() >= 5, "{:?}", probes[0].passes);
 }
