@@ -11,6 +11,10 @@
 //! what the host's speed does to both. Rounds interleave the passes, so slow drift reaches each
 //! alike, and a pass stops sampling once it has settled (at least [`MIN_ROUNDS`] rounds, the
 //! last two finding nothing faster): a quiet machine takes few rounds, a busy one more.
+//!
+//! The untimed part ([`PreparedProbe::new`]: the backend, the recording, the first submissions)
+//! and the timed one ([`PreparedProbe::sample`]) are apart, so that a probe child
+//! ([`ProbeChild`]) prepares while its parent is busy and times once the machine is quiet.
 
 use engine::backend::{self, BackendKind};
 use engine::plan::PassId;
