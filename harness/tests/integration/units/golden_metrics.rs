@@ -1,4 +1,4 @@
-//! Tests of `harness::golden::metrics`.
+//! Tests of `harness::golden::metrics` on synthetic images with known answers.
 
 use engine::{Image, ImageData};
 
