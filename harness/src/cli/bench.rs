@@ -191,6 +191,10 @@ pub(crate) fn speed_in_process(
         harness::measure::speed::PreparedProbe::new(scene, kind, variations)
     });
     if wait_for_go {
+        eprintln!(
+            "prepared {} probe(s); waiting for a line on stdin",
+            prepared.len()
+        );
         let mut line = String::new();
         std::io::stdin().read_line(&mut line)?;
     }

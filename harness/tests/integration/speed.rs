@@ -87,14 +87,14 @@ fn the_probe_child_takes_no_timed_round_before_it_is_told_to() {
             let _ = sender.send(line);
         }
     });
-    let prepared = lines
+    let waiting = lines
         .iter()
-        .find(|line| line.starts_with("preparing arrow on gl"));
-    assert!(prepared.is_some(), "the child never said it was preparing");
-    // Told nothing, it stays put (preparing the one probe takes well under a second here; a
-    // child that did not wait would say `probing` within milliseconds of it).
+        .find(|line| line.starts_with("prepared 1 probe(s); waiting"));
+    assert!(waiting.is_some(), "the child never said it was waiting");
+    // Told nothing, it stays put (a child that did not wait would say `probing` within
+    // milliseconds of being ready).
     let early: Vec<String> =
-        std::iter::from_fn(|| lines.recv_timeout(Duration::from_secs(2)).ok()).collect();
+        std::iter::from_fn(|| lines.recv_timeout(Duration::from_millis(500)).ok()).collect();
     assert!(
         !early.iter().any(|line| line.starts_with("probing")),
         "a timed round before the go: {early:?}"
