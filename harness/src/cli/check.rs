@@ -98,7 +98,11 @@ pub(crate) fn run(
             &available,
             |what| bar.set_message(what.to_owned()),
         );
-        harness::golden::speed::append_history(out, &run.speed, &available);
+        // The history is the series of an unchanged build's ratios (drift, a host's record):
+        // a run with the debug slowdown is not one.
+        if !options.unspecialised_lighting {
+            harness::golden::speed::append_history(out, &run.speed, &available);
+        }
     }
     bar.finish_and_clear();
     run.load_errors = broken;
@@ -344,7 +348,7 @@ fn print_diagnoses(run: &CheckRun) {
 /// The speed section of the table: a line per scene, pass and backend (the value against the
 /// limit, or why it is untimed), the probes that failed, and the passes that got faster.
 fn print_speed(run: &CheckRun) {
-    use harness::golden::speed::SpeedOutcome;
+    use harness::golden::speed::{SpeedOutcome, Tier};
     if run.speed.checks.is_empty() && run.speed.errors.is_empty() {
         return;
     }
@@ -375,18 +379,27 @@ fn print_speed(run: &CheckRun) {
     for e in &run.speed.errors {
         println!("speed probe FAILED: {e}");
     }
-    let faster: Vec<String> = run
-        .speed
-        .checks
-        .iter()
-        .filter(|c| c.outcome == SpeedOutcome::Faster)
-        .map(|c| format!("{}/{} on {}", c.scene, c.pass, c.backend))
-        .collect();
-    if !faster.is_empty() {
+    let faster = |tier| -> Vec<String> {
+        run.speed
+            .checks
+            .iter()
+            .filter(|c| c.outcome == SpeedOutcome::Faster && c.tier == tier)
+            .map(|c| format!("{}/{} on {}", c.scene, c.pass, c.backend))
+            .collect()
+    };
+    let (here, elsewhere) = (faster(Tier::SameHost), faster(Tier::OtherHost));
+    if !here.is_empty() {
         println!(
             "note: faster than their timing goldens beyond the limit (bless if intended, \
              `harness bless --scene S --speed-only`): {}",
-            faster.join(", ")
+            here.join(", ")
+        );
+    }
+    if !elsewhere.is_empty() {
+        println!(
+            "note: faster than their timing goldens beyond the limit, on a host that did not \
+             bless them (ratios differ between hosts: bless timing on the host that did): {}",
+            elsewhere.join(", ")
         );
     }
 }

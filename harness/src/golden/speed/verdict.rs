@@ -93,6 +93,9 @@ impl SpeedCheck {
                     .unwrap_or_default();
                 let what = match outcome {
                     SpeedOutcome::Slower => " SLOWER",
+                    SpeedOutcome::Faster if self.tier == Tier::OtherHost => {
+                        " faster (this host did not bless: ratios differ between hosts)"
+                    }
                     SpeedOutcome::Faster => " faster: bless if intended",
                     _ => "",
                 };
