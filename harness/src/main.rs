@@ -78,30 +78,7 @@ enum Command {
     /// on other hosts in golden/evidence/). Prints each source's worst value against every limit
     /// and exits 1 if any is above half its limit or a render failed. With --write, records the
     /// figures and the limits derived from them (margin x noise) in golden/noise.toml.
-    Noise {
-        /// Only these sources (repeatable): drivers, cpu-sse4.1, cpu-avx, vector-128, threads-1,
-        /// mesa-<version>, synthetic-rounding, a recorded host; `cheap` for the quick ones.
-        #[arg(long = "source")]
-        sources: Vec<String>,
-        /// Only these scenes (canonical names or scene files; repeatable).
-        #[arg(long = "scene")]
-        scenes: Vec<String>,
-        /// Write golden/noise.toml from this run (needs every source).
-        #[arg(long)]
-        write: bool,
-        /// With --write: limit = margin x max(noise, resolution) [default: 3]; with --timing,
-        /// ln limit = margin x ln noise [default: 2].
-        #[arg(long)]
-        margin: Option<f64>,
-        /// Print JSON.
-        #[arg(long)]
-        json: bool,
-        /// Measure the timing-noise model instead (golden/timing-noise.toml): each pass's
-        /// speed ratio against its timing golden over repeated probes, beside a busy
-        /// neighbour, under the CPU code paths and the second Mesa.
-        #[arg(long)]
-        timing: bool,
-    },
+    Noise(cli::noise::NoiseArgs),
     /// Write new goldens after an intended change: renders the scene, compares each pass with
     /// its golden, and rewrites only the passes that changed (outside tolerance) or have no
     /// golden, atomically, recording the driver and date in golden/<scene>/blessed.toml. Passes
@@ -341,14 +318,7 @@ fn main() -> ExitCode {
             },
         ),
         Command::Speed(args) => cli::bench::speed_command(args),
-        Command::Noise {
-            sources,
-            scenes,
-            write,
-            margin,
-            json,
-            timing,
-        } => cli::noise::command(&sources, &scenes, write, margin, json, timing),
+        Command::Noise(args) => cli::noise::entry(args),
         Command::Bless(args) => cli::bless::command(args),
         Command::Review { out, port } => cli::review::run(&out, port),
         Command::Report {

@@ -16,9 +16,68 @@ use super::load_cases;
 /// The sources that cannot be measured here, each with why.
 type Unmeasured = Vec<(String, String)>;
 
+/// The command line of `harness noise`.
+#[derive(clap::Args)]
+pub(crate) struct NoiseArgs {
+    /// Only these sources (repeatable): drivers, cpu-sse4.1, cpu-avx, vector-128, threads-1,
+    /// mesa-<version>, synthetic-rounding, a recorded host; `cheap` for the quick ones. With
+    /// --timing: runs, busy-neighbour, cpu-sse4.1, cpu-avx, mesa-<version>, a recorded host;
+    /// --write then raises the model's figures where these measure more and keeps the rest.
+    #[arg(long = "source")]
+    sources: Vec<String>,
+    /// Only these scenes (canonical names or scene files; repeatable).
+    #[arg(long = "scene")]
+    scenes: Vec<String>,
+    /// Write golden/noise.toml from this run (needs every source).
+    #[arg(long)]
+    write: bool,
+    /// With --write: limit = margin x max(noise, resolution) [default: 3]; with --timing,
+    /// ln limit = margin x ln noise [default: 2].
+    #[arg(long)]
+    margin: Option<f64>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+    /// Measure the timing-noise model instead (golden/timing-noise.toml): each pass's
+    /// speed ratio against its timing golden over repeated probes, beside a busy
+    /// neighbour, under the CPU code paths and the second Mesa.
+    #[arg(long)]
+    timing: bool,
+    /// With --timing, on a host that did not bless: probe every scene on each backend in
+    /// fresh processes and keep the ratios as this recorded host's figures
+    /// (golden/evidence/<NAME>/timing.toml), a source of the other-host limits.
+    #[arg(
+        long,
+        value_name = "NAME",
+        requires = "timing",
+        conflicts_with = "write"
+    )]
+    record_host: Option<String>,
+    /// With --record-host: also count the ratios of this host's earlier checks of the same
+    /// commit, from the speed history in OUT (the folder `check` wrote to: target/harness
+    /// unless its --out said otherwise): the drift of an unchanged build over many runs.
+    #[arg(long, value_name = "OUT", requires = "record_host")]
+    history: Option<std::path::PathBuf>,
+}
+
+/// `harness noise` as its command line asks: a host's recording, or a model measured.
+pub(crate) fn entry(args: NoiseArgs) -> anyhow::Result<ExitCode> {
+    match &args.record_host {
+        Some(name) => super::noise_timing::record_host(name, &args.scenes, args.history.as_deref()),
+        None => command(
+            &args.sources,
+            &args.scenes,
+            args.write,
+            args.margin,
+            args.json,
+            args.timing,
+        ),
+    }
+}
+
 /// `harness noise`: the image noise model, or with `timing` the timing-noise model, each with
 /// its default margin unless one is given.
-pub(crate) fn command(
+fn command(
     sources: &[String],
     scenes: &[String],
     write: bool,
@@ -28,7 +87,7 @@ pub(crate) fn command(
 ) -> anyhow::Result<ExitCode> {
     if timing {
         let margin = margin.unwrap_or(harness::golden::speed::DEFAULT_TIMING_MARGIN);
-        self::timing(scenes, write, margin, json)
+        super::noise_timing::timing(sources, scenes, write, margin, json)
     } else {
         let margin = margin.unwrap_or(harness::golden::noise::DEFAULT_MARGIN);
         run(sources, scenes, write, margin, json)
@@ -272,131 +331,4 @@ fn print_table(
         too_noisy.len(),
         failed_render_count
     );
-}
-
-/// `harness noise --timing`: probes the scenes named (every canonical one by default) on every
-/// available backend under every timing source, prints each pass's worst factor per tier with
-/// its limit and its score (or JSON), and with `write` records golden/timing-noise.toml. Exits 1
-/// when a measurement is above half its limit or a probe failed.
-pub(crate) fn timing(
-    scenes: &[String],
-    write: bool,
-    margin: f64,
-    json: bool,
-) -> anyhow::Result<ExitCode> {
-    use harness::golden::speed::{measure, Tier, TimingNoise};
-    let store = GoldenStore::workspace();
-    let cases = load_cases(scenes)?;
-    let scenes: Vec<(String, String)> = cases
-        .iter()
-        .map(|c| (c.name().to_owned(), c.argument()))
-        .collect();
-    let (sources, missing) = measure::timing_sources();
-    for (name, why) in &missing {
-        eprintln!("note: timing source {name} not measured: {why}");
-    }
-    if write && !missing.is_empty() {
-        anyhow::bail!("--write needs every timing source; install the missing ones first");
-    }
-    let backends: Vec<BackendKind> = BackendKind::ALL
-        .into_iter()
-        .filter(|k| engine::backend::probe(*k).available)
-        .collect();
-    let exe = std::env::current_exe()?;
-    let (measurements, errors) =
-        measure::measure_timing(&exe, store.root(), &scenes, &backends, &sources, |what| {
-            eprintln!("timing noise: {what} ...")
-        });
-    for e in &errors {
-        eprintln!("error: {e}");
-    }
-    let model = if write {
-        let mut model = measure::model_from(&measurements, &sources, margin);
-        // Scenes not measured in this run keep their figures.
-        if let Ok(old) = TimingNoise::load(store.root()) {
-            for (scene, figures) in old.scenes {
-                model.scenes.entry(scene).or_insert(figures);
-            }
-        }
-        model.save(store.root())?;
-        eprintln!("wrote {}", TimingNoise::path(store.root()).display());
-        model
-    } else {
-        TimingNoise::load(store.root())?
-    };
-    let scores = measure::scores(&model, &measurements);
-    let too_noisy = scores
-        .iter()
-        .filter(|(_, _, s)| *s > MAX_NOISE_RATIO)
-        .count();
-    if json {
-        let rows: Vec<serde_json::Value> = scores
-            .iter()
-            .map(|(m, limit, score)| {
-                serde_json::json!({
-                    "source": m.source, "tier": m.tier, "scene": m.scene,
-                    "backend": m.backend, "pass": m.pass, "factor": m.factor,
-                    "limit": limit, "score": score,
-                })
-            })
-            .collect();
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&serde_json::json!({
-                "measurements": rows, "errors": errors,
-            }))?
-        );
-    } else {
-        println!(
-            "{:<8} {:<12} {:<22} {:>14} {:>14} {:>10} {:>10}",
-            "scene", "backend", "pass", "host noise", "driver noise", "limit", "elsewhere"
-        );
-        for (scene, backends) in &model.scenes {
-            for (backend, passes) in backends {
-                for (pass, noise) in passes {
-                    let here = model.limit(noise.noise(Tier::SameHost).0);
-                    let elsewhere = model.limit(noise.noise(Tier::OtherHost).0);
-                    let untimed = |limit: f64| {
-                        if limit >= harness::golden::speed::MUST_CATCH {
-                            "(untimed)"
-                        } else {
-                            ""
-                        }
-                    };
-                    println!(
-                        "{scene:<8} {backend:<12} {pass:<22} {:>14} {:>14} {:>10} {:>10} {}",
-                        format!("x{:.2} {}", noise.host, short(&noise.host_at)),
-                        format!("x{:.2} {}", noise.drivers, short(&noise.drivers_at)),
-                        format!("x{here:.2}{}", untimed(here)),
-                        format!("x{elsewhere:.2}"),
-                        untimed(elsewhere)
-                    );
-                }
-            }
-        }
-        let worst = scores
-            .iter()
-            .max_by(|a, b| a.2.total_cmp(&b.2))
-            .map(|(m, limit, score)| {
-                format!(
-                    "{score:.2} of its limit ({} {} {} under {}: x{:.3}, limit x{limit:.2})",
-                    m.scene, m.backend, m.pass, m.source, m.factor
-                )
-            })
-            .unwrap_or_else(|| "-".to_owned());
-        println!(
-            "{} measurements, {too_noisy} above {MAX_NOISE_RATIO} of their limits; worst {worst}",
-            scores.len()
-        );
-    }
-    Ok(if too_noisy == 0 && errors.is_empty() {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::FAILURE
-    })
-}
-
-/// A source name short enough for the table.
-fn short(source: &str) -> &str {
-    source.get(..source.len().min(12)).unwrap_or(source)
 }

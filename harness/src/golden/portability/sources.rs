@@ -2,7 +2,7 @@
 //! code paths, a second Mesa release (once installed), synthetic rounding, and the hosts whose
 //! renders are recorded in `golden/evidence/`; and picking some of them by name.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use crate::golden::GoldenStore;
 
@@ -156,9 +156,18 @@ pub fn sources(store: &GoldenStore) -> (Vec<Source>, Vec<(String, String)>) {
     });
     let evidence = store.root().join("evidence");
     if let Ok(entries) = std::fs::read_dir(&evidence) {
+        // A host folder with renders (a host with speed ratios only is a timing source).
+        let has_renders = |dir: &Path| {
+            std::fs::read_dir(dir).is_ok_and(|files| {
+                files.filter_map(Result::ok).any(|f| {
+                    let path = f.path();
+                    path.extension().is_some_and(|e| e == "png" || e == "exr")
+                })
+            })
+        };
         let mut hosts: Vec<PathBuf> = entries
             .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.is_dir())
+            .filter(|p| p.is_dir() && has_renders(p))
             .collect();
         hosts.sort();
         for dir in hosts {

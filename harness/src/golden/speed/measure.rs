@@ -120,10 +120,11 @@ pub struct TimingMeasurement {
 }
 
 /// A process spinning on one core while it lives: the busy neighbour.
-struct BusyNeighbour(Option<std::process::Child>);
+pub struct BusyNeighbour(Option<std::process::Child>);
 
 impl BusyNeighbour {
-    fn start() -> Self {
+    /// Starts it (a warning when it cannot start: the probes then run without it).
+    pub fn start() -> Self {
         let child = std::process::Command::new("sh")
             .args(["-c", "while :; do :; done"])
             .stdin(std::process::Stdio::null())
@@ -255,6 +256,37 @@ pub fn model_from(
         if m.factor > *value {
             *value = ceil4(m.factor);
             *at = m.source.clone();
+        }
+    }
+    model
+}
+
+/// `model` with `measured`'s figures merged in: each pass's figure of each tier raised (with
+/// where) where `measured` has a larger one, every other figure kept, and `measured`'s sources
+/// added. What `noise --timing --source S --write` writes: one source measured again or a host
+/// recorded, without probing the others.
+pub fn merged(mut model: TimingNoise, measured: TimingNoise) -> TimingNoise {
+    model.sources.extend(measured.sources);
+    for (scene, backends) in measured.scenes {
+        for (backend, passes) in backends {
+            for (pass, new) in passes {
+                let old = model
+                    .scenes
+                    .entry(scene.clone())
+                    .or_default()
+                    .entry(backend)
+                    .or_default()
+                    .entry(pass)
+                    .or_insert_with(|| new.clone());
+                if new.host > old.host {
+                    old.host = new.host;
+                    old.host_at = new.host_at;
+                }
+                if new.drivers > old.drivers {
+                    old.drivers = new.drivers;
+                    old.drivers_at = new.drivers_at;
+                }
+            }
         }
     }
     model

@@ -29,6 +29,7 @@ pub mod goldens;
 pub mod history;
 pub mod measure;
 pub mod model;
+pub mod recorded;
 pub mod selftest;
 pub mod verdict;
 

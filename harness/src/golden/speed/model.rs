@@ -16,9 +16,10 @@ const HEADER: &str = "\
 # The timing-noise model, written by `harness noise --timing --write`.
 # Per scene, backend and pass: the largest factor an unchanged build's speed ratio came out
 # above its golden, under this host's sources (`host`: repeated runs, a busy neighbour) and
-# under another host's (`drivers`: llvmpipe's other CPU code paths, the second Mesa), with
-# where each was measured. A check's limit is max(noise, min_noise) ^ margin (on the log
-# scale, margin x the noise); on a host that did not bless, the `drivers` figure counts too.
+# under another host's (`drivers`: llvmpipe's other CPU code paths, the second Mesa, and the
+# hosts recorded in golden/evidence/), with where each was measured. A check's limit is
+# max(noise, min_noise) ^ margin (on the log scale, margin x the noise); on a host that did not
+# bless, the `drivers` figure counts too.
 # See harness/src/golden/speed/mod.rs.
 ";
 

@@ -21,6 +21,7 @@ mod golden_speed_goldens;
 mod golden_speed_history;
 mod golden_speed_measure;
 mod golden_speed_model;
+mod golden_speed_recorded;
 mod golden_speed_verdict;
 mod golden_store;
 mod golden_suite;

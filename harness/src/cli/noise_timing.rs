@@ -1,0 +1,341 @@
+//! `harness noise --timing`: the timing-noise model (golden/timing-noise.toml) measured from
+//! this host's sources and the hosts recorded in golden/evidence/, and `--record-host`, which
+//! records this host's speed ratios there.
+
+use std::process::ExitCode;
+
+use engine::backend::BackendKind;
+use harness::golden::noise::MAX_NOISE_RATIO;
+use harness::golden::GoldenStore;
+
+use super::load_cases;
+
+/// `harness noise --timing`: probes the scenes named (every canonical one by default) on every
+/// available backend under every timing source (or those named), counts the hosts recorded in
+/// golden/evidence/, prints each pass's worst factor per tier with its limit and its score (or
+/// JSON), and with `write` records golden/timing-noise.toml: from every source, or with sources
+/// named, their figures merged into the model (raised where they measure more, the rest kept).
+/// Exits 1 when a measurement is above half its limit or a probe failed.
+pub(super) fn timing(
+    only: &[String],
+    scenes: &[String],
+    write: bool,
+    margin: f64,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    use harness::golden::speed::{measure, recorded, TimingNoise};
+    let store = GoldenStore::workspace();
+    let cases = load_cases(scenes)?;
+    let scenes: Vec<(String, String)> = cases
+        .iter()
+        .map(|c| (c.name().to_owned(), c.argument()))
+        .collect();
+    let (mut sources, mut missing) = measure::timing_sources();
+    let mut recorded_measurements = Vec::new();
+    for (source, measurements) in recorded::recorded_hosts(store.root())? {
+        sources.push(source);
+        recorded_measurements.push(measurements);
+    }
+    if !only.is_empty() {
+        let known: Vec<&str> = sources
+            .iter()
+            .map(|s| s.name.as_str())
+            .chain(missing.iter().map(|(name, _)| name.as_str()))
+            .collect();
+        if let Some(unknown) = only.iter().find(|n| !known.contains(&n.as_str())) {
+            anyhow::bail!(
+                "unknown timing source {unknown}: the sources are {}",
+                known.join(", ")
+            );
+        }
+        missing.retain(|(name, _)| only.contains(name));
+    }
+    let chosen = |name: &str| only.is_empty() || only.iter().any(|n| n == name);
+    for (name, why) in &missing {
+        eprintln!("note: timing source {name} not measured: {why}");
+    }
+    if write && !missing.is_empty() {
+        anyhow::bail!(
+            "--write needs every timing source asked for; install the missing ones first"
+        );
+    }
+    let backends: Vec<BackendKind> = BackendKind::ALL
+        .into_iter()
+        .filter(|k| engine::backend::probe(*k).available)
+        .collect();
+    let exe = std::env::current_exe()?;
+    let probed: Vec<measure::TimingSource> = sources
+        .iter()
+        .filter(|s| s.probes > 0 && chosen(&s.name))
+        .cloned()
+        .collect();
+    let (mut measurements, errors) =
+        measure::measure_timing(&exe, store.root(), &scenes, &backends, &probed, |what| {
+            eprintln!("timing noise: {what} ...")
+        });
+    let wanted: Vec<&str> = scenes.iter().map(|(name, _)| name.as_str()).collect();
+    measurements.extend(
+        recorded_measurements
+            .into_iter()
+            .flatten()
+            .filter(|m| chosen(&m.source) && wanted.contains(&m.scene.as_str())),
+    );
+    sources.retain(|s| chosen(&s.name));
+    for e in &errors {
+        eprintln!("error: {e}");
+    }
+    let model = if write {
+        let measured = measure::model_from(&measurements, &sources, margin);
+        let model = match TimingNoise::load(store.root()) {
+            Ok(old) if !only.is_empty() => measure::merged(old, measured),
+            // Scenes not measured in this run keep their figures.
+            Ok(old) => {
+                let mut model = measured;
+                for (scene, figures) in old.scenes {
+                    model.scenes.entry(scene).or_insert(figures);
+                }
+                model
+            }
+            Err(e) if !only.is_empty() => return Err(e.into()),
+            Err(_) => measured,
+        };
+        model.save(store.root())?;
+        eprintln!("wrote {}", TimingNoise::path(store.root()).display());
+        model
+    } else {
+        TimingNoise::load(store.root())?
+    };
+    let scores = measure::scores(&model, &measurements);
+    let too_noisy = scores
+        .iter()
+        .filter(|(_, _, s)| *s > MAX_NOISE_RATIO)
+        .count();
+    if json {
+        print_timing_json(&scores, &errors)?;
+    } else {
+        print_timing_table(&model, &scores);
+    }
+    Ok(if too_noisy == 0 && errors.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}
+
+/// `harness noise --timing --json`: every measurement with its limit and score, and the errors.
+fn print_timing_json(
+    scores: &[(harness::golden::speed::measure::TimingMeasurement, f64, f64)],
+    errors: &[String],
+) -> anyhow::Result<()> {
+    let rows: Vec<serde_json::Value> = scores
+        .iter()
+        .map(|(m, limit, score)| {
+            serde_json::json!({
+                "source": m.source, "tier": m.tier, "scene": m.scene,
+                "backend": m.backend, "pass": m.pass, "factor": m.factor,
+                "limit": limit, "score": score,
+            })
+        })
+        .collect();
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&serde_json::json!({
+            "measurements": rows, "errors": errors,
+        }))?
+    );
+    Ok(())
+}
+
+/// `harness noise --timing`'s table: each pass's figures per tier with its limits here and
+/// elsewhere, and the worst measurement against its limit.
+fn print_timing_table(
+    model: &harness::golden::speed::TimingNoise,
+    scores: &[(harness::golden::speed::measure::TimingMeasurement, f64, f64)],
+) {
+    use harness::golden::speed::Tier;
+    let too_noisy = scores
+        .iter()
+        .filter(|(_, _, s)| *s > MAX_NOISE_RATIO)
+        .count();
+    println!(
+        "{:<8} {:<12} {:<22} {:>14} {:>14} {:>10} {:>10}",
+        "scene", "backend", "pass", "host noise", "driver noise", "limit", "elsewhere"
+    );
+    for (scene, backends) in &model.scenes {
+        for (backend, passes) in backends {
+            for (pass, noise) in passes {
+                let here = model.limit(noise.noise(Tier::SameHost).0);
+                let elsewhere = model.limit(noise.noise(Tier::OtherHost).0);
+                let untimed = |limit: f64| {
+                    if limit >= harness::golden::speed::MUST_CATCH {
+                        "(untimed)"
+                    } else {
+                        ""
+                    }
+                };
+                println!(
+                    "{scene:<8} {backend:<12} {pass:<22} {:>14} {:>14} {:>10} {:>10} {}",
+                    format!("x{:.2} {}", noise.host, short(&noise.host_at)),
+                    format!("x{:.2} {}", noise.drivers, short(&noise.drivers_at)),
+                    format!("x{here:.2}{}", untimed(here)),
+                    format!("x{elsewhere:.2}"),
+                    untimed(elsewhere)
+                );
+            }
+        }
+    }
+    let worst = scores
+        .iter()
+        .max_by(|a, b| a.2.total_cmp(&b.2))
+        .map(|(m, limit, score)| {
+            format!(
+                "{score:.2} of its limit ({} {} {} under {}: x{:.3}, limit x{limit:.2})",
+                m.scene, m.backend, m.pass, m.source, m.factor
+            )
+        })
+        .unwrap_or_else(|| "-".to_owned());
+    println!(
+        "{} measurements, {too_noisy} above {MAX_NOISE_RATIO} of their limits; worst {worst}",
+        scores.len()
+    );
+}
+
+/// A source name short enough for the table.
+fn short(source: &str) -> &str {
+    source.get(..source.len().min(12)).unwrap_or(source)
+}
+
+/// `harness noise --timing --record-host NAME`: on a host that did not bless the timing goldens,
+/// probes the scenes named (every canonical one by default) on every available backend under
+/// each timing source this machine has (at most
+/// [`RECORD_PROBES`](harness::golden::speed::recorded::RECORD_PROBES) per source), each a fresh
+/// process, and writes golden/evidence/NAME/timing.toml. Refuses on the host that blessed (its
+/// figures are this host's noise, not another's) and writes nothing when a probe failed.
+pub(super) fn record_host(
+    name: &str,
+    scenes: &[String],
+    history: Option<&std::path::Path>,
+) -> anyhow::Result<ExitCode> {
+    use harness::golden::speed::{host_fingerprint, measure, recorded, TimingGoldens};
+    if name.is_empty()
+        || !name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+    {
+        anyhow::bail!("--record-host {name:?}: a host's name is letters, digits, '-' and '_'");
+    }
+    let store = GoldenStore::workspace();
+    let cases = load_cases(scenes)?;
+    let scenes: Vec<(String, String)> = cases
+        .iter()
+        .map(|c| (c.name().to_owned(), c.argument()))
+        .collect();
+    let backends: Vec<(BackendKind, String)> = BackendKind::ALL
+        .into_iter()
+        .filter_map(|kind| {
+            let status = engine::backend::probe(kind);
+            let info = status.info?;
+            Some((
+                kind,
+                host_fingerprint(&harness::golden::store::fingerprint(&info)),
+            ))
+        })
+        .collect();
+    if backends.is_empty() {
+        anyhow::bail!("no backend is available here (`harness backends` says why)");
+    }
+    for (scene, _) in &scenes {
+        let goldens = TimingGoldens::load(store.root(), scene)?;
+        for (kind, host) in &backends {
+            if goldens.backends.get(kind).is_some_and(|g| &g.host == host) {
+                anyhow::bail!(
+                    "this host blessed {scene}'s timing goldens on {kind} ({host}): its figures \
+                     are its own noise (`harness noise --timing`), not another host's"
+                );
+            }
+        }
+    }
+    let (sources, missing) = measure::timing_sources();
+    for (source, why) in &missing {
+        eprintln!("note: timing source {source} not recorded: {why}");
+    }
+    let history = match history {
+        Some(out) => {
+            let (entries, skipped) = harness::golden::speed::history::read(out);
+            if entries.is_empty() {
+                anyhow::bail!(
+                    "--history {}: no speed history there ({} lines unreadable)",
+                    out.join(harness::golden::speed::history::HISTORY_FILE)
+                        .display(),
+                    skipped
+                );
+            }
+            entries
+        }
+        None => Vec::new(),
+    };
+    let exe = std::env::current_exe()?;
+    let (mut recorded, errors) = recorded::record(
+        &exe,
+        store.root(),
+        &scenes,
+        &backends,
+        &sources,
+        recorded::RECORD_PROBES,
+        &history,
+        |what| eprintln!("recording {name}: {what} ..."),
+    );
+    if !errors.is_empty() {
+        for e in &errors {
+            eprintln!("error: {e}");
+        }
+        anyhow::bail!("{} probe(s) failed; nothing written", errors.len());
+    }
+    let path = recorded::RecordedTimings::path(store.root(), name);
+    if let Some(earlier) = recorded::RecordedTimings::load(&path)? {
+        if earlier.hosts != recorded.hosts {
+            anyhow::bail!(
+                "{} was recorded on another host ({}); record this one under another name",
+                path.display(),
+                earlier.hosts.values().next().map_or("-", String::as_str)
+            );
+        }
+        let probes: usize = earlier.probes.values().sum();
+        let dropped = recorded.absorb(earlier);
+        eprintln!(
+            "adding to the {probes} earlier probe(s) per backend in {}",
+            path.display()
+        );
+        if !dropped.is_empty() {
+            eprintln!(
+                "note: their goldens changed since, so the earlier ratios of {} are dropped",
+                dropped.join(", ")
+            );
+        }
+    }
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    recorded.save(&path)?;
+    println!(
+        "{:<8} {:<12} {:<22} {:>24} {:>8}",
+        "scene", "backend", "pass", "largest of golden", "lowest"
+    );
+    for (scene, backends) in &recorded.scenes {
+        for (backend, passes) in backends {
+            for (pass, r) in passes {
+                let (factor, at) = r.factor();
+                println!(
+                    "{scene:<8} {backend:<12} {pass:<22} {:>24} {:>8}",
+                    format!("x{factor:.3} {}", short(at)),
+                    format!("x{:.3}", r.lowest())
+                );
+            }
+        }
+    }
+    eprintln!(
+        "wrote {}; `harness noise --timing --source {name} --write` counts it in the model",
+        path.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
