@@ -3,21 +3,31 @@
 //! before it is told to (what lets `check` prepare it while it renders the images).
 
 use engine::backend::BackendKind;
-use engine::plan::PassId;
 use engine::renderer::{SlowPass, Variations};
-use harness::golden::speed::{check_scenes, start_check, SpeedOutcome};
+use harness::golden::speed::{check_scenes, start_check, SpeedOutcome, Tier, TimingNoise};
 
 use crate::common;
 
-/// Chess on gl with tone mapping submitted three times over: the tone-mapping check fails, and
-/// every other pass of the frame passes (or is untimed), on this host or any other (x3 is
-/// beyond every limit the timing-noise model allows chess's tone mapping anywhere).
+/// Chess on gl with one pass submitted three times over: that pass's check fails, and every
+/// other pass of the frame passes (or is untimed), on this host or any other. The pass is the
+/// one the timing-noise model gives the tightest limit on a host that did not bless. x3 clears
+/// it even where a host reads the pass low: tripled, chess's geometry read x1.85 of its golden
+/// on host-c (limit x1.44), where unchanged ratios lie at x0.4 to x1.7 of the blessing host's.
 #[test]
 fn a_slowed_pass_fails_its_own_speed_check_and_no_other() {
     if !common::gl_available() {
         return;
     }
     let store = harness::golden::GoldenStore::workspace();
+    let model = TimingNoise::load(store.root()).unwrap();
+    let slowed = model.scenes["chess"][&BackendKind::Gl]
+        .iter()
+        .min_by(|a, b| {
+            let noise = |n: &harness::golden::speed::PassNoise| n.noise(Tier::OtherHost).0;
+            noise(a.1).total_cmp(&noise(b.1))
+        })
+        .map(|(pass, _)| *pass)
+        .unwrap();
     let driver = engine::backend::probe(BackendKind::Gl)
         .info
         .map(|info| harness::golden::fingerprint(&info))
@@ -29,7 +39,7 @@ fn a_slowed_pass_fails_its_own_speed_check_and_no_other() {
         &[BackendKind::Gl],
         Variations {
             slow_pass: Some(SlowPass {
-                pass: PassId::ToneMap,
+                pass: slowed,
                 factor: 3.0,
             }),
             ..Default::default()
@@ -44,19 +54,14 @@ fn a_slowed_pass_fails_its_own_speed_check_and_no_other() {
         |_| {},
     );
     assert!(run.errors.is_empty(), "{:?}", run.errors);
-    let tonemap = run
-        .checks
-        .iter()
-        .find(|c| c.pass == PassId::ToneMap)
-        .unwrap();
+    let check = run.checks.iter().find(|c| c.pass == slowed).unwrap();
     assert_eq!(
-        tonemap.outcome,
+        check.outcome,
         SpeedOutcome::Slower,
-        "{}",
-        tonemap.describe()
+        "{slowed}: {}",
+        check.describe()
     );
-    assert!(tonemap.slowdown().unwrap() > 2.0, "{}", tonemap.describe());
-    for other in run.checks.iter().filter(|c| c.pass != PassId::ToneMap) {
+    for other in run.checks.iter().filter(|c| c.pass != slowed) {
         assert!(!other.failed(), "{}: {}", other.pass, other.describe());
     }
     assert!(!run.passed());

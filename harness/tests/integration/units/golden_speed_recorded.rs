@@ -141,6 +141,43 @@ fn recorded_hosts_of(
     recorded_hosts(root.path()).unwrap()
 }
 
+/// The committed model counts every host recorded in golden/evidence/: each of its ratios sits
+/// at or below half its limit on a host that did not bless, as host-b's renders do in the image
+/// model. A recording added without merging it fails here, naming the command.
+#[test]
+fn the_committed_model_holds_every_recorded_host_at_half_its_limits() {
+    let store = harness::golden::GoldenStore::workspace();
+    let model = TimingNoise::load(store.root()).unwrap();
+    let hosts = recorded_hosts(store.root()).unwrap();
+    assert!(
+        hosts.iter().any(|(s, _)| s.name == "host-c"),
+        "host-c's speed ratios are kept in golden/evidence/host-c/timing.toml"
+    );
+    for (source, measurements) in &hosts {
+        assert!(
+            model.sources.contains_key(&source.name),
+            "golden/timing-noise.toml does not list {}: run `harness noise --timing --source {} --write`",
+            source.name,
+            source.name
+        );
+        let scored = harness::golden::speed::measure::scores(&model, measurements);
+        assert_eq!(scored.len(), measurements.len());
+        for (m, limit, score) in scored {
+            assert!(
+                score <= 0.5 + 1e-9,
+                "{} {} {} recorded on {} at x{:.3}, {score:.2} of its limit x{limit:.2} elsewhere: \
+                 run `harness noise --timing --source {} --write`",
+                m.scene,
+                m.backend,
+                m.pass,
+                m.source,
+                m.factor,
+                m.source
+            );
+        }
+    }
+}
+
 #[test]
 fn a_second_recording_of_a_host_adds_to_the_first_and_takes_the_check_history_anew() {
     let pass = |golden, runs: &[f64], checks: &[f64]| RecordedPass {
