@@ -251,7 +251,7 @@ pub fn model_from(
             });
         let (value, at) = match m.tier {
             Tier::SameHost => (&mut entry.host, &mut entry.host_at),
-            Tier::OtherHost => (&mut entry.drivers, &mut entry.drivers_at),
+            Tier::OtherHost | Tier::RecordedHost => (&mut entry.drivers, &mut entry.drivers_at),
         };
         if m.factor > *value {
             *value = ceil4(m.factor);

@@ -17,8 +17,12 @@
 //! [`MIN_NOISE_SHORT`] for a pass under [`SHORT_PASS_MS`]). A check is
 //! scored as `ln(ratio / golden) / ln(limit)`: 1 at the limit, and unchanged runs under every
 //! measured source at 1/margin or less. On a host whose driver fingerprint differs from the one
-//! that blessed, the other-host figures count too, and a pass whose limit there would not catch
-//! a doubling is reported as untimed on that host, with the reason.
+//! that blessed, the other-host figures count too (the CPU code paths, the second Mesa, and the
+//! hosts recorded in `golden/evidence/`, [`recorded`]), and a pass whose limit there would not
+//! catch a doubling is reported as untimed on that host, with the reason. A host that is itself
+//! recorded there (the same fingerprint) is checked against its own recording instead: each
+//! pass's median recorded ratio, with a limit from that host's own spread, since a ratio lands
+//! x0.4 to x1.7 away from the blessing host's on another CPU.
 //!
 //! The probe runs with llvmpipe/lavapipe on one rasterizer thread ([`PROBE_THREADS`]): the
 //! ratio then does not depend on the host's core count, and a busy neighbour on a two-core
@@ -38,7 +42,7 @@ use engine::backend::BackendKind;
 pub use bless::{bless_scenes, median_probe, SpeedBlessed};
 pub use goldens::{BackendTimings, PassTiming, TimingGoldens, TIMING_FILE};
 pub use model::{PassNoise, Tier, TimingNoise, TIMING_NOISE_FILE};
-pub use verdict::{check_speed, SpeedCheck, SpeedOutcome};
+pub use verdict::{check_speed, check_speed_with, SpeedCheck, SpeedOutcome};
 
 /// The environment the speed probe runs under: one rasterizer thread.
 pub const PROBE_THREADS: (&str, &str) = ("LP_NUM_THREADS", "1");
@@ -209,6 +213,13 @@ pub fn check_scenes(
             return run;
         }
     };
+    let recordings = match recorded::load_all(root) {
+        Ok(recordings) => recordings,
+        Err(e) => {
+            run.errors.push(e.to_string());
+            return run;
+        }
+    };
     progress(&format!(
         "timing {} scene(s) on {}",
         scenes.len(),
@@ -240,7 +251,7 @@ pub fn check_scenes(
                 continue;
             }
         };
-        let mut checks = check_speed(&probe, &goldens, &noise, &host);
+        let mut checks = check_speed_with(&probe, &goldens, &noise, &host, &recordings);
         if checks.iter().any(|c| c.outcome == SpeedOutcome::Slower) {
             // Confirm: probe the scene again and judge the samples of both. A real slowdown
             // stays; a probe that met a noisy moment in every round of a pass does not.
@@ -259,7 +270,8 @@ pub fn check_scenes(
             );
             run.errors.extend(errors);
             if let Some(again) = again.into_iter().find(|a| a.scene == probe.scene) {
-                checks = check_speed(&probe.merged(&again), &goldens, &noise, &host);
+                checks =
+                    check_speed_with(&probe.merged(&again), &goldens, &noise, &host, &recordings);
             }
         }
         run.checks.extend(checks);

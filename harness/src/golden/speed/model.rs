@@ -31,6 +31,9 @@ pub enum Tier {
     SameHost,
     /// Another host: its noise and the drivers' too.
     OtherHost,
+    /// A host recorded in golden/evidence/ (same fingerprint): checked against its own
+    /// recorded ratios and their spread ([`super::recorded`]).
+    RecordedHost,
 }
 
 /// One pass's measured timing noise.

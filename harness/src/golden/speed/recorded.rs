@@ -22,6 +22,12 @@ use super::{SpeedError, Tier, TimingGoldens, CHECK_ROUNDS};
 /// The file a recorded host's ratios are kept in, in its evidence folder.
 pub const RECORDED_TIMING_FILE: &str = "timing.toml";
 
+/// The sources whose median is a recorded host's own reference: its plain probes and checks.
+pub const REFERENCE_SOURCES: [&str; 2] = ["runs", CHECKS_SOURCE];
+/// The sources that are this host as it is (no other driver or code path): what its own checks
+/// meet, and so its own noise.
+pub const OWN_SOURCES: [&str; 3] = ["runs", "busy-neighbour", CHECKS_SOURCE];
+
 /// The most probes a recording takes per source and backend (the plain runs; the other
 /// sources take as many as the model's own measurement does).
 pub const RECORD_PROBES: usize = 6;
@@ -54,6 +60,40 @@ impl RecordedPass {
             }
         }
         worst
+    }
+
+    /// This host's own reference for the pass, when its recording was measured against
+    /// `golden` (the timing golden as it is now): the median of its ratios under the plain
+    /// sources ([`REFERENCE_SOURCES`]), and the largest factor above it under any of this
+    /// host's own conditions ([`OWN_SOURCES`]), at least 1. `None` when the golden changed
+    /// since (the recording is stale for this pass) or there are no such ratios.
+    pub fn reference(&self, golden: f64) -> Option<(f64, f64)> {
+        if self.golden != golden {
+            return None;
+        }
+        let of = |names: &[&str]| -> Vec<f64> {
+            names
+                .iter()
+                .filter_map(|n| self.ratios.get(*n))
+                .flatten()
+                .copied()
+                .collect()
+        };
+        let mut plain = of(&REFERENCE_SOURCES);
+        if plain.is_empty() {
+            return None;
+        }
+        plain.sort_by(f64::total_cmp);
+        let middle = plain.len() / 2;
+        let median = if plain.len() % 2 == 1 {
+            plain[middle]
+        } else {
+            (plain[middle - 1] + plain[middle]) / 2.0
+        };
+        let noise = of(&OWN_SOURCES)
+            .into_iter()
+            .fold(1.0, |worst, r| f64::max(worst, r / median));
+        Some((median, noise))
     }
 
     /// The smallest ratio over the golden.
@@ -184,6 +224,26 @@ impl RecordedTimings {
 pub fn recorded_hosts(
     root: &Path,
 ) -> Result<Vec<(TimingSource, Vec<TimingMeasurement>)>, SpeedError> {
+    Ok(load_all(root)?
+        .into_iter()
+        .map(|(name, recorded)| {
+            let source = TimingSource {
+                name: name.clone(),
+                description: recorded.description(&name),
+                tier: Tier::OtherHost,
+                env: Vec::new(),
+                busy: false,
+                probes: 0,
+            };
+            let measurements = recorded.measurements(&name);
+            (source, measurements)
+        })
+        .collect())
+}
+
+/// Every recording under `root`'s evidence folder, by host name, checked: every ratio and
+/// golden a positive number. A file that cannot be read is an error naming it.
+pub fn load_all(root: &Path) -> Result<Vec<(String, RecordedTimings)>, SpeedError> {
     let mut hosts = Vec::new();
     let Ok(entries) = std::fs::read_dir(root.join("evidence")) else {
         return Ok(hosts);
@@ -222,15 +282,7 @@ pub fn recorded_hosts(
                 ),
             });
         }
-        let source = TimingSource {
-            name: name.clone(),
-            description: recorded.description(&name),
-            tier: Tier::OtherHost,
-            env: Vec::new(),
-            busy: false,
-            probes: 0,
-        };
-        hosts.push((source, recorded.measurements(&name)));
+        hosts.push((name, recorded));
     }
     Ok(hosts)
 }

@@ -4,6 +4,7 @@
 use engine::backend::BackendKind;
 use engine::plan::PassId;
 
+use super::recorded::RecordedTimings;
 use super::{Tier, TimingGoldens, TimingNoise, MIN_PASS_MS, MUST_CATCH};
 use crate::measure::speed::SceneSpeed;
 
@@ -96,11 +97,19 @@ impl SpeedCheck {
                     SpeedOutcome::Faster if self.tier == Tier::OtherHost => {
                         " faster (this host did not bless: ratios differ between hosts)"
                     }
+                    SpeedOutcome::Faster if self.tier == Tier::RecordedHost => {
+                        " faster than this host's recording: record it again if intended"
+                    }
                     SpeedOutcome::Faster => " faster: bless if intended",
                     _ => "",
                 };
+                let of = if self.tier == Tier::RecordedHost {
+                    "this host's recording"
+                } else {
+                    "golden"
+                };
                 format!(
-                    "x{slowdown:.3} of golden (limit x{limit:.2}, {:.2} of it; {noise}; {:.2} ms){what}",
+                    "x{slowdown:.3} of {of} (limit x{limit:.2}, {:.2} of it; {noise}; {:.2} ms){what}",
                     self.score().unwrap_or(0.0),
                     self.ms
                 )
@@ -111,34 +120,76 @@ impl SpeedCheck {
 }
 
 /// The speed checks of one probe: each pass's ratio against its golden under the limit of
-/// `tier`'s figures. `blessed_host` decides the tier: the goldens' host for this backend equal
-/// to `host` is the same host.
+/// the tier's figures. The goldens' host for this backend equal to `host` is the same host;
+/// any other is another host.
 pub fn check_speed(
     probe: &SceneSpeed,
     goldens: &TimingGoldens,
     noise: &TimingNoise,
     host: &str,
 ) -> Vec<SpeedCheck> {
+    check_speed_with(probe, goldens, noise, host, &[])
+}
+
+/// As [`check_speed`], with the hosts recorded in golden/evidence/: on a host that did not
+/// bless but was recorded (same fingerprint), a pass whose recording was measured against its
+/// golden as it is is checked against that host's own reference and spread
+/// ([`RecordedPass::reference`](super::recorded::RecordedPass::reference)), not against the
+/// blessing host's ratio, which lies x0.4 to x1.7 away there.
+pub fn check_speed_with(
+    probe: &SceneSpeed,
+    goldens: &TimingGoldens,
+    noise: &TimingNoise,
+    host: &str,
+    recordings: &[(String, RecordedTimings)],
+) -> Vec<SpeedCheck> {
     let golden_backend = goldens.backends.get(&probe.backend);
-    let tier = match golden_backend {
+    let host_tier = match golden_backend {
         Some(g) if g.host == host => Tier::SameHost,
         _ => Tier::OtherHost,
     };
+    let recording = (host_tier == Tier::OtherHost)
+        .then(|| {
+            recordings
+                .iter()
+                .find(|(_, r)| r.hosts.get(&probe.backend).is_some_and(|h| h == host))
+        })
+        .flatten();
     let mut checks = Vec::new();
     for pass in &probe.passes {
         let (Some(ratio), Some(ms)) = (pass.ratio(), pass.min_ms()) else {
             continue;
         };
-        let golden = golden_backend
+        let blessed = golden_backend
             .and_then(|g| g.passes.get(&pass.pass))
             .map(|g| g.ratio);
-        let figures = noise.figures(&probe.scene, probe.backend, pass.pass);
-        let (noise_figure, borrowed) = match &figures {
-            Some((n, borrowed)) => {
-                let (value, at) = n.noise(tier);
-                (Some((value, at.to_owned())), *borrowed)
+        let own = recording.and_then(|(name, r)| {
+            let recorded = r
+                .scenes
+                .get(&probe.scene)?
+                .get(&probe.backend)?
+                .get(&pass.pass)?;
+            let (reference, spread) = recorded.reference(blessed?)?;
+            Some((name, reference, spread))
+        });
+        let (tier, golden, noise_figure, borrowed) = match own {
+            Some((name, reference, spread)) => (
+                Tier::RecordedHost,
+                Some(reference),
+                Some((spread, format!("{name}'s recording"))),
+                false,
+            ),
+            None => {
+                let figures = noise.figures(&probe.scene, probe.backend, pass.pass);
+                let (figure, borrowed) = match &figures {
+                    Some((n, borrowed)) => {
+                        let (value, at) = n.noise(host_tier);
+                        (Some((value, at.to_owned())), *borrowed)
+                    }
+                    None => (None, false),
+                };
+                (host_tier, blessed, figure, borrowed)
             }
-            None => (None, false),
         };
         let limit = noise_figure.as_ref().map(|(n, _)| noise.limit_for(*n, ms));
         let outcome = match (golden, &noise_figure, limit) {
@@ -154,6 +205,7 @@ pub fn check_speed(
                         match tier {
                             Tier::SameHost => "here",
                             Tier::OtherHost => "on a host that did not bless",
+                            Tier::RecordedHost => "on this recorded host",
                         }
                     ))
                 } else if ratio / golden > limit {

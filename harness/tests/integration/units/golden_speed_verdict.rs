@@ -115,3 +115,100 @@ fn a_slower_pass_fails_a_faster_one_is_a_note_and_noise_decides_what_is_timed() 
         .iter()
         .all(|c| c.outcome == SpeedOutcome::MissingGolden && c.failed()));
 }
+
+/// On a host recorded in golden/evidence/ (same fingerprint), a pass is checked against that
+/// host's own median ratio and spread; a pass whose golden changed since the recording, and
+/// every other host, fall back to the blessing host's golden and the other-host figures.
+#[test]
+fn a_recorded_host_is_checked_against_its_own_recording_while_it_is_current() {
+    use harness::golden::speed::recorded::{RecordedPass, RecordedTimings, CHECKS_SOURCE};
+    use std::collections::BTreeMap;
+    // The goldens: tone mapping 6, geometry 4 (blessed "there").
+    let mut goldens = TimingGoldens::default();
+    goldens.record(&probe(3.0, 4.0), &[], "there", "t");
+    let recorded = |golden: f64, runs: &[f64], busy: &[f64]| RecordedPass {
+        ratios: BTreeMap::from([
+            ("runs".to_owned(), runs.to_vec()),
+            (CHECKS_SOURCE.to_owned(), vec![runs[0]]),
+            ("busy-neighbour".to_owned(), busy.to_vec()),
+            // Another code path is another host's figure, not this one's.
+            ("cpu-sse4.1".to_owned(), vec![golden * 5.0]),
+        ]),
+        golden,
+    };
+    // This host reads tone mapping at half the golden (3, 2.8, 3.2 and a busy 3.6); geometry's
+    // recording was measured against a golden of 5, since re-blessed as 4.
+    let recording = RecordedTimings {
+        recorded: "t".to_owned(),
+        commit: None,
+        probes: BTreeMap::new(),
+        hosts: BTreeMap::from([(BackendKind::Gl, "recorded".to_owned())]),
+        scenes: BTreeMap::from([(
+            "s".to_owned(),
+            BTreeMap::from([(
+                BackendKind::Gl,
+                BTreeMap::from([
+                    (PassId::ToneMap, recorded(6.0, &[3.0, 2.8, 3.2], &[3.6])),
+                    (PassId::Geometry, recorded(5.0, &[4.0], &[4.0])),
+                ]),
+            )]),
+        )]),
+    };
+    let tonemap = &recording.scenes["s"][&BackendKind::Gl][&PassId::ToneMap];
+    let (reference, spread) = tonemap.reference(6.0).unwrap();
+    assert_eq!(
+        reference, 3.0,
+        "the median of the plain probes and the checks"
+    );
+    assert!(
+        (spread - 1.2).abs() < 1e-12,
+        "the busy probe, not the SSE4.1 one: {spread}"
+    );
+    assert_eq!(tonemap.reference(6.5), None, "stale once the golden moved");
+    let recordings = [("host-c".to_owned(), recording)];
+    let noise = model();
+    let check = |tonemap_ms: f64, host: &str, pass: PassId| {
+        check_speed_with(&probe(tonemap_ms, 4.0), &goldens, &noise, host, &recordings)
+            .into_iter()
+            .find(|c| c.pass == pass)
+            .unwrap()
+    };
+    // Doubled on the recorded host (ratio 6 against its own 3): slower, though it equals the
+    // blessing host's golden.
+    let doubled = check(3.0, "recorded", PassId::ToneMap);
+    assert_eq!(doubled.tier, Tier::RecordedHost);
+    assert_eq!(doubled.golden, Some(3.0));
+    assert_eq!(
+        doubled.outcome,
+        SpeedOutcome::Slower,
+        "{}",
+        doubled.describe()
+    );
+    assert!(
+        doubled.describe().contains("host-c's recording"),
+        "{}",
+        doubled.describe()
+    );
+    let unchanged = check(1.5, "recorded", PassId::ToneMap);
+    assert_eq!(
+        unchanged.outcome,
+        SpeedOutcome::Passed,
+        "{}",
+        unchanged.describe()
+    );
+    // Geometry's recording is stale: the other-host figures against the golden.
+    let geometry = check(1.5, "recorded", PassId::Geometry);
+    assert_eq!(
+        (geometry.tier, geometry.golden),
+        (Tier::OtherHost, Some(4.0))
+    );
+    // A host nobody recorded: the other-host tier, against the golden.
+    let elsewhere = check(3.0, "unrecorded", PassId::ToneMap);
+    assert_eq!(
+        (elsewhere.tier, elsewhere.golden),
+        (Tier::OtherHost, Some(6.0))
+    );
+    // The host that blessed is never read against a recording.
+    let here = check(3.0, "there", PassId::ToneMap);
+    assert_eq!(here.tier, Tier::SameHost);
+}
