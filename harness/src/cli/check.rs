@@ -354,7 +354,8 @@ fn print_speed(run: &CheckRun) {
     }
     println!(
         "\nspeed: each pass alone over its floor, against its timing golden \
-         (golden/<scene>/timing.toml; limits from golden/timing-noise.toml)"
+         (golden/<scene>/timing.toml; limits from golden/timing-noise.toml), or on a recorded \
+         host against its own recording (golden/evidence/<host>/timing.toml)"
     );
     println!(
         "{:<8} {:<22} {:<12} {:<8} value",

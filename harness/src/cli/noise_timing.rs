@@ -25,11 +25,7 @@ pub(super) fn timing(
 ) -> anyhow::Result<ExitCode> {
     use harness::golden::speed::{measure, recorded, TimingNoise};
     let store = GoldenStore::workspace();
-    let cases = load_cases(scenes)?;
-    let scenes: Vec<(String, String)> = cases
-        .iter()
-        .map(|c| (c.name().to_owned(), c.argument()))
-        .collect();
+    let scenes = named_scenes(scenes)?;
     let (mut sources, mut missing) = measure::timing_sources();
     let mut recorded_measurements = Vec::new();
     for (source, measurements) in recorded::recorded_hosts(store.root())? {
@@ -200,6 +196,15 @@ fn print_timing_table(
     );
 }
 
+/// The scenes named (every canonical one when none is), each as its name and the argument a
+/// probe child takes (a name or a scene file).
+fn named_scenes(scenes: &[String]) -> anyhow::Result<Vec<(String, String)>> {
+    Ok(load_cases(scenes)?
+        .iter()
+        .map(|c| (c.name().to_owned(), c.argument()))
+        .collect())
+}
+
 /// A source name short enough for the table.
 fn short(source: &str) -> &str {
     source.get(..source.len().min(12)).unwrap_or(source)
@@ -225,11 +230,7 @@ pub(super) fn record_host(
         anyhow::bail!("--record-host {name:?}: a host's name is letters, digits, '-' and '_'");
     }
     let store = GoldenStore::workspace();
-    let cases = load_cases(scenes)?;
-    let scenes: Vec<(String, String)> = cases
-        .iter()
-        .map(|c| (c.name().to_owned(), c.argument()))
-        .collect();
+    let scenes = named_scenes(scenes)?;
     let backends: Vec<(BackendKind, String)> = BackendKind::ALL
         .into_iter()
         .filter_map(|kind| {
@@ -253,6 +254,19 @@ pub(super) fn record_host(
                      are its own noise (`harness noise --timing`), not another host's"
                 );
             }
+        }
+    }
+    let path = recorded::RecordedTimings::path(store.root(), name);
+    let earlier = recorded::RecordedTimings::load(&path)?;
+    if let Some(earlier) = &earlier {
+        let hosts: std::collections::BTreeMap<BackendKind, String> =
+            backends.iter().cloned().collect();
+        if earlier.hosts != hosts {
+            anyhow::bail!(
+                "{} was recorded on another host ({}); record this one under another name",
+                path.display(),
+                earlier.hosts.values().next().map_or("-", String::as_str)
+            );
         }
     }
     let (sources, missing) = measure::timing_sources();
@@ -291,19 +305,11 @@ pub(super) fn record_host(
         }
         anyhow::bail!("{} probe(s) failed; nothing written", errors.len());
     }
-    let path = recorded::RecordedTimings::path(store.root(), name);
-    if let Some(earlier) = recorded::RecordedTimings::load(&path)? {
-        if earlier.hosts != recorded.hosts {
-            anyhow::bail!(
-                "{} was recorded on another host ({}); record this one under another name",
-                path.display(),
-                earlier.hosts.values().next().map_or("-", String::as_str)
-            );
-        }
+    if let Some(earlier) = earlier {
         let probes: usize = earlier.probes.values().sum();
         let dropped = recorded.absorb(earlier);
         eprintln!(
-            "adding to the {probes} earlier probe(s) per backend in {}",
+            "adding to the {probes} earlier probe(s) and check(s) per backend in {}",
             path.display()
         );
         if !dropped.is_empty() {

@@ -145,6 +145,25 @@ impl Drop for BusyNeighbour {
     }
 }
 
+/// The timing goldens of `scenes` (name, argument) under `root`, by scene name, and an error
+/// for each scene whose goldens could not be read.
+pub fn load_goldens(
+    root: &Path,
+    scenes: &[(String, String)],
+) -> (BTreeMap<String, TimingGoldens>, Vec<String>) {
+    let mut goldens = BTreeMap::new();
+    let mut errors = Vec::new();
+    for (scene, _) in scenes {
+        match TimingGoldens::load(root, scene) {
+            Ok(g) => {
+                goldens.insert(scene.clone(), g);
+            }
+            Err(e) => errors.push(e.to_string()),
+        }
+    }
+    (goldens, errors)
+}
+
 /// Probes `scenes` (name, argument) on `backends` under each source, and each pass's largest
 /// factor over its golden under `root`; with the probes that failed.
 pub fn measure_timing(
@@ -156,16 +175,7 @@ pub fn measure_timing(
     mut progress: impl FnMut(&str),
 ) -> (Vec<TimingMeasurement>, Vec<String>) {
     let arguments: Vec<String> = scenes.iter().map(|(_, a)| a.clone()).collect();
-    let mut goldens = BTreeMap::new();
-    let mut errors = Vec::new();
-    for (scene, _) in scenes {
-        match TimingGoldens::load(root, scene) {
-            Ok(g) => {
-                goldens.insert(scene.clone(), g);
-            }
-            Err(e) => errors.push(e.to_string()),
-        }
-    }
+    let (goldens, mut errors) = load_goldens(root, scenes);
     let mut worst: BTreeMap<(String, String, BackendKind, PassId), (Tier, f64)> = BTreeMap::new();
     for source in sources {
         for &kind in backends {

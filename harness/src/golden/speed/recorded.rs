@@ -1,14 +1,17 @@
 //! Speed ratios recorded on other hosts, `golden/evidence/<host>/timing.toml`: a source of the
-//! timing-noise model's other-host figures, as host-b's renders are a source of the image model.
+//! timing-noise model's other-host figures, as host-b's renders are a source of the image model,
+//! and the reference a recorded host's own checks are read against.
 //!
 //! A host that did not bless probes every canonical scene on each of its backends under the
 //! model's own sources (repeated runs, a busy neighbour, the CPU code paths, the second Mesa),
-//! each probe a fresh process (`harness noise --timing --record-host <name>`). The file keeps
-//! every probe's ratio with the golden it was measured against, and the host's factor for a
-//! pass is the largest of those ratios over that golden: how far that host reads from the one
-//! that blessed, for the same engine, under everything a check there may meet. It does not move when the goldens are measured again on
-//! the host that blessed; a change to a pass's work makes it stale (record the host again, or
-//! delete its file).
+//! each probe a fresh process, and may add the ratios of its earlier checks
+//! (`harness noise --timing --record-host <name> [--history OUT]`). The file keeps every ratio
+//! with the golden it was measured against. For the model, the host's factor for a pass is the
+//! largest of those ratios over that golden: how far that host reads from the one that blessed,
+//! for the same engine, under everything a check there may meet. For that host's own checks
+//! ([`RecordedPass::reference`]), the median of its plain ratios is the reference and its own
+//! spread the noise. A pass whose golden is blessed again no longer matches its recording and
+//! falls back to the other-host figures there until the host is recorded again.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -17,7 +20,7 @@ use engine::backend::BackendKind;
 use engine::plan::PassId;
 
 use super::measure::{TimingMeasurement, TimingSource};
-use super::{SpeedError, Tier, TimingGoldens, CHECK_ROUNDS};
+use super::{SpeedError, Tier, CHECK_ROUNDS};
 
 /// The file a recorded host's ratios are kept in, in its evidence folder.
 pub const RECORDED_TIMING_FILE: &str = "timing.toml";
@@ -307,16 +310,7 @@ pub fn record(
     history: &[super::history::HistoryEntry],
     mut progress: impl FnMut(&str),
 ) -> (RecordedTimings, Vec<String>) {
-    let mut errors = Vec::new();
-    let mut goldens = BTreeMap::new();
-    for (scene, _) in scenes {
-        match TimingGoldens::load(root, scene) {
-            Ok(g) => {
-                goldens.insert(scene.clone(), g);
-            }
-            Err(e) => errors.push(e.to_string()),
-        }
-    }
+    let (goldens, mut errors) = super::measure::load_goldens(root, scenes);
     let arguments: Vec<String> = scenes.iter().map(|(_, a)| a.clone()).collect();
     let sources: Vec<(&TimingSource, usize)> = sources
         .iter()
