@@ -234,6 +234,10 @@ fn killing_a_bless_mid_write_leaves_the_old_golden_intact() {
         ])
         .env("HARNESS_ROOT", root.path())
         .env(harness::images::WRITE_DELAY_ENV, "60000")
+        // No kept verifications or FLIP results: their files are written atomically too, and
+        // the delay must hold the golden's write, not a cache's (the first write when this test
+        // runs alone or in a process of its own, as under nextest).
+        .env(harness::golden::verify_cache::CACHE_ENV, "")
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::null())
         .spawn()
