@@ -261,7 +261,9 @@ pub(super) fn record_host(
     if let Some(earlier) = &earlier {
         let hosts: std::collections::BTreeMap<BackendKind, String> =
             backends.iter().cloned().collect();
-        if earlier.hosts != hosts {
+        if earlier.hosts != hosts
+            || !(earlier.cpu.is_empty() || earlier.cpu == harness::golden::speed::cpu_signature())
+        {
             anyhow::bail!(
                 "{} was recorded on another host ({}); record this one under another name",
                 path.display(),

@@ -62,6 +62,11 @@ pub const SHORT_PASS_MS: f64 = 2.0;
 /// still caught). In those runs, short passes came out up to x1.35 above their goldens
 /// (corner's 0.6 ms tone mapping and mask).
 pub const MIN_NOISE_SHORT: f64 = 1.3;
+/// The smallest noise factor of a recorded host's own limits (x1.69 at a margin of 2), as for a
+/// short pass: a recording is fewer probes over less time than the blessing host's drift study.
+/// On host-c, fresh checks came out up to x1.45 above the median of a recording of 57 ratios
+/// whose largest was x1.21 above it (ibl's lighting on wgpu-vulkan, 2026-11-26).
+pub const MIN_NOISE_RECORDED: f64 = MIN_NOISE_SHORT;
 /// A limit that would not catch a pass taking this many times as long is no check: such a pass
 /// is untimed, with the reason.
 pub const MUST_CATCH: f64 = 2.0;
@@ -130,6 +135,26 @@ pub fn host_fingerprint(driver: &str) -> String {
         })
         .unwrap_or_else(|| "unknown CPU".to_owned());
     format!("{driver} | CPU {cpu}")
+}
+
+/// The CPU as its family, model and stepping (`/proc/cpuinfo`), which virtual machines keep
+/// where they make the model name generic ("Intel(R) Xeon(R) Processor" covers several
+/// generations of Xeon): what a recorded host's own reference is tied to.
+pub fn cpu_signature() -> String {
+    let text = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let field = |name: &str| {
+        text.lines()
+            .find(|l| l.split(':').next().is_some_and(|k| k.trim() == name))
+            .and_then(|l| l.split_once(':'))
+            .map_or("?", |(_, v)| v.trim())
+            .to_owned()
+    };
+    format!(
+        "family {} model {} stepping {}",
+        field("cpu family"),
+        field("model"),
+        field("stepping")
+    )
 }
 
 /// Rounds of one speed check (each pass alone, then its floor, per round).

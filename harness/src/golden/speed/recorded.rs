@@ -122,6 +122,11 @@ pub struct RecordedTimings {
     pub probes: BTreeMap<String, usize>,
     /// The host as each backend's speed check saw it ([`super::host_fingerprint`]).
     pub hosts: BTreeMap<BackendKind, String>,
+    /// The CPU's family, model and stepping ([`super::cpu_signature`]): a check reads a pass
+    /// against this recording only on the same CPU, whatever the model name says. Empty in a
+    /// recording made before it was kept: then never.
+    #[serde(default)]
+    pub cpu: String,
     /// Per scene, backend and pass.
     pub scenes: BTreeMap<String, BTreeMap<BackendKind, BTreeMap<PassId, RecordedPass>>>,
 }
@@ -178,6 +183,9 @@ impl RecordedTimings {
             *self.probes.entry(source).or_default() += probes;
         }
         self.recorded = format!("{} and {}", earlier.recorded, self.recorded);
+        if self.cpu.is_empty() {
+            self.cpu = earlier.cpu;
+        }
         dropped
     }
 
@@ -322,6 +330,7 @@ pub fn record(
         commit: super::history::commit(),
         probes: sources.iter().map(|(s, n)| (s.name.clone(), *n)).collect(),
         hosts: backends.iter().cloned().collect(),
+        cpu: super::cpu_signature(),
         scenes: BTreeMap::new(),
     };
     for (source, probes) in sources {

@@ -5,7 +5,7 @@ use engine::backend::BackendKind;
 use engine::plan::PassId;
 
 use super::recorded::RecordedTimings;
-use super::{Tier, TimingGoldens, TimingNoise, MIN_PASS_MS, MUST_CATCH};
+use super::{Tier, TimingGoldens, TimingNoise, MIN_NOISE_RECORDED, MIN_PASS_MS, MUST_CATCH};
 use crate::measure::speed::SceneSpeed;
 
 /// What a speed check found.
@@ -132,7 +132,7 @@ pub fn check_speed(
 }
 
 /// As [`check_speed`], with the hosts recorded in golden/evidence/: on a host that did not
-/// bless but was recorded (same fingerprint), a pass whose recording was measured against its
+/// bless but was recorded (same fingerprint and CPU signature), a pass whose recording was measured against its
 /// golden as it is is checked against that host's own reference and spread
 /// ([`RecordedPass::reference`](super::recorded::RecordedPass::reference)), not against the
 /// blessing host's ratio, which lies x0.4 to x1.7 away there.
@@ -148,11 +148,12 @@ pub fn check_speed_with(
         Some(g) if g.host == host => Tier::SameHost,
         _ => Tier::OtherHost,
     };
-    let recording = (host_tier == Tier::OtherHost)
+    let recording = (host_tier == Tier::OtherHost && !recordings.is_empty())
         .then(|| {
-            recordings
-                .iter()
-                .find(|(_, r)| r.hosts.get(&probe.backend).is_some_and(|h| h == host))
+            let cpu = super::cpu_signature();
+            recordings.iter().find(|(_, r)| {
+                r.cpu == cpu && r.hosts.get(&probe.backend).is_some_and(|h| h == host)
+            })
         })
         .flatten();
     let mut checks = Vec::new();
@@ -191,7 +192,14 @@ pub fn check_speed_with(
                 (host_tier, blessed, figure, borrowed)
             }
         };
-        let limit = noise_figure.as_ref().map(|(n, _)| noise.limit_for(*n, ms));
+        let floor = if tier == Tier::RecordedHost {
+            MIN_NOISE_RECORDED
+        } else {
+            1.0
+        };
+        let limit = noise_figure
+            .as_ref()
+            .map(|(n, _)| noise.limit_for(n.max(floor), ms));
         let outcome = match (golden, &noise_figure, limit) {
             (None, ..) => SpeedOutcome::MissingGolden,
             _ if ms < MIN_PASS_MS => SpeedOutcome::Untimed(format!(

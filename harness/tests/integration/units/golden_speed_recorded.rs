@@ -28,6 +28,7 @@ fn host(ratios: &[f64], golden: f64) -> RecordedTimings {
             BackendKind::Gl,
             "llvmpipe | CPU Intel(R) Xeon(R)".to_owned(),
         )]),
+        cpu: "family 6 model 207 stepping 2".to_owned(),
         scenes: BTreeMap::from([(
             "ibl".to_owned(),
             BTreeMap::from([(BackendKind::Gl, BTreeMap::from([(PassId::ToneMap, pass)]))]),
@@ -192,6 +193,7 @@ fn a_second_recording_of_a_host_adds_to_the_first_and_takes_the_check_history_an
         commit: None,
         probes: BTreeMap::from([("runs".to_owned(), 1), (CHECKS_SOURCE.to_owned(), checks)]),
         hosts: BTreeMap::new(),
+        cpu: String::new(),
         scenes: BTreeMap::from([(
             "ibl".to_owned(),
             BTreeMap::from([(

@@ -143,6 +143,7 @@ fn a_recorded_host_is_checked_against_its_own_recording_while_it_is_current() {
         commit: None,
         probes: BTreeMap::new(),
         hosts: BTreeMap::from([(BackendKind::Gl, "recorded".to_owned())]),
+        cpu: harness::golden::speed::cpu_signature(),
         scenes: BTreeMap::from([(
             "s".to_owned(),
             BTreeMap::from([(
@@ -165,6 +166,18 @@ fn a_recorded_host_is_checked_against_its_own_recording_while_it_is_current() {
         "the busy probe, not the SSE4.1 one: {spread}"
     );
     assert_eq!(tonemap.reference(6.5), None, "stale once the golden moved");
+    // The same fingerprint on another CPU (a generic model name under a virtual machine): not
+    // this recording's host.
+    let mut elsewhere_cpu = recording.clone();
+    elsewhere_cpu.cpu = "family 25 model 17 stepping 1".to_owned();
+    let other_cpu = check_speed_with(
+        &probe(3.0, 4.0),
+        &goldens,
+        &model(),
+        "recorded",
+        &[("host-c".to_owned(), elsewhere_cpu)],
+    );
+    assert!(other_cpu.iter().all(|c| c.tier == Tier::OtherHost));
     let recordings = [("host-c".to_owned(), recording)];
     let noise = model();
     let check = |tonemap_ms: f64, host: &str, pass: PassId| {
