@@ -60,37 +60,22 @@ pub(crate) struct NoiseArgs {
     history: Option<std::path::PathBuf>,
 }
 
-/// `harness noise` as its command line asks: a host's recording, or a model measured.
+/// `harness noise` as its command line asks: a host's recording, the timing-noise model, or
+/// the image noise model, each with its default margin unless one is given.
 pub(crate) fn entry(args: NoiseArgs) -> anyhow::Result<ExitCode> {
-    match &args.record_host {
-        Some(name) => super::noise_timing::record_host(name, &args.scenes, args.history.as_deref()),
-        None => command(
-            &args.sources,
-            &args.scenes,
-            args.write,
-            args.margin,
-            args.json,
-            args.timing,
-        ),
+    if let Some(name) = &args.record_host {
+        return super::noise_timing::record_host(name, &args.scenes, args.history.as_deref());
     }
-}
-
-/// `harness noise`: the image noise model, or with `timing` the timing-noise model, each with
-/// its default margin unless one is given.
-fn command(
-    sources: &[String],
-    scenes: &[String],
-    write: bool,
-    margin: Option<f64>,
-    json: bool,
-    timing: bool,
-) -> anyhow::Result<ExitCode> {
-    if timing {
-        let margin = margin.unwrap_or(harness::golden::speed::DEFAULT_TIMING_MARGIN);
-        super::noise_timing::timing(sources, scenes, write, margin, json)
+    if args.timing {
+        let margin = args
+            .margin
+            .unwrap_or(harness::golden::speed::DEFAULT_TIMING_MARGIN);
+        super::noise_timing::timing(&args.sources, &args.scenes, args.write, margin, args.json)
     } else {
-        let margin = margin.unwrap_or(harness::golden::noise::DEFAULT_MARGIN);
-        run(sources, scenes, write, margin, json)
+        let margin = args
+            .margin
+            .unwrap_or(harness::golden::noise::DEFAULT_MARGIN);
+        run(&args.sources, &args.scenes, args.write, margin, args.json)
     }
 }
 

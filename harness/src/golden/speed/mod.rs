@@ -20,9 +20,9 @@
 //! that blessed, the other-host figures count too (the CPU code paths, the second Mesa, and the
 //! hosts recorded in `golden/evidence/`, [`recorded`]), and a pass whose limit there would not
 //! catch a doubling is reported as untimed on that host, with the reason. A host that is itself
-//! recorded there (the same fingerprint) is checked against its own recording instead: each
-//! pass's median recorded ratio, with a limit from that host's own spread, since a ratio lands
-//! x0.4 to x1.7 away from the blessing host's on another CPU.
+//! recorded there (the same fingerprint and [`cpu_signature`]) is checked against its own
+//! recording instead: each pass's median recorded ratio, with a limit from that host's own
+//! spread, since a ratio lands x0.4 to x1.7 away from the blessing host's on another CPU.
 //!
 //! The probe runs with llvmpipe/lavapipe on one rasterizer thread ([`PROBE_THREADS`]): the
 //! ratio then does not depend on the host's core count, and a busy neighbour on a two-core
@@ -125,15 +125,7 @@ fn write_toml<T: serde::Serialize>(
 /// The host as a speed check sees it: the backend's driver fingerprint, the CPU model, and the
 /// variables that change llvmpipe's code paths. Two hosts with the same one time alike.
 pub fn host_fingerprint(driver: &str) -> String {
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|text| {
-            text.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split_once(':'))
-                .map(|(_, name)| name.trim().to_owned())
-        })
-        .unwrap_or_else(|| "unknown CPU".to_owned());
+    let cpu = cpuinfo_field("model name").unwrap_or_else(|| "unknown CPU".to_owned());
     format!("{driver} | CPU {cpu}")
 }
 
@@ -141,20 +133,22 @@ pub fn host_fingerprint(driver: &str) -> String {
 /// where they make the model name generic ("Intel(R) Xeon(R) Processor" covers several
 /// generations of Xeon): what a recorded host's own reference is tied to.
 pub fn cpu_signature() -> String {
-    let text = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
-    let field = |name: &str| {
-        text.lines()
-            .find(|l| l.split(':').next().is_some_and(|k| k.trim() == name))
-            .and_then(|l| l.split_once(':'))
-            .map_or("?", |(_, v)| v.trim())
-            .to_owned()
-    };
+    let field = |name| cpuinfo_field(name).unwrap_or_else(|| "?".to_owned());
     format!(
         "family {} model {} stepping {}",
         field("cpu family"),
         field("model"),
         field("stepping")
     )
+}
+
+/// The first CPU's `name` field in `/proc/cpuinfo`, trimmed.
+fn cpuinfo_field(name: &str) -> Option<String> {
+    let text = std::fs::read_to_string("/proc/cpuinfo").ok()?;
+    text.lines()
+        .filter_map(|l| l.split_once(':'))
+        .find(|(key, _)| key.trim() == name)
+        .map(|(_, value)| value.trim().to_owned())
 }
 
 /// Rounds of one speed check (each pass alone, then its floor, per round).

@@ -132,8 +132,8 @@ pub fn check_speed(
 }
 
 /// As [`check_speed`], with the hosts recorded in golden/evidence/: on a host that did not
-/// bless but was recorded (same fingerprint and CPU signature), a pass whose recording was measured against its
-/// golden as it is is checked against that host's own reference and spread
+/// bless but was recorded (same fingerprint and CPU signature), a pass whose recording was
+/// measured against its golden as it is is checked against that host's own reference and spread
 /// ([`RecordedPass::reference`](super::recorded::RecordedPass::reference)), not against the
 /// blessing host's ratio, which lies x0.4 to x1.7 away there.
 pub fn check_speed_with(
