@@ -194,6 +194,15 @@ enum Command {
         /// `harness check` with the same --out shows them).
         #[arg(long, default_value_os_t = default_out_dir())]
         out: PathBuf,
+        /// Only the IBL sweep's settings whose names contain this text (repeatable; the
+        /// default is always kept, as the baseline of the lighting times).
+        #[arg(long = "only")]
+        only: Vec<String>,
+        /// Also sweep this IBL setting: keys of a scene file's `[quality.ibl]`, comma-separated,
+        /// e.g. `--try "extract_sun = true, anisotropic_samples = 8"` (repeatable; with --try
+        /// and no --only, the built-in settings other than the default are left out).
+        #[arg(long = "try")]
+        tried: Vec<String>,
         /// Print JSON.
         #[arg(long)]
         json: bool,
@@ -363,13 +372,19 @@ fn main() -> ExitCode {
             repeats,
             environment,
             out,
+            only,
+            tried,
             json,
         } => cli::sweep::run(
             &scene,
-            knob,
-            backend,
-            repeats,
-            environment.as_deref(),
+            cli::sweep::SweepArgs {
+                knob,
+                kind: backend,
+                repeats,
+                environment: environment.as_deref(),
+                only: &only,
+                tried: &tried,
+            },
             &out,
             json,
         ),

@@ -7,25 +7,62 @@ use std::process::ExitCode;
 use engine::backend::BackendKind;
 use harness::measure::sweep::Knob;
 
-/// Sweeps `knob` over its settings on `scene` (lit by `environment` when one is given) and
-/// prints the table (or JSON).
+/// What `harness sweep` sweeps, and how.
+pub(crate) struct SweepArgs<'a> {
+    /// The knob swept.
+    pub knob: Knob,
+    /// The backend rendering.
+    pub kind: BackendKind,
+    /// Timed rounds over every setting.
+    pub repeats: usize,
+    /// Another sky for the scene, if any.
+    pub environment: Option<&'a Path>,
+    /// The IBL sweep's built-in settings kept by name.
+    pub only: &'a [String],
+    /// The IBL sweep's settings of the user's own (`[quality.ibl]` keys).
+    pub tried: &'a [String],
+}
+
+/// Sweeps the knob over its settings on `scene` (lit by the environment when one is given)
+/// and prints the table (or JSON).
 pub(crate) fn run(
     scene: &str,
-    knob: Knob,
-    kind: BackendKind,
-    repeats: usize,
-    environment: Option<&Path>,
+    args: SweepArgs<'_>,
     out: &Path,
     json: bool,
 ) -> anyhow::Result<ExitCode> {
+    let SweepArgs {
+        knob,
+        kind,
+        repeats,
+        environment,
+        only,
+        tried,
+    } = args;
+    if (!only.is_empty() || !tried.is_empty()) && knob != Knob::Ibl {
+        anyhow::bail!(
+            "--only and --try choose settings of the ibl sweep; the {} sweep visits all of its own",
+            knob.name()
+        );
+    }
+    let mut choice = harness::measure::sweep::IblSweepChoice {
+        only: only.to_vec(),
+        tried: Vec::new(),
+    };
+    for text in tried {
+        let settings = harness::measure::sweep::parse_tried_setting(text)
+            .map_err(|e| anyhow::anyhow!("--try {text:?}: {e}"))?;
+        choice.tried.push((text.clone(), settings));
+    }
     let mut loaded = harness::load_scene(scene)?;
     if let Some(path) = environment {
         replace_environment(&mut loaded.scene, path)?;
     }
     if knob == Knob::Ibl {
-        let rows = harness::measure::sweep::ibl_sweep(&loaded.scene, kind, repeats, |what| {
-            eprintln!("  {what} ...");
-        })?;
+        let rows =
+            harness::measure::sweep::ibl_sweep(&loaded.scene, kind, repeats, &choice, |what| {
+                eprintln!("  {what} ...");
+            })?;
         let text = serde_json::to_string_pretty(&rows)?;
         save_sweep(out, &loaded.scene.name, knob, &text);
         if json {

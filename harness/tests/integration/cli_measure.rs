@@ -246,6 +246,16 @@ fn unknown_knobs_and_series_are_refused_with_the_known_ones() {
         stderr.contains("shadow") && stderr.contains("ibl") && stderr.contains("gbuffer"),
         "{stderr}"
     );
+    // A setting to try that is not one is refused before anything renders, naming the key.
+    let (code, _, stderr) = harness(&["sweep", "--knob", "ibl", "--try", "samples = 4"]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("--try") && stderr.contains("unknown field `samples`"),
+        "{stderr}"
+    );
+    let (code, _, stderr) = harness(&["sweep", "--knob", "gbuffer", "--only", "fis"]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("gbuffer sweep visits all"), "{stderr}");
     let (code, _, stderr) = harness(&["bench", "--series", "pixels"]);
     assert_eq!(code, 2, "{stderr}");
     assert!(

@@ -295,13 +295,67 @@ pub enum MapSource {
 /// time (median of `repeats` rounds over every setting in turn) and the error against the
 /// Monte Carlo reference per roughness. The reference is computed once, from the default
 /// render's G-buffer (the G-buffer does not depend on IBL settings).
+///
+/// `choice` narrows the settings visited and adds settings of the user's own; the default, the
+/// baseline of every lighting time, is always visited.
 pub fn ibl_sweep(
     scene: &Scene,
     kind: BackendKind,
     repeats: usize,
+    choice: &IblSweepChoice,
     progress: impl FnMut(&str),
 ) -> Result<Vec<IblSweepRow>, SweepError> {
-    ibl_sweep_with(scene, kind, repeats, MapSource::Timed, progress)
+    sweep_settings(
+        scene,
+        kind,
+        repeats,
+        MapSource::Timed,
+        choice.settings(),
+        progress,
+    )
+}
+
+/// Which settings `harness sweep --knob ibl` visits besides the default.
+#[derive(Clone, Debug, Default)]
+pub struct IblSweepChoice {
+    /// Only the built-in settings whose names contain one of these (every one when both this
+    /// and `tried` are empty; none when only `tried` is given).
+    pub only: Vec<String>,
+    /// Settings of the user's own, each named by its text.
+    pub tried: Vec<(String, engine::ibl::IblSettings)>,
+}
+
+impl IblSweepChoice {
+    /// The settings visited, in order: the default and the built-in settings chosen, then the
+    /// tried ones.
+    pub fn settings(&self) -> Vec<(String, engine::ibl::IblSettings)> {
+        let mut settings = ibl_settings();
+        settings.extend(ibl_size_settings());
+        settings.extend(ibl_sampling_settings());
+        if !self.only.is_empty() || !self.tried.is_empty() {
+            let default = engine::ibl::IblSettings::default();
+            settings.retain(|(name, s)| {
+                *s == default || self.only.iter().any(|o| name.contains(o.as_str()))
+            });
+        }
+        settings.extend(self.tried.iter().cloned());
+        settings
+    }
+}
+
+/// Parses a setting to try: the keys of a scene file's `[quality.ibl]` table, comma-separated
+/// as in a TOML inline table (`extract_sun = true, extracted_lights = 2`), the rest default.
+pub fn parse_tried_setting(text: &str) -> Result<engine::ibl::IblSettings, String> {
+    #[derive(serde::Deserialize)]
+    struct Wrapper {
+        ibl: engine::ibl::IblSettings,
+    }
+    let wrapper: Wrapper = toml::from_str(&format!("ibl = {{ {text} }}"))
+        .map_err(|e| format!("not a [quality.ibl] setting: {}", e.message()))?;
+    match wrapper.ibl.problem() {
+        Some(problem) => Err(problem),
+        None => Ok(wrapper.ibl),
+    }
 }
 
 /// [`ibl_sweep`] with its maps from `maps`. With [`MapSource::Cached`] each setting renders
@@ -311,6 +365,23 @@ pub fn ibl_sweep_with(
     kind: BackendKind,
     repeats: usize,
     maps: MapSource,
+    progress: impl FnMut(&str),
+) -> Result<Vec<IblSweepRow>, SweepError> {
+    let mut settings = ibl_settings();
+    if maps == MapSource::Timed {
+        settings.extend(ibl_size_settings());
+        settings.extend(ibl_sampling_settings());
+    }
+    sweep_settings(scene, kind, repeats, maps, settings, progress)
+}
+
+/// [`ibl_sweep_with`] over `settings_list`.
+fn sweep_settings(
+    scene: &Scene,
+    kind: BackendKind,
+    repeats: usize,
+    maps: MapSource,
+    settings_list: Vec<(String, engine::ibl::IblSettings)>,
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<IblSweepRow>, SweepError> {
     let environment = scene
@@ -323,11 +394,6 @@ pub fn ibl_sweep_with(
     let mut references = None;
     let mut built: Vec<(engine::ibl::cache::Key, f64)> = Vec::new();
     let mut prepared = Vec::new();
-    let mut settings_list = ibl_settings();
-    if maps == MapSource::Timed {
-        settings_list.extend(ibl_size_settings());
-        settings_list.extend(ibl_sampling_settings());
-    }
     for (name, settings) in settings_list {
         // Cached: the render below prepares its maps through the caches, as any render does.
         let precompute_s = match maps {

@@ -23,8 +23,8 @@ mod tables;
 
 pub use gbuffer::{gbuffer_settings, gbuffer_sweep, GbufferSweepRow, GBUFFER_DISTANCES};
 pub use ibl::{
-    ibl_settings, ibl_sweep, ibl_sweep_with, IblSweepRow, MapSource, BEST_SETTING,
-    IBL_REFERENCE_PIXELS, IBL_REFERENCE_SAMPLES,
+    ibl_settings, ibl_sweep, ibl_sweep_with, parse_tried_setting, IblSweepChoice, IblSweepRow,
+    MapSource, BEST_SETTING, IBL_REFERENCE_PIXELS, IBL_REFERENCE_SAMPLES,
 };
 pub use pareto::{pareto_front, pareto_front_n, pareto_svg};
 pub use report::{report_sections, result_file};
