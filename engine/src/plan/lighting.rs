@@ -446,10 +446,15 @@ impl RenderPlan {
             .map_or(&[], |p| &p.draws[..])
     }
 
-    /// Gives every lighting draw the generic variant (for `harness check
-    /// --debug-unspecialised-lighting`, a slowdown the speed checks must catch): both light
-    /// types picked per light, and for PBR the sun disc, clearcoat and anisotropy branched on
-    /// per pixel. The shader gives the same picture; it only does more work for it.
+    /// Gives every lighting draw the one generic variant a shader without specialisation would
+    /// run (for `harness check --debug-unspecialised-lighting`, a slowdown the speed checks
+    /// must catch): as many lights as a draw holds ([`MAX_LIGHTS_PER_DRAW`], the slots past the
+    /// draw's own lights zero, so they add exact zeros), both light types picked per light,
+    /// the split-sum IBL in every draw (weighted by the uniforms' intensity, zero in the draws
+    /// and scenes without it), and for PBR the sun disc, clearcoat and anisotropy branched on
+    /// per pixel. Only what needs resources of its own stays the draw's: its shadowed light's
+    /// filter, the IBL's samples, the ambient occlusion. The shader gives the same picture; it
+    /// only does more work for it.
     pub fn unspecialise_lighting(&mut self) {
         for pass in &mut self.lighting {
             if pass.model == LightingModel::Unlit {
@@ -457,6 +462,8 @@ impl RenderPlan {
             }
             let pbr = pass.model == LightingModel::Pbr;
             for draw in &mut pass.draws {
+                draw.variant.lights = MAX_LIGHTS_PER_DRAW as u32;
+                draw.variant.ibl = true;
                 draw.variant.directional = true;
                 draw.variant.point = true;
                 draw.variant.sun_disc = pbr;

@@ -26,9 +26,10 @@ pub struct Variations {
     /// the point.
     pub slow_pass: Option<SlowPass>,
     /// Speed: the lighting passes lose their specialisation, a real regression reproduced
-    /// (`harness check --debug-unspecialised-lighting`): every draw compiles the generic
-    /// variant, with both light types, the sun disc, clearcoat and anisotropy chosen per pixel
-    /// (see [`RenderPlan::unspecialise_lighting`](crate::plan::RenderPlan::unspecialise_lighting)).
+    /// (`harness check --debug-unspecialised-lighting`): every draw compiles the one generic
+    /// variant, with every light slot a draw holds, both light types, the IBL, and the sun
+    /// disc, clearcoat and anisotropy chosen per pixel (see
+    /// [`RenderPlan::unspecialise_lighting`](crate::plan::RenderPlan::unspecialise_lighting)).
     /// The picture is the same; only the time changes.
     pub unspecialised_lighting: bool,
 }

@@ -557,3 +557,54 @@ fn a_slowed_pass_is_submitted_that_many_times_and_no_other() {
         &b.outputs[&TargetId::Final]
     ));
 }
+
+/// `--debug-unspecialised-lighting` gives every lit draw the one generic variant (every light
+/// slot a draw holds, both light types, IBL, the PBR features branched per pixel) and the same
+/// picture: the slots past a draw's lights and the IBL of a draw without it add exact zeros.
+#[test]
+fn the_unspecialised_lighting_draws_everything_and_gives_the_same_picture() {
+    let scenes = [
+        test_scenes::five_models(64),
+        test_scenes::many_point_lights(64, 20),
+    ];
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        for scene in &scenes {
+            unspecialised_gives_the_same_picture(backend.as_mut(), scene);
+        }
+    }
+}
+
+/// One scene of [`the_unspecialised_lighting_draws_everything_and_gives_the_same_picture`].
+fn unspecialised_gives_the_same_picture(backend: &mut dyn Backend, scene: &Scene) {
+    let kind = backend.kind();
+    let plain = PreparedFrame::new(scene).unwrap();
+    let generic = plain.clone().with_variations(renderer::Variations {
+        unspecialised_lighting: true,
+        ..Default::default()
+    });
+    for pass in &generic.plan().lighting {
+        for draw in &pass.draws {
+            let v = &draw.variant;
+            if pass.model == engine::scene::LightingModel::Unlit {
+                assert_eq!(v.lights, 0, "{}: unlit {v:?}", scene.name);
+                continue;
+            }
+            assert!(
+                v.lights == 16 && v.ibl && v.directional && v.point,
+                "{}: {:?} {v:?}",
+                scene.name,
+                pass.model
+            );
+        }
+    }
+    let a = renderer::render_prepared(backend, &plain, Readback::All).unwrap();
+    let b = renderer::render_prepared(backend, &generic, Readback::All).unwrap();
+    for (target, image) in &a.outputs {
+        assert!(
+            bitwise_equal(image, &b.outputs[target]),
+            "{} on {kind}: {target} differs unspecialised",
+            scene.name
+        );
+    }
+}
