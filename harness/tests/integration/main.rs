@@ -35,6 +35,7 @@ mod review;
 mod selftest;
 mod shadows;
 mod speed;
+mod speed_hooks;
 mod sweeps;
 mod units;
 mod verify_cache;

@@ -1,0 +1,99 @@
+//! The renderer's speed hooks: a pass slowed for the speed self-test, and the lighting forced
+//! back to one unspecialised variant for `check --debug-unspecialised-lighting`. Both must
+//! change the time and nothing else.
+
+use crate::common;
+use engine::plan::{PassId, TargetId};
+use engine::renderer::{self, Frame, PreparedFrame, Readback};
+use engine::scene::Scene;
+use engine::Backend;
+use harness::golden::metrics::bitwise_equal;
+use harness::test_scenes;
+
+/// The speed hook `Variations::slow_pass` submits one plan pass's render passes that many
+/// times over (what `harness bench --slow-pass` times), and no other pass more than once.
+#[test]
+fn a_slowed_pass_is_submitted_that_many_times_and_no_other() {
+    let scene = test_scenes::five_models(64);
+    let Some(&kind) = common::available_backends().first() else {
+        return;
+    };
+    let mut backend = engine::backend::create(kind).unwrap();
+    let plain = PreparedFrame::new(&scene).unwrap();
+    let repeated = plain.clone().with_variations(renderer::Variations {
+        slow_pass: Some(renderer::SlowPass {
+            pass: PassId::ToneMap,
+            factor: 3.0,
+        }),
+        ..Default::default()
+    });
+    let count =
+        |frame: &Frame, pass: PassId| frame.timings.owners.iter().filter(|o| **o == pass).count();
+    let a = renderer::render_prepared(backend.as_mut(), &plain, Readback::All).unwrap();
+    let b = renderer::render_prepared(backend.as_mut(), &repeated, Readback::All).unwrap();
+    assert_eq!(
+        (count(&a, PassId::ToneMap), count(&b, PassId::ToneMap)),
+        (1, 3)
+    );
+    for spec in &a.plan.passes {
+        if spec.id != PassId::ToneMap {
+            assert_eq!(count(&a, spec.id), count(&b, spec.id), "{}", spec.id);
+        }
+    }
+    // Tone mapping clears and redraws its target: repeating it leaves the image as it was.
+    assert!(bitwise_equal(
+        &a.outputs[&TargetId::Final],
+        &b.outputs[&TargetId::Final]
+    ));
+}
+
+/// `--debug-unspecialised-lighting` gives every lit draw the one generic variant (every light
+/// slot a draw holds, both light types, IBL, the PBR features branched per pixel) and the same
+/// picture: the slots past a draw's lights and the IBL of a draw without it add exact zeros.
+#[test]
+fn the_unspecialised_lighting_draws_everything_and_gives_the_same_picture() {
+    let scenes = [
+        test_scenes::five_models(64),
+        test_scenes::many_point_lights(64, 20),
+    ];
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        for scene in &scenes {
+            unspecialised_gives_the_same_picture(backend.as_mut(), scene);
+        }
+    }
+}
+
+/// One scene of [`the_unspecialised_lighting_draws_everything_and_gives_the_same_picture`].
+fn unspecialised_gives_the_same_picture(backend: &mut dyn Backend, scene: &Scene) {
+    let kind = backend.kind();
+    let plain = PreparedFrame::new(scene).unwrap();
+    let generic = plain.clone().with_variations(renderer::Variations {
+        unspecialised_lighting: true,
+        ..Default::default()
+    });
+    for pass in &generic.plan().lighting {
+        for draw in &pass.draws {
+            let v = &draw.variant;
+            if pass.model == engine::scene::LightingModel::Unlit {
+                assert_eq!(v.lights, 0, "{}: unlit {v:?}", scene.name);
+                continue;
+            }
+            assert!(
+                v.lights == 16 && v.ibl && v.directional && v.point,
+                "{}: {:?} {v:?}",
+                scene.name,
+                pass.model
+            );
+        }
+    }
+    let a = renderer::render_prepared(backend, &plain, Readback::All).unwrap();
+    let b = renderer::render_prepared(backend, &generic, Readback::All).unwrap();
+    for (target, image) in &a.outputs {
+        assert!(
+            bitwise_equal(image, &b.outputs[target]),
+            "{} on {kind}: {target} differs unspecialised",
+            scene.name
+        );
+    }
+}
