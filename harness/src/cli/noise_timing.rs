@@ -245,10 +245,15 @@ pub(super) fn record_host(
     if backends.is_empty() {
         anyhow::bail!("no backend is available here (`harness backends` says why)");
     }
+    let cpu = harness::golden::speed::cpu_signature();
     for (scene, _) in &scenes {
         let goldens = TimingGoldens::load(store.root(), scene)?;
         for (kind, host) in &backends {
-            if goldens.backends.get(kind).is_some_and(|g| &g.host == host) {
+            if goldens
+                .backends
+                .get(kind)
+                .is_some_and(|g| g.blessed_on(host, &cpu))
+            {
                 anyhow::bail!(
                     "this host blessed {scene}'s timing goldens on {kind} ({host}): its figures \
                      are its own noise (`harness noise --timing`), not another host's"

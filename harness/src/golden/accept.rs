@@ -211,17 +211,20 @@ pub fn accept_timings(
                 floor_ms: vec![c.ms / c.ratio],
             }],
         };
-        let driver = goldens
+        let (driver, cpu) = goldens
             .backends
             .get(&c.backend)
-            .map(|b| b.host.clone())
+            .map(|b| (b.host.clone(), b.cpu.clone()))
             .unwrap_or_default();
-        let host = if driver.is_empty() {
-            crate::golden::speed::host_fingerprint(c.backend.name())
+        let (host, cpu) = if driver.is_empty() {
+            (
+                crate::golden::speed::host_fingerprint(c.backend.name()),
+                crate::golden::speed::cpu_signature(),
+            )
         } else {
-            driver
+            (driver, cpu)
         };
-        goldens.record(&probe, &[c.pass], &host, &blessed);
+        goldens.record(&probe, &[c.pass], &host, &cpu, &blessed);
         lines.push(format!(
             "{scene}/{} on {} (speed): ratio {:.3} as the check measured it; {}",
             c.pass,

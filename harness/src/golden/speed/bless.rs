@@ -140,7 +140,7 @@ pub fn bless_scenes(
                 });
             }
             if !rewrite.is_empty() && !dry_run {
-                goldens.record(&probe, &rewrite, &host, &blessed);
+                goldens.record(&probe, &rewrite, &host, &super::cpu_signature(), &blessed);
                 goldens.save(root, scene)?;
             }
         }

@@ -38,10 +38,23 @@ pub struct BackendTimings {
     pub blessed: String,
     /// The host that blessed ([`super::host_fingerprint`]).
     pub host: String,
+    /// Its CPU's family, model and stepping ([`super::cpu_signature`]): the fingerprint's model
+    /// name is generic under many hypervisors ("AMD EPYC" covers several generations). Empty
+    /// in goldens blessed before it was kept; the fingerprint alone decides there.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub cpu: String,
     /// Rounds the probe timed.
     pub rounds: usize,
     /// Per pass.
     pub passes: BTreeMap<PassId, PassTiming>,
+}
+
+impl BackendTimings {
+    /// Whether these goldens were blessed on the host with fingerprint `host` and CPU
+    /// signature `cpu` (goldens that kept no signature: on the fingerprint alone).
+    pub fn blessed_on(&self, host: &str, cpu: &str) -> bool {
+        self.host == host && (self.cpu.is_empty() || self.cpu == cpu)
+    }
 }
 
 /// A scene's timing goldens, per backend.
@@ -69,19 +82,29 @@ impl TimingGoldens {
     }
 
     /// Records `probe`'s passes for its backend: every pass (`only` empty) or those in `only`,
-    /// keeping the others' goldens. `host` is the blessing host's fingerprint.
-    pub fn record(&mut self, probe: &SceneSpeed, only: &[PassId], host: &str, blessed: &str) {
+    /// keeping the others' goldens. `host` is the blessing host's fingerprint, `cpu` its CPU
+    /// signature.
+    pub fn record(
+        &mut self,
+        probe: &SceneSpeed,
+        only: &[PassId],
+        host: &str,
+        cpu: &str,
+        blessed: &str,
+    ) {
         let entry = self
             .backends
             .entry(probe.backend)
             .or_insert_with(|| BackendTimings {
                 blessed: blessed.to_owned(),
                 host: host.to_owned(),
+                cpu: cpu.to_owned(),
                 rounds: probe.rounds,
                 passes: BTreeMap::new(),
             });
         entry.blessed = blessed.to_owned();
         entry.host = host.to_owned();
+        entry.cpu = cpu.to_owned();
         entry.rounds = probe.rounds;
         for pass in &probe.passes {
             if !only.is_empty() && !only.contains(&pass.pass) {

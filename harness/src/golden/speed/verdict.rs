@@ -144,13 +144,13 @@ pub fn check_speed_with(
     recordings: &[(String, RecordedTimings)],
 ) -> Vec<SpeedCheck> {
     let golden_backend = goldens.backends.get(&probe.backend);
+    let cpu = super::cpu_signature();
     let host_tier = match golden_backend {
-        Some(g) if g.host == host => Tier::SameHost,
+        Some(g) if g.blessed_on(host, &cpu) => Tier::SameHost,
         _ => Tier::OtherHost,
     };
     let recording = (host_tier == Tier::OtherHost && !recordings.is_empty())
         .then(|| {
-            let cpu = super::cpu_signature();
             recordings.iter().find(|(_, r)| {
                 r.cpu == cpu && r.hosts.get(&probe.backend).is_some_and(|h| h == host)
             })

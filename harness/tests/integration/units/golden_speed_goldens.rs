@@ -27,15 +27,31 @@ fn goldens_round_trip_and_a_partial_bless_keeps_the_other_passes() {
         ],
     };
     let mut goldens = TimingGoldens::default();
-    goldens.record(&probe(2.0), &[], "host a", "t0");
+    goldens.record(
+        &probe(2.0),
+        &[],
+        "host a",
+        "family 1 model 2 stepping 3",
+        "t0",
+    );
     goldens.save(dir.path(), "s").unwrap();
     let mut loaded = TimingGoldens::load(dir.path(), "s").unwrap();
     assert_eq!(loaded, goldens);
-    loaded.record(&probe(3.0), &[PassId::ToneMap], "host b", "t1");
+    loaded.record(
+        &probe(3.0),
+        &[PassId::ToneMap],
+        "host b",
+        "family 4 model 5 stepping 6",
+        "t1",
+    );
     let gl = &loaded.backends[&BackendKind::Gl];
     assert_eq!(gl.passes[&PassId::Geometry].ratio, 2.0);
     assert_eq!(gl.passes[&PassId::ToneMap].ratio, 3.0);
     assert_eq!(gl.host, "host b");
+    assert_eq!(gl.cpu, "family 4 model 5 stepping 6");
+    assert!(gl.blessed_on("host b", "family 4 model 5 stepping 6"));
+    assert!(!gl.blessed_on("host b", "family 4 model 5 stepping 7"));
+    assert!(!gl.blessed_on("host a", "family 4 model 5 stepping 6"));
     assert_eq!(
         TimingGoldens::load(dir.path(), "none").unwrap(),
         TimingGoldens::default()
@@ -45,4 +61,26 @@ fn goldens_round_trip_and_a_partial_bless_keeps_the_other_passes() {
         .unwrap_err()
         .to_string();
     assert!(error.contains("timing.toml"), "{error}");
+}
+
+/// Goldens blessed before the CPU signature was kept name the host by its fingerprint alone.
+#[test]
+fn goldens_without_a_cpu_signature_are_the_fingerprints_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("s")).unwrap();
+    std::fs::write(
+        TimingGoldens::path(dir.path(), "s"),
+        "[gl]\nblessed = \"t\"\nhost = \"h\"\nrounds = 4\n\n\
+         [gl.passes.tonemap]\nratio = 2.0\nms = 1.0\nfloor_ms = 0.5\n",
+    )
+    .unwrap();
+    let old = TimingGoldens::load(dir.path(), "s").unwrap();
+    let gl = &old.backends[&BackendKind::Gl];
+    assert_eq!(gl.cpu, "");
+    assert!(gl.blessed_on("h", "family 6 model 207 stepping 2"));
+    assert!(!gl.blessed_on("another", "family 6 model 207 stepping 2"));
+    // Written again, an empty signature stays out of the file.
+    old.save(dir.path(), "s").unwrap();
+    let text = std::fs::read_to_string(TimingGoldens::path(dir.path(), "s")).unwrap();
+    assert!(!text.contains("cpu"), "{text}");
 }

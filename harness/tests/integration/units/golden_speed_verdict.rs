@@ -2,6 +2,7 @@
 
 use engine::backend::BackendKind;
 use engine::plan::PassId;
+use harness::golden::speed::cpu_signature;
 use harness::golden::speed::verdict::*;
 use harness::golden::speed::PassNoise;
 use harness::golden::speed::{Tier, TimingGoldens, TimingNoise};
@@ -52,7 +53,7 @@ fn model() -> TimingNoise {
 fn a_slower_pass_fails_a_faster_one_is_a_note_and_noise_decides_what_is_timed() {
     // Tone mapping takes 3 ms (its floor 0.5 ms), geometry 4 ms (its floor 1 ms).
     let mut goldens = TimingGoldens::default();
-    goldens.record(&probe(3.0, 4.0), &[], "here", "t");
+    goldens.record(&probe(3.0, 4.0), &[], "here", &cpu_signature(), "t");
     let noise = model();
     let verdict = |p: &SceneSpeed, host: &str, pass: PassId| {
         check_speed(p, &goldens, &noise, host)
@@ -98,7 +99,7 @@ fn a_slower_pass_fails_a_faster_one_is_a_note_and_noise_decides_what_is_timed() 
     );
     // A short pass (under 2 ms) has a noise floor of 1.3: limit 1.69 even here.
     let mut short_goldens = TimingGoldens::default();
-    short_goldens.record(&probe(1.0, 4.0), &[], "here", "t");
+    short_goldens.record(&probe(1.0, 4.0), &[], "here", &cpu_signature(), "t");
     let short_pass = |ms: f64| {
         check_speed(&probe(ms, 4.0), &short_goldens, &noise, "here")
             .into_iter()
@@ -125,7 +126,7 @@ fn a_recorded_host_is_checked_against_its_own_recording_while_it_is_current() {
     use std::collections::BTreeMap;
     // The goldens: tone mapping 6, geometry 4 (blessed "there").
     let mut goldens = TimingGoldens::default();
-    goldens.record(&probe(3.0, 4.0), &[], "there", "t");
+    goldens.record(&probe(3.0, 4.0), &[], "there", &cpu_signature(), "t");
     let recorded = |golden: f64, runs: &[f64], busy: &[f64]| RecordedPass {
         ratios: BTreeMap::from([
             ("runs".to_owned(), runs.to_vec()),
@@ -224,4 +225,20 @@ fn a_recorded_host_is_checked_against_its_own_recording_while_it_is_current() {
     // The host that blessed is never read against a recording.
     let here = check(3.0, "there", PassId::ToneMap);
     assert_eq!(here.tier, Tier::SameHost);
+}
+
+/// The blessing host is its fingerprint and its CPU signature: another CPU behind the same
+/// generic model name ("AMD EPYC") is another host, checked at the other-host tier.
+#[test]
+fn the_blessing_host_is_its_fingerprint_and_its_cpu() {
+    let noise = model();
+    let tier = |cpu: &str| {
+        let mut goldens = TimingGoldens::default();
+        goldens.record(&probe(3.0, 4.0), &[], "here", cpu, "t");
+        check_speed(&probe(3.0, 4.0), &goldens, &noise, "here")[0].tier
+    };
+    assert_eq!(tier(&cpu_signature()), Tier::SameHost);
+    assert_eq!(tier("family 0 model 0 stepping 0"), Tier::OtherHost);
+    // Goldens that kept no signature: the fingerprint alone.
+    assert_eq!(tier(""), Tier::SameHost);
 }
