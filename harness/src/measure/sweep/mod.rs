@@ -30,8 +30,9 @@ pub use pareto::{pareto_front, pareto_front_n, pareto_svg};
 pub use report::{report_sections, result_file};
 pub use shadow::{shadow_sweep, shadow_sweep_with, ShadowSweepCost, SweepRow};
 pub use tables::{
-    gbuffer_table, ibl_goal_line, ibl_table, stable_gbuffer_table, stable_ibl_table, stable_table,
-    table, worst_cells, IBL_GOAL_MEAN, IBL_GOAL_P95,
+    gbuffer_table, ibl_default_goal_line, ibl_goal_line, ibl_table, stable_gbuffer_table,
+    stable_ibl_table, stable_table, table, worst_cells, IBL_DEFAULT_COST, IBL_DEFAULT_MEAN,
+    IBL_GOAL_MEAN, IBL_GOAL_P95,
 };
 
 use engine::plan::PassId;

@@ -139,7 +139,59 @@ pub fn ibl_table(rows: &[IblSweepRow]) -> String {
         }
     }
     out.push_str(&format!("\n{}\n", ibl_goal_line(rows)));
+    out.push_str(&format!("{}\n", ibl_default_goal_line(rows)));
     out
+}
+
+/// The bound for a default (issue 39): in every cell at most this mean relative error...
+pub const IBL_DEFAULT_MEAN: f64 = 0.25;
+/// ...for at most this many times the default setting's lighting time, measured in the same
+/// sweep.
+pub const IBL_DEFAULT_COST: f64 = 1.5;
+
+/// One line: the settings within [`IBL_DEFAULT_MEAN`] in every cell at most
+/// [`IBL_DEFAULT_COST`] times the default row's lighting time (a candidate for the default), or
+/// the cheapest within the error bound and the most accurate within the cost bound.
+pub fn ibl_default_goal_line(rows: &[IblSweepRow]) -> String {
+    let goal = format!(
+        "a default's bound: every cell within {:.0}% mean, lighting at most x{} the default's",
+        IBL_DEFAULT_MEAN * 100.0,
+        IBL_DEFAULT_COST
+    );
+    let Some(base) = rows
+        .iter()
+        .find(|r| r.is_default)
+        .and_then(|r| r.lighting_ms)
+    else {
+        return format!("{goal}: no timed default row to compare with");
+    };
+    let cost = |r: &IblSweepRow| r.lighting_ms.map_or(f64::INFINITY, |ms| ms / base);
+    let accurate = |r: &&IblSweepRow| worst_cells(r).0 <= IBL_DEFAULT_MEAN;
+    let meeting: Vec<String> = rows
+        .iter()
+        .filter(|r| accurate(r) && cost(r) <= IBL_DEFAULT_COST)
+        .map(|r| format!("{} (x{:.2})", r.setting, cost(r)))
+        .collect();
+    if !meeting.is_empty() {
+        return format!("{goal}: met by {}", meeting.join(", "));
+    }
+    let cheapest = rows
+        .iter()
+        .filter(accurate)
+        .min_by(|a, b| cost(a).total_cmp(&cost(b)))
+        .map_or("none".to_owned(), |r| {
+            format!("{} (x{:.2})", r.setting, cost(r))
+        });
+    let closest = rows
+        .iter()
+        .filter(|r| cost(r) <= IBL_DEFAULT_COST)
+        .min_by(|a, b| worst_cells(a).0.total_cmp(&worst_cells(b).0))
+        .map_or("none".to_owned(), |r| {
+            format!("{} ({:.1}%)", r.setting, worst_cells(r).0 * 100.0)
+        });
+    format!(
+        "{goal}: met by none; cheapest within the error: {cheapest}; most accurate within the cost: {closest}"
+    )
 }
 
 /// The accuracy goal for IBL against the Monte Carlo reference: in every cell (material row x

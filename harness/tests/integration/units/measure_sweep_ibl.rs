@@ -76,3 +76,48 @@ fn the_sweep_visits_the_default_and_what_was_chosen() {
     };
     assert_eq!(names(&tried), ["default", text]);
 }
+
+/// A row of the IBL sweep with every cell at `worst` mean error and `lighting_ms`.
+fn row(setting: &str, is_default: bool, lighting_ms: f64, worst: f64) -> IblSweepRow {
+    let cell = |mean: f64| harness::reference::ibl::CellError {
+        roughness: 0.5,
+        mean,
+        p95: mean * 2.0,
+        bias: 0.0,
+        pixels: 10,
+    };
+    IblSweepRow {
+        setting: setting.to_owned(),
+        settings: engine::ibl::IblSettings::default(),
+        precompute_s: 1.0,
+        lighting_ms: Some(lighting_ms),
+        specular_mib: 1.0,
+        by_roughness: Vec::new(),
+        mean_relative: worst,
+        p99_max_relative: (worst, worst),
+        by_family: vec![("metal".to_owned(), vec![cell(worst / 2.0), cell(worst)])],
+        is_default,
+        pareto: false,
+    }
+}
+
+#[test]
+fn the_default_bound_weighs_each_setting_against_the_default_rows_lighting_time() {
+    use harness::measure::sweep::ibl_default_goal_line;
+    // The default misses (40%); a setting at x1.4 is within 25%; one at x2 is more accurate.
+    let rows = [
+        row("default", true, 10.0, 0.40),
+        row("cheap", false, 14.0, 0.20),
+        row("dear", false, 20.0, 0.05),
+    ];
+    let line = ibl_default_goal_line(&rows);
+    assert!(line.ends_with("met by cheap (x1.40)"), "{line}");
+    let line = ibl_default_goal_line(&[rows[0].clone(), rows[2].clone()]);
+    assert!(
+        line.ends_with(
+            "met by none; cheapest within the error: dear (x2.00); most accurate within the \
+             cost: default (40.0%)"
+        ),
+        "{line}"
+    );
+}
