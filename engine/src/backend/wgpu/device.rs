@@ -12,6 +12,8 @@ use crate::backend::pool::Pool;
 use crate::backend::*;
 use crate::shaders;
 
+use super::quirks::{instance_flags, keep_gl_display, too_old_for_the_shaders, MIN_DESKTOP_GL};
+
 impl WgpuBackend {
     /// Opens the first adapter of the pinned API (`WgpuVulkan` or `WgpuGl`).
     pub fn new(kind: BackendKind) -> Result<Self> {
@@ -35,7 +37,7 @@ impl WgpuBackend {
         };
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
             backends,
-            flags: wgpu::InstanceFlags::default(),
+            flags: instance_flags(),
             memory_budget_thresholds: Default::default(),
             backend_options: Default::default(),
             display: None,
@@ -46,8 +48,29 @@ impl WgpuBackend {
             compatible_surface: None,
             apply_limit_buckets: false,
         }))
-        .map_err(|e| unavailable(format!("no {api} adapter found ({e})")))?;
+        .map_err(|e| {
+            keep_gl_display(kind, &instance, None);
+            unavailable(format!("no {api} adapter found ({e})"))
+        })?;
         let adapter_info = adapter.get_info();
+        if kind == BackendKind::WgpuGl {
+            if let Some(version) = too_old_for_the_shaders(&adapter_info.driver_info) {
+                keep_gl_display(kind, &instance, Some(&adapter));
+                return Err(BackendError::Unavailable {
+                    backend: kind.name(),
+                    reason: format!(
+                        "OpenGL adapter `{}` gave wgpu a {version} context; the shaders need \
+                         GLSL {}.{} (bitfieldReverse, textureQueryLevels)",
+                        adapter_info.name, MIN_DESKTOP_GL.0, MIN_DESKTOP_GL.1
+                    ),
+                    fix: "the gl backend asks this driver for a 4.6 or 4.5 core context and \
+                          runs here; for wgpu-gl, a driver that answers wgpu's 3.3 request \
+                          with 4.3 or later, such as Mesa: apt-get install -y libegl1 \
+                          libegl-mesa0 libgl1-mesa-dri"
+                        .to_owned(),
+                });
+            }
+        }
         // Adapter-specific format features lift wgpu's downlevel limits where the driver can do
         // more (R32F render targets on wgpu-gl, which GL 4.5 supports).
         let wanted = wgpu::Features::TIMESTAMP_QUERY
@@ -63,6 +86,7 @@ impl WgpuBackend {
             trace: wgpu::Trace::Off,
         }))
         .map_err(|e| {
+            keep_gl_display(kind, &instance, Some(&adapter));
             unavailable(format!(
                 "{api} adapter `{}` refused a device: {e}",
                 adapter_info.name

@@ -18,6 +18,7 @@
 mod commands;
 mod conv;
 mod device;
+mod quirks;
 mod readback;
 
 use ::wgpu;
