@@ -63,3 +63,28 @@ fn a_tie_in_fraction_goes_to_the_larger_difference() {
     assert_eq!((worst.a, worst.b), (BackendKind::Gl, BackendKind::WgpuGl));
     assert!(!worst.within_tolerance);
 }
+
+/// A driver other than the blessing one is information on another software rasterizer, and a
+/// warning that the noise model does not reach it on a GPU.
+#[test]
+fn the_driver_note_warns_when_goldens_of_a_software_rasterizer_meet_a_gpu() {
+    let llvmpipe = "OpenGL 4.5 (Core Profile) Mesa 22.3.6 | llvmpipe (LLVM 15.0.6, 256 bits)";
+    let mesa_25 = "OpenGL 4.5 (Core Profile) Mesa 25.0.7 | llvmpipe (LLVM 15.0.6, 256 bits)";
+    let nvidia = "OpenGL 4.6.0 NVIDIA 580.159.04 | NVIDIA H200/PCIe/SSE2";
+    assert!(is_software_rasterizer(llvmpipe) && !is_software_rasterizer(nvidia));
+    let scenes = ["arrow".to_owned(), "ibl".to_owned()];
+    let other_mesa = driver_note(&scenes, BackendKind::Gl, llvmpipe, mesa_25);
+    assert!(
+        other_mesa.starts_with("goldens of arrow, ibl were blessed on gl with")
+            && other_mesa.ends_with("are expected, and are not failures"),
+        "{other_mesa}"
+    );
+    let gpu = driver_note(&scenes, BackendKind::Gl, llvmpipe, nvidia);
+    assert!(
+        gpu.contains("which is not one") && gpu.contains("docs/2026-11-26-nvidia-gpu.md"),
+        "{gpu}"
+    );
+    // Goldens blessed on a GPU and checked on llvmpipe: the plain note.
+    let back = driver_note(&scenes, BackendKind::Gl, nvidia, llvmpipe);
+    assert!(back.ends_with("are not failures"), "{back}");
+}
