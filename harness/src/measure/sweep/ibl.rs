@@ -367,11 +367,10 @@ pub fn ibl_sweep_with(
     maps: MapSource,
     progress: impl FnMut(&str),
 ) -> Result<Vec<IblSweepRow>, SweepError> {
-    let mut settings = ibl_settings();
-    if maps == MapSource::Timed {
-        settings.extend(ibl_size_settings());
-        settings.extend(ibl_sampling_settings());
-    }
+    let settings = match maps {
+        MapSource::Timed => IblSweepChoice::default().settings(),
+        MapSource::Cached => ibl_settings(),
+    };
     sweep_settings(scene, kind, repeats, maps, settings, progress)
 }
 
