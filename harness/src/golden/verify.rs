@@ -388,13 +388,18 @@ pub fn verify_failing(
     verifications
 }
 
-/// Copies the files of `from` (not its folders: a scene's golden folder has none) into `to`.
+/// Copies the files of `from` (not its folders: a scene's golden folder has none) into `to`,
+/// less the bless lock: a lock a bless holds is no input of the check, and a copy of it would
+/// make the same candidates' verification a different one to [`super::verify_cache`].
 fn copy_folder(from: &Path, to: &Path) -> Result<(), String> {
     std::fs::create_dir_all(to).map_err(|e| format!("cannot create {}: {e}", to.display()))?;
     let Ok(entries) = std::fs::read_dir(from) else {
         return Ok(());
     };
     for entry in entries.flatten() {
+        if entry.file_name() == super::LOCK_FILE {
+            continue;
+        }
         if entry.file_type().is_ok_and(|t| t.is_file()) {
             std::fs::copy(entry.path(), to.join(entry.file_name()))
                 .map_err(|e| format!("cannot copy {}: {e}", entry.path().display()))?;

@@ -136,6 +136,13 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
         .output()
         .unwrap();
     assert!(output.status.success(), "{output:?}");
+    // The check verified these candidates already: the bless (which holds the scene's lock
+    // while it verifies) finds them kept, and renders nothing under the sources again.
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("every source: the same candidates were verified before"),
+        "{stderr}"
+    );
     let server = Server::start(root.path(), &out);
     let (url, port, token) = (server.url.clone(), server.port, server.token.clone());
     let host = format!("Host: 127.0.0.1:{port}\r\n");
