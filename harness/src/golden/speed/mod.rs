@@ -142,9 +142,13 @@ pub fn cpu_signature() -> String {
     )
 }
 
-/// The first CPU's `name` field in `/proc/cpuinfo`, trimmed.
+/// The first CPU's `name` field in `/proc/cpuinfo`, trimmed. The file is read once per process
+/// (a check asks for the CPU per scene and backend, and the CPU does not change under it).
 fn cpuinfo_field(name: &str) -> Option<String> {
-    let text = std::fs::read_to_string("/proc/cpuinfo").ok()?;
+    static CPUINFO: std::sync::OnceLock<Option<String>> = std::sync::OnceLock::new();
+    let text = CPUINFO
+        .get_or_init(|| std::fs::read_to_string("/proc/cpuinfo").ok())
+        .as_deref()?;
     text.lines()
         .filter_map(|l| l.split_once(':'))
         .find(|(key, _)| key.trim() == name)
