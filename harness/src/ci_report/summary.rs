@@ -6,7 +6,7 @@ use std::path::Path;
 
 use super::{counts, speed_status, Status};
 use crate::golden::check::CheckRun;
-use crate::golden::speed::SpeedOutcome;
+use crate::golden::speed::{SpeedOutcome, Tier};
 
 /// The run as Markdown; `report` is where its review page was written.
 pub fn summary(run: &CheckRun, report: &Path) -> String {
@@ -89,8 +89,35 @@ pub fn summary(run: &CheckRun, report: &Path) -> String {
             let _ = writeln!(out, "- {}", cell(&orphan.to_string()));
         }
     }
+    speed_coverage(&mut out, run);
     passing(&mut out, run);
     out
+}
+
+/// What the speed checks can catch on the host that ran them, per backend, and what to do
+/// where the host neither blessed nor is recorded.
+fn speed_coverage(out: &mut String, run: &CheckRun) {
+    let coverage = crate::golden::speed::coverage(&run.speed.checks);
+    if coverage.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        out,
+        "
+### What the speed checks catch on this host
+"
+    );
+    for c in &coverage {
+        let _ = writeln!(out, "- `{}`: {}", c.backend.name(), cell(&c.describe()));
+    }
+    if coverage.iter().any(|c| c.tier == Tier::OtherHost) {
+        let _ = writeln!(
+            out,
+            "
+Note: {}.",
+            crate::golden::speed::verdict::RECORD_THIS_HOST
+        );
+    }
 }
 
 /// A table row, each cell made safe for a Markdown table.

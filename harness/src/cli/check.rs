@@ -406,4 +406,18 @@ fn print_speed(run: &CheckRun) {
             elsewhere.join(", ")
         );
     }
+    let coverage = harness::golden::speed::coverage(&run.speed.checks);
+    if !coverage.is_empty() {
+        println!("what the speed checks catch here (a pass slower than its golden by more than its limit \
+             fails):");
+        for c in &coverage {
+            println!("  {:<12} {}", c.backend.name(), c.describe());
+        }
+    }
+    if coverage.iter().any(|c| c.tier == Tier::OtherHost) {
+        println!(
+            "note: {}",
+            harness::golden::speed::verdict::RECORD_THIS_HOST
+        );
+    }
 }

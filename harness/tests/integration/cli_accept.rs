@@ -182,8 +182,10 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
                 "--backend",
                 "gl",
                 "--json",
-                "--out",
+                "--summary",
             ])
+            .arg(out.with_extension("md"))
+            .arg("--out")
             .arg(&out)
             .env("HARNESS_ROOT", root.path())
             .output()
@@ -200,6 +202,16 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
     };
     let slower = vec!["geometry".to_owned(), "lighting_pbr".to_owned()];
     assert_eq!(check(), (Some(1), slower));
+    // The summary says what the speed checks can catch on this host, whichever tier it is.
+    let summary = std::fs::read_to_string(out.with_extension("md")).unwrap();
+    let coverage = summary
+        .split("### What the speed checks catch on this host")
+        .nth(1)
+        .expect("a coverage section");
+    assert!(
+        coverage.contains("- `gl`: ") && coverage.contains("passes timed"),
+        "{summary}"
+    );
     let page = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(page.contains(
         "<tr class=\"failed\" data-speed=\"1\" data-scene=\"arrow\" data-pass=\"geometry\" \

@@ -42,7 +42,9 @@ use engine::backend::BackendKind;
 pub use bless::{bless_scenes, median_probe, SpeedBlessed};
 pub use goldens::{BackendTimings, PassTiming, TimingGoldens, TIMING_FILE};
 pub use model::{PassNoise, Tier, TimingNoise, TIMING_NOISE_FILE};
-pub use verdict::{check_speed, check_speed_with, SpeedCheck, SpeedOutcome};
+pub use verdict::{
+    check_speed, check_speed_with, coverage, SpeedCheck, SpeedCoverage, SpeedOutcome,
+};
 
 /// The environment the speed probe runs under: one rasterizer thread.
 pub const PROBE_THREADS: (&str, &str) = ("LP_NUM_THREADS", "1");

@@ -246,3 +246,92 @@ pub fn check_speed_with(
     }
     checks
 }
+
+/// What one backend's speed checks at one tier can catch: how many passes were timed, the
+/// smallest slowdown each of them fails (its limit), and how many were left untimed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpeedCoverage {
+    /// Backend.
+    pub backend: BackendKind,
+    /// Which figures the limits count: the blessing host's, a recording's, or any host's.
+    pub tier: Tier,
+    /// Passes with a verdict against a limit.
+    pub timed: usize,
+    /// Passes left untimed (too short, or too noisy at this tier to catch a doubling).
+    pub untimed: usize,
+    /// The timed passes' limits as factors: the smallest, the median and the largest.
+    pub limits: Option<[f64; 3]>,
+}
+
+impl SpeedCoverage {
+    /// One line: how many passes were timed and how, their limits (the slowdown beyond which
+    /// each fails), and how many were untimed.
+    pub fn describe(&self) -> String {
+        let how = match self.tier {
+            Tier::SameHost => "on the host that blessed",
+            Tier::RecordedHost => "against this host's recording",
+            Tier::OtherHost => "on a host that did not bless",
+        };
+        let limits = match self.limits {
+            Some([low, median, high]) => {
+                format!(", limits x{low:.2} to x{high:.2} (median x{median:.2})")
+            }
+            None => String::new(),
+        };
+        format!(
+            "{} passes timed {how}{limits}; {} untimed",
+            self.timed, self.untimed
+        )
+    }
+}
+
+/// What to do where checks ran at [`Tier::OtherHost`]: record the host, so that its checks
+/// read against its own ratios.
+pub const RECORD_THIS_HOST: &str = "this host's driver fingerprint and CPU match neither the \
+    timing goldens' nor a recording's, so its speed checks use limits wide enough for any host, \
+    and catch less. `harness noise --timing --record-host NAME` records it \
+    (golden/evidence/NAME/timing.toml, to commit); its checks then read against its own ratios";
+
+/// Per backend and tier, in the order the checks came: what the speed checks of a run can
+/// catch on this host. Checks without a golden count in neither column (they fail).
+pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
+    let mut groups: Vec<(BackendKind, Tier, Vec<f64>, usize)> = Vec::new();
+    for c in checks {
+        let index = match groups
+            .iter()
+            .position(|(b, t, ..)| *b == c.backend && *t == c.tier)
+        {
+            Some(i) => i,
+            None => {
+                groups.push((c.backend, c.tier, Vec::new(), 0));
+                groups.len() - 1
+            }
+        };
+        let group = &mut groups[index];
+        match (&c.outcome, c.limit) {
+            (SpeedOutcome::Untimed(_), _) => group.3 += 1,
+            (SpeedOutcome::MissingGolden, _) | (_, None) => {}
+            (_, Some(limit)) => group.2.push(limit),
+        }
+    }
+    groups
+        .into_iter()
+        .map(|(backend, tier, mut limits, untimed)| {
+            limits.sort_by(f64::total_cmp);
+            let range = (!limits.is_empty()).then(|| {
+                [
+                    limits[0],
+                    limits[limits.len() / 2],
+                    limits[limits.len() - 1],
+                ]
+            });
+            SpeedCoverage {
+                backend,
+                tier,
+                timed: limits.len(),
+                untimed,
+                limits: range,
+            }
+        })
+        .collect()
+}

@@ -242,3 +242,63 @@ fn the_blessing_host_is_its_fingerprint_and_its_cpu() {
     // Goldens that kept no signature: the fingerprint alone.
     assert_eq!(tier(""), Tier::SameHost);
 }
+
+fn covered(
+    backend: BackendKind,
+    tier: Tier,
+    outcome: SpeedOutcome,
+    limit: Option<f64>,
+) -> SpeedCheck {
+    SpeedCheck {
+        scene: "s".to_owned(),
+        backend,
+        pass: PassId::ToneMap,
+        ratio: 2.0,
+        ms: 1.0,
+        golden: Some(2.0),
+        limit,
+        noise: None,
+        borrowed: false,
+        tier,
+        outcome,
+    }
+}
+
+#[test]
+fn coverage_counts_the_timed_and_untimed_passes_per_backend_and_tier() {
+    use BackendKind::{Gl, WgpuVulkan};
+    let untimed = || SpeedOutcome::Untimed("too short to time".to_owned());
+    let checks = [
+        covered(Gl, Tier::SameHost, SpeedOutcome::Passed, Some(1.44)),
+        covered(WgpuVulkan, Tier::OtherHost, untimed(), Some(2.5)),
+        covered(Gl, Tier::SameHost, SpeedOutcome::Slower, Some(1.8)),
+        covered(Gl, Tier::SameHost, SpeedOutcome::Faster, Some(1.6)),
+        covered(Gl, Tier::SameHost, untimed(), Some(2.2)),
+        covered(Gl, Tier::SameHost, SpeedOutcome::MissingGolden, None),
+        covered(WgpuVulkan, Tier::OtherHost, SpeedOutcome::Passed, Some(1.5)),
+        covered(Gl, Tier::RecordedHost, SpeedOutcome::Passed, Some(1.69)),
+    ];
+    let found: Vec<_> = coverage(&checks)
+        .iter()
+        .map(|c| (c.backend, c.tier, c.timed, c.untimed, c.limits))
+        .collect();
+    assert_eq!(
+        found,
+        [
+            (Gl, Tier::SameHost, 3, 1, Some([1.44, 1.6, 1.8])),
+            (WgpuVulkan, Tier::OtherHost, 1, 1, Some([1.5; 3])),
+            (Gl, Tier::RecordedHost, 1, 0, Some([1.69; 3])),
+        ]
+    );
+    assert_eq!(
+        coverage(&checks)[0].describe(),
+        "3 passes timed on the host that blessed, limits x1.44 to x1.80 (median x1.60); \
+         1 untimed"
+    );
+    let none_timed = coverage(&[covered(Gl, Tier::OtherHost, untimed(), None)]);
+    assert_eq!(
+        none_timed[0].describe(),
+        "0 passes timed on a host that did not bless; 1 untimed"
+    );
+    assert!(coverage(&[]).is_empty());
+}
