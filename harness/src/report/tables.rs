@@ -184,4 +184,22 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
         );
     }
     out.push_str("</table>");
+    let coverage = crate::golden::speed::coverage(&run.speed.checks);
+    if !coverage.is_empty() {
+        out.push_str("<p>What the speed checks catch on this host:</p><ul>");
+        for c in &coverage {
+            let _ = write!(out, "<li>{}: {}</li>", c.backend, escape(&c.describe()));
+        }
+        out.push_str("</ul>");
+    }
+    if coverage
+        .iter()
+        .any(|c| c.tier == crate::golden::speed::Tier::OtherHost)
+    {
+        let _ = write!(
+            out,
+            "<p class=\"note\">Note: {}.</p>",
+            escape(crate::golden::speed::verdict::RECORD_THIS_HOST)
+        );
+    }
 }

@@ -202,7 +202,8 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
     };
     let slower = vec!["geometry".to_owned(), "lighting_pbr".to_owned()];
     assert_eq!(check(), (Some(1), slower));
-    // The summary says what the speed checks can catch on this host, whichever tier it is.
+    // The summary and the page say what the speed checks can catch on this host, whichever
+    // tier it is.
     let summary = std::fs::read_to_string(out.with_extension("md")).unwrap();
     let coverage = summary
         .split("### What the speed checks catch on this host")
@@ -213,6 +214,7 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
         "{summary}"
     );
     let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(page.contains("<p>What the speed checks catch on this host:</p><ul><li>gl: "));
     assert!(page.contains(
         "<tr class=\"failed\" data-speed=\"1\" data-scene=\"arrow\" data-pass=\"geometry\" \
          data-backend=\"gl\">"
