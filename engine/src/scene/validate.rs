@@ -25,6 +25,7 @@ impl Scene {
 
 fn validate(scene: &Scene) -> Result<(), InvalidScene> {
     let checks = || -> Result<(), String> {
+        check_name(&scene.name)?;
         check_output_and_camera(scene)?;
         for object in &scene.objects {
             check_object(object, scene.textures.len())?;
@@ -43,6 +44,30 @@ fn validate(scene: &Scene) -> Result<(), InvalidScene> {
 fn finite3(v: DVec3) -> bool {
     v.is_finite()
 }
+
+/// The scene's name names its folders (`golden/<name>/`, the failure images' `<out>/failures/
+/// <name>/`), so it must be one folder name: a name that climbs out (`..`), is empty or holds a
+/// separator would put goldens and failure images elsewhere, or clear another scene's.
+fn check_name(name: &str) -> Result<(), String> {
+    let bad = name.is_empty()
+        || name == "."
+        || name == ".."
+        || name
+            .chars()
+            .any(|c| c == '/' || c == '\\' || c.is_control());
+    if bad {
+        return Err(format!(
+            "name {name:?} cannot name a folder (golden/<name>/): it must not be empty, `.` or \
+             `..`, nor hold `/`, `\\` or control characters"
+        ));
+    }
+    Ok(())
+}
+
+/// The largest far / near ratio: beyond 2^24 a 32-bit float depth buffer cannot tell geometry
+/// near the far plane (depth 1 - near/far) from the cleared background (depth 1), and it
+/// vanishes.
+const MAX_FAR_OVER_NEAR: f64 = 16_777_216.0;
 
 /// Output size, exposure, camera and ambient.
 fn check_output_and_camera(scene: &Scene) -> Result<(), String> {
@@ -80,6 +105,16 @@ fn check_output_and_camera(scene: &Scene) -> Result<(), String> {
         return Err(format!(
             "camera near {} and far {} must satisfy 0 < near < far",
             c.near, c.far
+        ));
+    }
+    if c.far / c.near > MAX_FAR_OVER_NEAR {
+        return Err(format!(
+            "camera far / near is {:.3e}, over 2^24 (near {}, far {}): the 32-bit depth buffer \
+             cannot tell what lies towards the far plane from the empty background; raise near \
+             or lower far",
+            c.far / c.near,
+            c.near,
+            c.far
         ));
     }
     if !scene.ambient.iter().all(|a| a.is_finite() && *a >= 0.0) {
