@@ -11,6 +11,29 @@ use crate::scene::{
     GbufferSettings, LightingModel, PointShadowPass, ShadowFilter, SsaoSettings, ToneMap,
 };
 
+/// Exactly three numbers. A TOML document's list deserialized into `[T; 3]` keeps its first
+/// three and drops the rest without a word, so a fourth (a typo, a NaN) would pass unseen.
+fn three<'de, D, T>(deserializer: D) -> Result<[T; 3], D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    let values = Vec::<T>::deserialize(deserializer)?;
+    let found = values.len();
+    values
+        .try_into()
+        .map_err(|_| serde::de::Error::invalid_length(found, &"3 numbers"))
+}
+
+/// [`three`] for an optional field.
+fn three_or_none<'de, D, T>(deserializer: D) -> Result<Option<[T; 3]>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    three(deserializer).map(Some)
+}
+
 fn default_up() -> [f64; 3] {
     [0.0, 1.0, 0.0]
 }
@@ -35,11 +58,13 @@ fn default_true() -> bool {
 #[serde(deny_unknown_fields)]
 pub struct CameraSpec {
     /// Eye position.
+    #[serde(deserialize_with = "three")]
     pub position: [f64; 3],
     /// Point looked at.
+    #[serde(deserialize_with = "three")]
     pub target: [f64; 3],
     /// Up vector (default +Y).
-    #[serde(default = "default_up")]
+    #[serde(default = "default_up", deserialize_with = "three")]
     pub up: [f64; 3],
     /// Vertical field of view, degrees (default 45).
     #[serde(default = "default_fov")]
@@ -99,6 +124,7 @@ pub struct EnvironmentSpec {
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
     /// Linear base color.
+    #[serde(default, deserialize_with = "three_or_none")]
     pub base_color: Option<[f32; 3]>,
     /// Perceptual roughness.
     pub roughness: Option<f32>,
@@ -137,10 +163,10 @@ pub struct ObjectSpec {
     /// OBJ path relative to the scene file, or `builtin:sphere` / `builtin:plane`.
     pub mesh: String,
     /// World position.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "three")]
     pub position: [f64; 3],
     /// Euler angles in degrees, applied X, then Y, then Z.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "three")]
     pub rotation: [f64; 3],
     /// Scale (default 1).
     pub scale: Option<ScaleSpec>,
@@ -199,8 +225,10 @@ pub enum LightSpec {
 #[serde(deny_unknown_fields)]
 pub struct DirectionalLightSpec {
     /// Direction from the scene towards the light.
+    #[serde(deserialize_with = "three")]
     pub direction: [f64; 3],
     /// Linear color (default white).
+    #[serde(default, deserialize_with = "three_or_none")]
     pub color: Option<[f32; 3]>,
     /// Intensity (default 1).
     pub intensity: Option<f32>,
@@ -213,8 +241,10 @@ pub struct DirectionalLightSpec {
 #[serde(deny_unknown_fields)]
 pub struct PointLightSpec {
     /// Position.
+    #[serde(deserialize_with = "three")]
     pub position: [f64; 3],
     /// Linear color (default white).
+    #[serde(default, deserialize_with = "three_or_none")]
     pub color: Option<[f32; 3]>,
     /// Intensity (default 1).
     pub intensity: Option<f32>,
@@ -235,7 +265,7 @@ pub struct SceneFile {
     /// One-line description shown by `harness inspect` and the report.
     pub description: Option<String>,
     /// Uniform ambient radiance (default black).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "three")]
     pub ambient: [f32; 3],
     /// Camera.
     pub camera: CameraSpec,

@@ -107,6 +107,46 @@ fn load_error(dir: &Path, name: &str, text: &str) -> SceneFileError {
     scene_file::load(&path).err().unwrap()
 }
 
+/// A name that cannot be one folder (it names `golden/<name>/` and the failure images' folder),
+/// a list of other than three numbers where three are read (TOML's lists would otherwise keep
+/// the first three), and a far / near ratio a 32-bit depth buffer cannot hold are refused,
+/// naming the file.
+#[test]
+fn names_that_leave_their_folder_lists_of_four_and_depth_beyond_f32_are_refused() {
+    let temp = tempfile::tempdir().unwrap();
+    let dir = temp.path();
+    for name in ["../../elsewhere", "", "..", "a/b"] {
+        let e = load_error(dir, "named.toml", &format!("name = {name:?}\n{CAMERA}")).to_string();
+        assert!(
+            e.contains("named.toml") && e.contains("cannot name a folder"),
+            "{name:?}: {e}"
+        );
+    }
+    let four = "[camera]\nposition = [0, 1, 3, 4]\ntarget = [0, 0, 0]\n";
+    let e = load_error(dir, "four.toml", four).to_string();
+    assert!(
+        e.contains("four.toml:2:") && e.contains("invalid length 4, expected 3 numbers"),
+        "{e}"
+    );
+    let e = load_error(
+        dir,
+        "color.toml",
+        &format!("{CAMERA}[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\ncolor = [1, 1]\n"),
+    )
+    .to_string();
+    assert!(
+        e.contains("color.toml") && e.contains("invalid length 2"),
+        "{e}"
+    );
+    let e = load_error(
+        dir,
+        "depth.toml",
+        "[camera]\nposition = [0, 1, 3]\ntarget = [0, 0, 0]\nnear = 1e-7\nfar = 100.0\n",
+    )
+    .to_string();
+    assert!(e.contains("depth.toml") && e.contains("over 2^24"), "{e}");
+}
+
 /// A scene file may light its scene with a Radiance `.hdr` environment as well as an EXR: its
 /// size is read from the header for the limits, then it loads; above the limits it is refused
 /// naming the file, and a file of neither format is an error naming it.
