@@ -57,8 +57,9 @@ pub(crate) fn run(
     let exe = std::env::current_exe()?;
     // The speed probes' child starts now and prepares them (starting its backends, recording
     // and warming up the frames) on the core the image renders leave idle; their timed rounds
-    // wait until the renders are done.
-    let speed = options.speed.then(|| {
+    // wait until the renders are done. None when no scene loaded (a child given no scene would
+    // probe every canonical one).
+    let speed = (options.speed && !speed_scenes.is_empty()).then(|| {
         harness::golden::speed::start_check(&exe, &speed_scenes, backends, variations, &[])
     });
     let bar = indicatif::ProgressBar::new(0).with_style(
