@@ -234,6 +234,17 @@ pub(crate) fn merge(shards: &[PathBuf], out: &Path, options: &Options) -> anyhow
 /// Notes on stderr each scene whose limits are borrowed from the canonical scenes (or a
 /// fallback) because golden/noise.toml has no figures for it, and how to measure its own.
 fn note_borrowed_limits(cases: &[Case]) {
+    let model = harness::golden::GoldenStore::workspace()
+        .root()
+        .join(harness::golden::noise::NOISE_FILE);
+    if !cases.is_empty() && !model.exists() {
+        eprintln!(
+            "note: {} does not exist, so no limit is a measured one: each is the built-in \
+             fallback of its metric (measure the model with `harness noise --write`)",
+            model.display()
+        );
+        return;
+    }
     for case in cases {
         let borrowed: Vec<String> = case
             .limit_sources

@@ -110,10 +110,47 @@ impl NoiseModel {
             path: path.clone(),
             message: e.to_string(),
         })?;
-        toml::from_str(&text).map_err(|e| NoiseError::File {
-            path,
+        let model: NoiseModel = toml::from_str(&text).map_err(|e| NoiseError::File {
+            path: path.clone(),
             message: e.to_string(),
-        })
+        })?;
+        model
+            .problem()
+            .map_or(Ok(model), |message| Err(NoiseError::File { path, message }))
+    }
+
+    /// The first figure that cannot be a limit or a measurement (a limit of NaN fails every
+    /// check, one of infinity passes every one), named by its key.
+    fn problem(&self) -> Option<String> {
+        if !(self.margin.is_finite() && self.margin > 0.0) {
+            return Some(format!(
+                "margin {} must be finite and positive",
+                self.margin
+            ));
+        }
+        for (scene, passes) in &self.scenes {
+            for (pass, checks) in passes {
+                for (metric, figures) in checks {
+                    let key = format!("scenes.{scene}.{pass}.\"{metric}\"");
+                    if !(figures.limit.is_finite() && figures.limit > 0.0) {
+                        return Some(format!(
+                            "{key}: limit {} must be finite and positive",
+                            figures.limit
+                        ));
+                    }
+                    let values = std::iter::once(("resolution", &figures.resolution))
+                        .chain(figures.noise.iter().map(|(k, v)| (k.as_str(), v)));
+                    for (name, value) in values {
+                        if !(value.is_finite() && *value >= 0.0) {
+                            return Some(format!(
+                                "{key}: {name} {value} must be finite and not negative"
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        None
     }
 
     /// Writes the model atomically into `store`'s folder.

@@ -24,6 +24,7 @@ const HEADER: &str = "\
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PassTiming {
     /// The speed ratio.
+    #[serde(deserialize_with = "super::positive_finite")]
     pub ratio: f64,
     /// The pass's fastest time, ms (information).
     pub ms: f64,

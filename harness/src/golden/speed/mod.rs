@@ -92,6 +92,19 @@ pub enum SpeedError {
     Probe(String),
 }
 
+/// A ratio or factor read from a file of the speed goldens: finite and positive, or an error at
+/// its key (a NaN ratio would read "xNaN of golden ... ok", a negative one always "faster").
+fn positive_finite<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
+    let value = <f64 as serde::Deserialize>::deserialize(deserializer)?;
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "{value} is not a finite positive number"
+        )))
+    }
+}
+
 /// Reads a TOML file of the speed goldens: its value, or `None` when there is no file yet.
 fn read_toml<T: serde::de::DeserializeOwned>(
     path: &std::path::Path,

@@ -40,10 +40,12 @@ pub enum Tier {
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PassNoise {
     /// Largest factor above the golden under this host's sources.
+    #[serde(deserialize_with = "super::positive_finite")]
     pub host: f64,
     /// Where it was measured (`<source>`).
     pub host_at: String,
     /// Largest factor above the golden under another host's sources.
+    #[serde(deserialize_with = "super::positive_finite")]
     pub drivers: f64,
     /// Where it was measured.
     pub drivers_at: String,

@@ -61,6 +61,20 @@ fn goldens_round_trip_and_a_partial_bless_keeps_the_other_passes() {
         .unwrap_err()
         .to_string();
     assert!(error.contains("timing.toml"), "{error}");
+    // A ratio that is not a finite positive number is an error at its key, not a verdict.
+    let text = toml::to_string(&goldens).unwrap();
+    for bad in ["nan", "-2.0", "0.0", "inf"] {
+        let broken = text.replacen("ratio = 2.0", &format!("ratio = {bad}"), 1);
+        assert_ne!(broken, text);
+        std::fs::write(TimingGoldens::path(dir.path(), "s"), broken).unwrap();
+        let error = TimingGoldens::load(dir.path(), "s")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("timing.toml") && error.contains("not a finite positive number"),
+            "{bad}: {error}"
+        );
+    }
 }
 
 /// Goldens blessed before the CPU signature was kept name the host by its fingerprint alone.
