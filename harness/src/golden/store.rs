@@ -34,6 +34,17 @@ pub enum GoldenError {
         /// How many.
         count: usize,
     },
+    /// A golden holds NaN or infinite values: the file is corrupt (a bless refuses them).
+    #[error(
+        "{path}: the golden holds {count} NaN/Inf values, which no bless writes: the file is \
+         corrupt (restore it from version control, or bless the pass again)"
+    )]
+    CorruptGolden {
+        /// The golden file.
+        path: PathBuf,
+        /// How many values.
+        count: usize,
+    },
     /// The scene's bless lock could not be taken.
     #[error("cannot lock {path} for blessing: {error}")]
     Lock {
@@ -233,6 +244,12 @@ impl GoldenStore {
         } else {
             images::read_exr(&path)?
         };
+        if let Some(values) = image.as_f32() {
+            let count = values.iter().filter(|v| !v.is_finite()).count();
+            if count > 0 {
+                return Err(GoldenError::CorruptGolden { path, count });
+            }
+        }
         if let Some(stamp) = stamp {
             decoded().put(path, stamp, image.clone());
         }
