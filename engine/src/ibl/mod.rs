@@ -113,6 +113,23 @@ pub struct IblMaps {
     pub suns: Vec<sun::Sun>,
 }
 
+impl IblMaps {
+    /// Whether every value of the maps is finite: an environment bright enough to overflow
+    /// the precompute's 32-bit sums (a texel near 3e38) leaves NaN or infinity in them.
+    pub fn is_finite(&self) -> bool {
+        let level = |l: &CubeLevel| l.texels.iter().flatten().all(|v| v.is_finite());
+        let cube = |c: &CubeMap| c.levels.iter().all(level);
+        cube(&self.specular)
+            && cube(&self.radiance)
+            && level(&self.irradiance)
+            && self.dfg.iter().flatten().all(|v| v.is_finite())
+            && self
+                .suns
+                .iter()
+                .all(|s| s.direction.is_finite() && s.irradiance.iter().all(|v| v.is_finite()))
+    }
+}
+
 /// Builds the maps (the whole precompute, no caches).
 pub fn build(image: &EnvironmentImage, settings: &IblSettings) -> IblMaps {
     let (residual, suns) = if settings.extract_sun {
@@ -205,7 +222,8 @@ pub fn prepare(
     }
     let maps = Arc::new(build(image, settings));
     let seconds = start.elapsed().as_secs_f64();
-    if let Some(dir) = &directory {
+    // Maps that overflowed are not kept (the render refuses them; see `PreparedFrame::new`).
+    if let Some(dir) = directory.as_ref().filter(|_| maps.is_finite()) {
         if let Err(e) = cache::write(dir, &key, &maps) {
             log::warn!("{e}; continuing without caching these IBL maps");
         }

@@ -214,6 +214,24 @@ impl PreparedFrame {
             .environment
             .as_ref()
             .map(|environment| crate::ibl::prepare(&environment.image, &scene.quality.ibl).0);
+        if let (Some(maps), Some(environment)) = (&ibl_maps, &scene.environment) {
+            if !maps.is_finite() {
+                let brightest = environment
+                    .image
+                    .texels
+                    .iter()
+                    .flat_map(|t| &t[..3])
+                    .fold(0f32, |m, v| m.max(*v));
+                return Err(RenderError::InvalidScene {
+                    scene: scene.name.clone(),
+                    problem: format!(
+                        "environment {}: its IBL maps overflow 32-bit floats (its brightest \
+                         texel is {brightest:.3e}); scale the image down",
+                        environment.image.label
+                    ),
+                });
+            }
+        }
         // With `extract_sun`, the maps lack the environment's sun: it is lit as a light instead.
         let scene = crate::ibl::sun::scene_with_sun(scene, ibl_maps.as_deref())
             .unwrap_or_else(|| scene.clone());

@@ -499,3 +499,50 @@ fn the_disk_cache_removes_the_entries_used_longest_ago() {
     assert_eq!(ibl::cache::evict(dir.path(), 1), 1);
     assert!(paths[0].exists() && !paths[2].exists());
 }
+
+/// An environment bright enough to overflow the precompute's 32-bit sums leaves non-finite
+/// maps: a frame refuses them, naming the environment and its brightest texel, where it
+/// rendered black before.
+#[test]
+fn an_environment_that_overflows_the_precompute_is_refused() {
+    let settings = IblSettings {
+        source_size: 16,
+        specular_size: 8,
+        specular_samples: 16,
+        irradiance_size: 4,
+        ..IblSettings::default()
+    };
+    assert!(ibl::build(&uniform(1.0e20), &settings).is_finite());
+    assert!(!ibl::build(&uniform(3.0e38), &settings).is_finite());
+    let mut quality = engine::scene::Quality::default();
+    quality.ibl = settings;
+    let scene = engine::scene::Scene {
+        name: "bright".into(),
+        camera: engine::scene::Camera {
+            position: glam::DVec3::new(0.0, 0.0, 3.0),
+            target: glam::DVec3::ZERO,
+            up: glam::DVec3::Y,
+            fov_y_degrees: 40.0,
+            near: 0.05,
+            far: 100.0,
+        },
+        objects: Vec::new(),
+        lights: Vec::new(),
+        ambient: [0.0; 3],
+        environment: Some(engine::scene::Environment {
+            image: Arc::new(uniform(3.0e38)),
+            rotation_degrees: 0.0,
+            intensity: 1.0,
+        }),
+        textures: Vec::new(),
+        quality,
+    };
+    let error = engine::renderer::PreparedFrame::new(&scene)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        error.contains("environment uniform") && error.contains("3.000e38"),
+        "{error}"
+    );
+}
