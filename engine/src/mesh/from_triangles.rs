@@ -23,7 +23,10 @@ use std::collections::HashMap;
 
 use glam::{Vec2, Vec3};
 
-use super::tangents::{corner_tangents, healthy_vertices, weld};
+use super::tangents::{
+    accumulated_tangents, corner_tangents, healthy_vertices, max_valence, weld,
+    MAX_MIKKTSPACE_VALENCE,
+};
 use super::{Aabb, MeshData};
 
 impl MeshData {
@@ -48,7 +51,20 @@ impl MeshData {
         let uv = vertex_uvs(name, uvs, &pos, notes);
 
         let healthy = healthy_vertices(&pos, &uv, &tris);
-        let (corner_tangents, mikktspace_ok) = corner_tangents(&pos, &nrm, &uv, &tris);
+        let valence = max_valence(&pos, &nrm, &uv, &tris);
+        let (corner_tangents, mikktspace_ok) = if valence > MAX_MIKKTSPACE_VALENCE {
+            note_warn(
+                notes,
+                format!(
+                    "mesh `{name}`: a vertex is shared by {valence} triangles, over the \
+                     {MAX_MIKKTSPACE_VALENCE} MikkTSpace is run for (its time grows with the \
+                     square of that count); tangents by per-vertex accumulation instead"
+                ),
+            );
+            (accumulated_tangents(&pos, &nrm, &uv, &tris), true)
+        } else {
+            corner_tangents(&pos, &nrm, &uv, &tris)
+        };
         if !mikktspace_ok {
             note_warn(
                 notes,

@@ -48,6 +48,83 @@ pub(super) fn healthy_vertices(pos: &[Vec3], uv: &[Vec2], tris: &[[u32; 3]]) -> 
     healthy
 }
 
+/// The most triangles one vertex (by its position, normal and UV, as MikkTSpace welds them)
+/// may touch for MikkTSpace to run: its time grows with the square of a vertex's triangle count
+/// (a 25 000-triangle fan took 17 s), while meshes of real models stay far below this.
+pub(super) const MAX_MIKKTSPACE_VALENCE: usize = 2048;
+
+/// The largest number of triangles that share one vertex, vertices told apart as MikkTSpace
+/// tells them (equal position, normal and UV are one vertex).
+pub(super) fn max_valence(pos: &[Vec3], nrm: &[Vec3], uv: &[Vec2], tris: &[[u32; 3]]) -> usize {
+    let mut count: HashMap<[u32; 8], usize> = HashMap::new();
+    for &i in tris.iter().flatten() {
+        let i = i as usize;
+        let (p, n, t) = (
+            pos.get(i).copied().unwrap_or(Vec3::ZERO),
+            nrm.get(i).copied().unwrap_or(Vec3::ZERO),
+            uv.get(i).copied().unwrap_or(Vec2::ZERO),
+        );
+        let key = [p.x, p.y, p.z, n.x, n.y, n.z, t.x, t.y].map(f32::to_bits);
+        *count.entry(key).or_default() += 1;
+    }
+    count.into_values().max().unwrap_or(0)
+}
+
+/// Tangents by per-vertex accumulation (Lengyel's method: each triangle's UV-space tangent
+/// and bitangent, summed at its corners' vertices), one slot per corner: the linear-time
+/// stand-in for MikkTSpace on meshes beyond [`MAX_MIKKTSPACE_VALENCE`].
+pub(super) fn accumulated_tangents(
+    pos: &[Vec3],
+    nrm: &[Vec3],
+    uv: &[Vec2],
+    tris: &[[u32; 3]],
+) -> Vec<Option<[f32; 4]>> {
+    let mut tangent = vec![Vec3::ZERO; pos.len()];
+    let mut bitangent = vec![Vec3::ZERO; pos.len()];
+    for t in tris {
+        let [a, b, c] = t.map(|i| i as usize);
+        let (Some(pa), Some(pb), Some(pc), Some(ua), Some(ub), Some(uc)) = (
+            pos.get(a),
+            pos.get(b),
+            pos.get(c),
+            uv.get(a),
+            uv.get(b),
+            uv.get(c),
+        ) else {
+            continue;
+        };
+        let (e1, e2) = (*pb - *pa, *pc - *pa);
+        let (d1, d2) = (*ub - *ua, *uc - *ua);
+        let det = d1.x * d2.y - d2.x * d1.y;
+        if det.abs() < 1e-20 || !det.is_finite() {
+            continue;
+        }
+        let r = 1.0 / det;
+        let (ft, fb) = ((e1 * d2.y - e2 * d1.y) * r, (e2 * d1.x - e1 * d2.x) * r);
+        for i in [a, b, c] {
+            if let (Some(t), Some(b)) = (tangent.get_mut(i), bitangent.get_mut(i)) {
+                *t += ft;
+                *b += fb;
+            }
+        }
+    }
+    tris.iter()
+        .flatten()
+        .map(|&i| {
+            let i = i as usize;
+            let n = nrm.get(i).copied()?;
+            let t = tangent.get(i).copied()?;
+            let t = (t - n * n.dot(t)).try_normalize()?;
+            let sign = if n.cross(t).dot(bitangent.get(i).copied()?) < 0.0 {
+                -1.0
+            } else {
+                1.0
+            };
+            Some([t.x, t.y, t.z, sign])
+        })
+        .collect()
+}
+
 /// MikkTSpace tangents, one slot per triangle corner (`None` where it produced none), and
 /// whether MikkTSpace succeeded.
 pub(super) fn corner_tangents(
