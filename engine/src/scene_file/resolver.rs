@@ -351,6 +351,14 @@ impl Resolver {
         for o in overrides {
             apply_overrides(&mut material, o);
         }
+        let object = spec.name.as_deref().unwrap_or(&spec.mesh);
+        let of = mtl_name.map_or(String::new(), |m| format!(", material `{m}`"));
+        for problem in out_of_range(&material) {
+            self.warnings.push(format!(
+                "{}: object `{object}`{of}: {problem}",
+                self.path.display()
+            ));
+        }
         material
     }
 
@@ -456,4 +464,38 @@ fn apply_overrides(material: &mut Material, o: &MaterialSpec) {
     if o.specular.is_some() {
         material.specular_map = None;
     }
+}
+
+/// A material's values outside the ranges its fields document (finite ones: NaN and infinity
+/// are refused by the scene's validation), each as a phrase for a load warning.
+fn out_of_range(m: &Material) -> Vec<String> {
+    let mut problems = Vec::new();
+    let unit = [
+        ("roughness", m.roughness),
+        ("metallic", m.metallic),
+        ("specular", m.specular),
+        ("clearcoat", m.clearcoat),
+        ("clearcoat_roughness", m.clearcoat_roughness),
+    ];
+    for (name, value) in unit {
+        if value.is_finite() && !(0.0..=1.0).contains(&value) {
+            problems.push(format!("{name} {value} is outside 0..1"));
+        }
+    }
+    if m.anisotropy.is_finite() && !(-1.0..=1.0).contains(&m.anisotropy) {
+        problems.push(format!("anisotropy {} is outside -1..1", m.anisotropy));
+    }
+    if m.base_color.iter().any(|c| *c < 0.0) {
+        problems.push(format!(
+            "base colour {:?} is negative (no surface reflects less than nothing)",
+            m.base_color
+        ));
+    }
+    if m.specular_exponent.is_finite() && m.specular_exponent <= 0.0 {
+        problems.push(format!(
+            "specular exponent {} is not positive",
+            m.specular_exponent
+        ));
+    }
+    problems
 }

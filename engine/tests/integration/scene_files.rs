@@ -338,10 +338,11 @@ fn canonical_scenes_load_with_valid_tangent_frames() {
     );
 }
 
-/// A negative light intensity and absolute asset paths load, each with a warning naming the
-/// scene file and what is at fault; the canonical scenes have neither.
+/// A negative light intensity, absolute asset paths and material values outside their ranges
+/// load, each with a warning naming the scene file and what is at fault; the canonical scenes
+/// have none of them.
 #[test]
-fn negative_intensities_and_absolute_paths_are_warned_about() {
+fn negative_intensities_absolute_paths_and_materials_out_of_range_are_warned_about() {
     let dir = tempfile::tempdir().unwrap();
     let cube = fixture("cube.obj");
     let sunset = scenes_dir()
@@ -353,6 +354,7 @@ fn negative_intensities_and_absolute_paths_are_warned_about() {
         &scene,
         format!(
             "{CAMERA}[environment]\npath = \"{}\"\n[[objects]]\nname = \"cube\"\nmesh = \"{}\"\n\
+             material = {{ roughness = 2.0, anisotropy = -3.0, base_color = [-1, 0, 0] }}\n\
              [[lights]]\ntype = \"directional\"\ndirection = [0, 1, 0]\nintensity = -2.0\n",
             sunset.display(),
             cube.display()
@@ -370,6 +372,9 @@ fn negative_intensities_and_absolute_paths_are_warned_about() {
             "untidy.toml: [environment] path `{}` is an absolute path",
             sunset.display()
         ),
+        "roughness 2 is outside 0..1".to_owned(),
+        "anisotropy -3 is outside -1..1".to_owned(),
+        "base colour [-1.0, 0.0, 0.0] is negative".to_owned(),
     ];
     for needle in &expected {
         assert!(

@@ -213,6 +213,10 @@ fn a_vertex_shared_by_thousands_of_triangles_gets_accumulated_tangents() {
     for (i, v) in mesh.vertices.iter().enumerate() {
         common::check_vertex(v, &format!("fan {i}"));
         // The UVs are the positions scaled: +u is +x, +v is +y.
-        assert!(v.tangent[0] > 0.999 && v.tangent[3] == 1.0, "{i}: {:?}", v.tangent);
+        assert!(
+            v.tangent[0] > 0.999 && v.tangent[3] == 1.0,
+            "{i}: {:?}",
+            v.tangent
+        );
     }
 }
