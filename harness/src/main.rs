@@ -219,7 +219,7 @@ enum Command {
         backends: Vec<BackendKind>,
         /// Frames timed per scene and backend, after one warm-up frame [default: 5, or 21 per
         /// variant with --breakdown].
-        #[arg(long)]
+        #[arg(long, value_parser = at_least_one)]
         frames: Option<usize>,
         /// Slow this pass down by --slowdown in every frame timed (its render passes submitted
         /// that many times over): how a slower pass shows in the ratios (its pixels are not
@@ -430,5 +430,14 @@ fn main() -> ExitCode {
             eprintln!("error: {}", harness::error_text(e.as_ref()));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// A count of at least one (`--frames 0` would time nothing, and ran one frame instead).
+fn at_least_one(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(0) => Err("must be at least 1".to_owned()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(e.to_string()),
     }
 }

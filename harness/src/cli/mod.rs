@@ -95,6 +95,14 @@ fn scenes_or_canonical(scenes: &[String]) -> Vec<String> {
     if scenes.is_empty() {
         engine::scene_file::canonical_scenes(&harness::scenes_dir())
     } else {
-        scenes.to_vec()
+        // A scene named twice is checked once (its failure folder would be cleared and
+        // written twice, its speed probed twice).
+        let mut unique: Vec<String> = Vec::new();
+        for scene in scenes {
+            if !unique.contains(scene) {
+                unique.push(scene.clone());
+            }
+        }
+        unique
     }
 }
