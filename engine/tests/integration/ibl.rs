@@ -514,8 +514,10 @@ fn an_environment_that_overflows_the_precompute_is_refused() {
     };
     assert!(ibl::build(&uniform(1.0e20), &settings).is_finite());
     assert!(!ibl::build(&uniform(3.0e38), &settings).is_finite());
-    let mut quality = engine::scene::Quality::default();
-    quality.ibl = settings;
+    let quality = engine::scene::Quality {
+        ibl: settings,
+        ..Default::default()
+    };
     let scene = engine::scene::Scene {
         name: "bright".into(),
         camera: engine::scene::Camera {
