@@ -27,6 +27,21 @@ fn unknown_scene_names_list_the_canonical_scenes() {
     let (code, _, stderr) = harness(&["plan", "--scene", "chesss"]);
     assert_eq!(code, 1);
     assert!(stderr.contains("chess"), "{stderr}");
+    // `check` of it alone (named twice: once) fails without probing any scene's speed (a
+    // probe child given no scene would time every canonical one).
+    let out = tempfile::tempdir().unwrap();
+    let out = out.path().to_str().unwrap();
+    let args = [
+        "check", "--scene", "chesss", "--scene", "chesss", "--out", out,
+    ];
+    let (code, stdout, stderr) = harness(&args);
+    assert_eq!(code, 1, "{stderr}");
+    assert_eq!(
+        stderr.matches("scene `chesss` did not load").count(),
+        1,
+        "{stderr}"
+    );
+    assert!(stdout.contains("(0 of speed)"), "{stdout}");
 }
 
 /// The committed scene assets are exactly what the generator writes, so they can be regenerated.
