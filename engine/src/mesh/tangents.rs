@@ -27,17 +27,9 @@ use super::Vertex;
 pub(super) fn healthy_vertices(pos: &[Vec3], uv: &[Vec2], tris: &[[u32; 3]]) -> Vec<bool> {
     let mut healthy = vec![false; pos.len()];
     for t in tris {
-        let [a, b, c] = t.map(|i| i as usize);
-        if let (Some(pa), Some(pb), Some(pc), Some(ua), Some(ub), Some(uc)) = (
-            pos.get(a),
-            pos.get(b),
-            pos.get(c),
-            uv.get(a),
-            uv.get(b),
-            uv.get(c),
-        ) {
-            if !tri_degenerate(*pa, *pb, *pc) && !uv_degenerate(*ua, *ub, *uc) {
-                for i in [a, b, c] {
+        if let Some(([pa, pb, pc], [ua, ub, uc])) = corners(pos, uv, t) {
+            if !tri_degenerate(pa, pb, pc) && !uv_degenerate(ua, ub, uc) {
+                for i in t.map(|i| i as usize) {
                     if let Some(h) = healthy.get_mut(i) {
                         *h = true;
                     }
@@ -46,6 +38,15 @@ pub(super) fn healthy_vertices(pos: &[Vec3], uv: &[Vec2], tris: &[[u32; 3]]) -> 
         }
     }
     healthy
+}
+
+/// A triangle's corner positions and UVs, or None where an index is out of range.
+fn corners(pos: &[Vec3], uv: &[Vec2], t: &[u32; 3]) -> Option<([Vec3; 3], [Vec2; 3])> {
+    let [a, b, c] = t.map(|i| i as usize);
+    Some((
+        [*pos.get(a)?, *pos.get(b)?, *pos.get(c)?],
+        [*uv.get(a)?, *uv.get(b)?, *uv.get(c)?],
+    ))
 }
 
 /// The most triangles one vertex (by its position, normal and UV, as MikkTSpace welds them)
@@ -82,26 +83,18 @@ pub(super) fn accumulated_tangents(
     let mut tangent = vec![Vec3::ZERO; pos.len()];
     let mut bitangent = vec![Vec3::ZERO; pos.len()];
     for t in tris {
-        let [a, b, c] = t.map(|i| i as usize);
-        let (Some(pa), Some(pb), Some(pc), Some(ua), Some(ub), Some(uc)) = (
-            pos.get(a),
-            pos.get(b),
-            pos.get(c),
-            uv.get(a),
-            uv.get(b),
-            uv.get(c),
-        ) else {
+        let Some(([pa, pb, pc], [ua, ub, uc])) = corners(pos, uv, t) else {
             continue;
         };
-        let (e1, e2) = (*pb - *pa, *pc - *pa);
-        let (d1, d2) = (*ub - *ua, *uc - *ua);
+        let (e1, e2) = (pb - pa, pc - pa);
+        let (d1, d2) = (ub - ua, uc - ua);
         let det = d1.x * d2.y - d2.x * d1.y;
         if det.abs() < 1e-20 || !det.is_finite() {
             continue;
         }
         let r = 1.0 / det;
         let (ft, fb) = ((e1 * d2.y - e2 * d1.y) * r, (e2 * d1.x - e1 * d2.x) * r);
-        for i in [a, b, c] {
+        for i in t.map(|i| i as usize) {
             if let (Some(t), Some(b)) = (tangent.get_mut(i), bitangent.get_mut(i)) {
                 *t += ft;
                 *b += fb;
