@@ -433,6 +433,49 @@ pub(crate) fn check_upload(desc: &TextureDesc, at: Subresource, data: &[u8]) -> 
     Ok((w, h))
 }
 
+/// The environment variables that point a backend's driver loader elsewhere than the system's
+/// drivers (the Vulkan loader's, glvnd's EGL vendor files, Mesa's DRI path).
+fn driver_variables(kind: BackendKind) -> &'static [&'static str] {
+    match kind {
+        BackendKind::WgpuVulkan => &[
+            "VK_DRIVER_FILES",
+            "VK_ICD_FILENAMES",
+            "VK_ADD_DRIVER_FILES",
+            "VK_LOADER_DRIVERS_SELECT",
+            "VK_LOADER_DRIVERS_DISABLE",
+        ],
+        BackendKind::Gl | BackendKind::WgpuGl => &[
+            "LIBGL_DRIVERS_PATH",
+            "__EGL_VENDOR_LIBRARY_FILENAMES",
+            "__EGL_VENDOR_LIBRARY_DIRS",
+            "EGL_PLATFORM",
+            "MESA_LOADER_DRIVER_OVERRIDE",
+        ],
+    }
+}
+
+/// An unavailable backend's `fix`: where this process sets variables that point the driver
+/// loader elsewhere, those first (a driver they lead away from is not found), then `install`.
+pub(crate) fn unavailable_fix(kind: BackendKind, install: &str) -> String {
+    let set: Vec<String> = driver_variables(kind)
+        .iter()
+        .filter_map(|name| {
+            std::env::var(name)
+                .ok()
+                .map(|value| format!("{name}={value}"))
+        })
+        .collect();
+    if set.is_empty() {
+        install.to_owned()
+    } else {
+        format!(
+            "check {} (set here, pointing the driver loader away from the system's drivers; \
+             unset to use those), or {install}",
+            set.join(" ")
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -69,3 +69,25 @@ fn scene_assets_regenerate_byte_for_byte() {
     }
     assert!(compared >= 12, "only {compared} files generated");
 }
+
+/// A driver that is not found because a variable points the loader elsewhere: the fix names
+/// the variable and its value before the install advice.
+#[test]
+fn an_unavailable_backend_names_the_variable_that_redirected_its_loader() {
+    let output = common::harness_command()
+        .arg("backends")
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let fix = stdout
+        .lines()
+        .skip_while(|l| !l.starts_with("wgpu-vulkan"))
+        .nth(1)
+        .unwrap_or_default();
+    assert!(
+        fix.contains("fix: check VK_DRIVER_FILES=/nonexistent/icd.json")
+            && fix.contains("apt-get install"),
+        "{stdout}"
+    );
+}

@@ -40,7 +40,7 @@ fn unavailable(reason: String) -> BackendError {
     BackendError::Unavailable {
         backend: BackendKind::Gl.name(),
         reason,
-        fix: FIX.to_owned(),
+        fix: crate::backend::unavailable_fix(BackendKind::Gl, FIX),
     }
 }
 

@@ -33,7 +33,7 @@ impl WgpuBackend {
         let unavailable = |reason: String| BackendError::Unavailable {
             backend: kind.name(),
             reason,
-            fix: fix.to_owned(),
+            fix: crate::backend::unavailable_fix(kind, fix),
         };
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
             backends,
