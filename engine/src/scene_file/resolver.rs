@@ -224,6 +224,16 @@ impl Resolver {
         self.reserve_environment(&env_path)
             .map_err(|e| self.asset(e))?;
         let loaded = assets::load_environment(&env_path).map_err(|e| self.asset(e))?;
+        if loaded.width != 2 * loaded.height {
+            self.warnings.push(format!(
+                "{}: environment {} is {}x{}, not twice as wide as tall: an equirectangular \
+                 image spans 360 degrees across and 180 down, so it will be stretched",
+                self.path.display(),
+                env_path.display(),
+                loaded.width,
+                loaded.height
+            ));
+        }
         Ok(Environment {
             image: Arc::new(EnvironmentImage {
                 label: env_path.display().to_string(),

@@ -484,3 +484,28 @@ fn the_ibl_extracted_lights_are_a_count_from_one_to_eight() {
         );
     }
 }
+
+/// An environment that is not twice as wide as tall loads (stretched over the sphere) with a
+/// warning naming the scene file, the image and its size.
+#[test]
+fn an_environment_not_twice_as_wide_as_tall_is_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    exr::prelude::write_rgba_file(dir.path().join("square.exr"), 16, 16, |_, _| {
+        (0.5f32, 0.5f32, 0.5f32, 1.0f32)
+    })
+    .unwrap();
+    let scene = dir.path().join("square.toml");
+    std::fs::write(
+        &scene,
+        format!("{CAMERA}[environment]\npath = \"square.exr\"\n"),
+    )
+    .unwrap();
+    let warnings = scene_file::load(&scene).unwrap().warnings;
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("square.toml: environment")
+                && w.contains("square.exr is 16x16, not twice as wide as tall")),
+        "{warnings:#?}"
+    );
+}
