@@ -138,6 +138,18 @@ impl Rule {
         let limit_key = if metric == Metric::Psnr { "min" } else { "max" };
         let limit = number(table, limit_key, path)?
             .ok_or_else(|| err(format!("metric `{name}` needs `{limit_key}`")))?;
+        if limit_key == "max" && limit < 0.0 {
+            return Err(err(format!(
+                "`max` {limit} is negative: no render could pass (0 asks for no difference)"
+            )));
+        }
+        if let Metric::FractionOver { threshold, .. } = metric {
+            if threshold < 0.0 {
+                return Err(err(format!(
+                    "`threshold` {threshold} is negative: every pixel would count as over it"
+                )));
+            }
+        }
         Ok(Rule::Check { metric, limit })
     }
 }

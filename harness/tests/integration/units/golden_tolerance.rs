@@ -79,4 +79,13 @@ shift = 1"#,
     assert!(e.to_string().contains("unknown key `shift`"), "{e}");
     let e = rule(r#"all = [{ metric = "rmse" }]"#).unwrap_err();
     assert!(e.to_string().contains("final.all[0]"), "{e}");
+    // A limit no render could meet, and a threshold every pixel is over.
+    let e = rule("metric = \"flip_mean\"\nmax = -1").unwrap_err();
+    assert!(e.to_string().contains("`max` -1 is negative"), "{e}");
+    let e = rule("metric = \"fraction_over\"\nthreshold = -0.1\nmax = 0.01").unwrap_err();
+    assert!(
+        e.to_string().contains("`threshold` -0.1 is negative"),
+        "{e}"
+    );
+    assert!(rule("metric = \"max_abs\"\nmax = 0").is_ok());
 }
