@@ -212,6 +212,13 @@ pub(super) fn parse_mtl_bytes(path: &Path, bytes: &[u8]) -> Result<ParsedMtl, As
         } else {
             file.replace('\\', "/")
         };
+        if Path::new(&file).is_absolute() {
+            warn(format!(
+                "{}:{lineno}: `{key}` names the absolute path `{file}`; it will not resolve on \
+                 another machine (give it relative to the MTL file)",
+                path.display()
+            ));
+        }
         let map = MapRef {
             slot,
             key: key.to_string(),
@@ -404,5 +411,20 @@ mod tests {
             .map(|x| x.path.clone());
         assert_eq!(normal, Some(PathBuf::from("dir/n.png")));
         assert_eq!(m.diffuse, Some([0.5; 3]));
+        assert!(mtl.warnings.is_empty(), "{:?}", mtl.warnings);
+        // An absolute map path loads, with a warning naming the file and line.
+        let src = b"newmtl m\nmap_Kd /textures/wood.png\n";
+        let mtl = parse_mtl_bytes(Path::new("dir/x.mtl"), src).unwrap();
+        assert_eq!(
+            mtl.materials[0].maps[0].path,
+            PathBuf::from("/textures/wood.png")
+        );
+        assert!(
+            mtl.warnings
+                .iter()
+                .any(|w| w.starts_with("dir/x.mtl:2:") && w.contains("absolute path")),
+            "{:?}",
+            mtl.warnings
+        );
     }
 }
