@@ -131,8 +131,8 @@ fn check_object(object: &Object, texture_count: usize) -> Result<(), String> {
     }
     if t.scale.abs().min_element() < 1e-12 {
         return Err(format!(
-            "object `{}`: scale {:?} has a zero component",
-            object.name, t.scale
+            "object `{}`: scale [{}, {}, {}] has a zero component",
+            object.name, t.scale.x, t.scale.y, t.scale.z
         ));
     }
     let m = &object.material;

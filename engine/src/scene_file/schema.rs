@@ -146,7 +146,7 @@ pub struct MaterialSpec {
 
 /// A scale: one number or three.
 #[derive(Clone, Copy, Debug, Deserialize)]
-#[serde(untagged)]
+#[serde(untagged, expecting = "`scale` must be one number or a list of three")]
 pub enum ScaleSpec {
     /// Uniform.
     Uniform(f64),

@@ -123,6 +123,12 @@ fn names_that_leave_their_folder_lists_of_four_and_depth_beyond_f32_are_refused(
         );
     }
     let four = "[camera]\nposition = [0, 1, 3, 4]\ntarget = [0, 0, 0]\n";
+    let scale = format!("{CAMERA}[[objects]]\nmesh = \"cube\"\nscale = [1, 2]\n");
+    let e = load_error(dir, "scale.toml", &scale).to_string();
+    assert!(
+        e.contains("scale.toml:6:9:") && e.ends_with("`scale` must be one number or a list of three"),
+        "{e}"
+    );
     let e = load_error(dir, "four.toml", four).to_string();
     assert!(
         e.contains("four.toml:2:") && e.contains("invalid length 4, expected 3 numbers"),
