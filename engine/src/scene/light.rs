@@ -201,21 +201,24 @@ impl Light {
         else {
             return None;
         };
+        if !(64..=8192).contains(&s.map_size) {
+            return Some(format!(
+                "shadow map_size {} must be in 64..8192",
+                s.map_size
+            ));
+        }
         let values = [
-            s.bias,
-            s.slope_bias,
-            s.normal_offset,
-            s.soft_radius,
-            s.vsm_min_variance,
-            s.vsm_bleeding_reduction,
+            ("bias", s.bias),
+            ("slope_bias", s.slope_bias),
+            ("normal_offset", s.normal_offset),
+            ("soft_radius", s.soft_radius),
+            ("vsm_min_variance", s.vsm_min_variance),
+            ("vsm_bleeding_reduction", s.vsm_bleeding_reduction),
         ];
-        if !(64..=8192).contains(&s.map_size) || !values.iter().all(|b| b.is_finite() && *b >= 0.0)
-        {
-            return Some(
-                "shadow map_size must be 64..8192 and biases, radii and VSM settings finite and \
-                 non-negative"
-                    .to_owned(),
-            );
+        if let Some((name, value)) = values.iter().find(|(_, v)| !(v.is_finite() && *v >= 0.0)) {
+            return Some(format!(
+                "shadow {name} {value} must be finite and not negative"
+            ));
         }
         if !(1..=4096).contains(&s.soft_samples) {
             return Some(format!(

@@ -126,7 +126,8 @@ fn names_that_leave_their_folder_lists_of_four_and_depth_beyond_f32_are_refused(
     let scale = format!("{CAMERA}[[objects]]\nmesh = \"cube\"\nscale = [1, 2]\n");
     let e = load_error(dir, "scale.toml", &scale).to_string();
     assert!(
-        e.contains("scale.toml:6:9:") && e.ends_with("`scale` must be one number or a list of three"),
+        e.contains("scale.toml:6:9:")
+            && e.ends_with("`scale` must be one number or a list of three"),
         "{e}"
     );
     let e = load_error(dir, "four.toml", four).to_string();
@@ -260,6 +261,13 @@ fn bad_values_and_missing_assets_are_errors_naming_the_file() {
     )
     .to_string();
     assert!(e.contains("nan.toml") && e.contains("finite"), "{e}");
+    let bias =
+        "[[lights]]\ntype = \"directional\"\ndirection = [0, 1, 0]\nshadow = { bias = -1.0 }\n";
+    let e = load_error(dir, "bias.toml", &format!("{CAMERA}{bias}")).to_string();
+    assert!(
+        e.contains("bias.toml") && e.contains("shadow bias -1 must be finite and not negative"),
+        "{e}"
+    );
     let e = load_error(dir, "vsm.toml", &format!("{CAMERA}{POINT_LIGHT_WITH_VSM}")).to_string();
     assert!(
         e.contains("vsm.toml") && e.contains("light 0") && e.contains("directional"),
