@@ -351,3 +351,27 @@ fn utf16_obj_files_with_a_byte_order_mark_are_decoded() {
         );
     }
 }
+
+/// A mesh's notes (here: corners whose UVs collapse, so their tangent is a fallback) name the
+/// OBJ file as well as the mesh, whose name alone (`unnamed_object` without `o` or `g`) does
+/// not say where it is.
+#[test]
+fn a_mesh_note_names_the_obj_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("flat_uvs.obj");
+    std::fs::write(
+        &path,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5 0.5\nf 1/1 2/1 3/1\n",
+    )
+    .unwrap();
+    let model = engine::assets::load_obj(&path, &mut engine::assets::TextureCache::new()).unwrap();
+    let prefix = format!("{}: mesh `", path.display());
+    assert!(
+        model
+            .warnings
+            .iter()
+            .any(|w| w.starts_with(&prefix) && w.contains("arbitrary tangent")),
+        "{:?}",
+        model.warnings
+    );
+}

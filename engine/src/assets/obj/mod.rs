@@ -201,6 +201,7 @@ pub fn load_obj(path: &Path, textures: &mut TextureCache) -> Result<Model, Asset
         } else {
             m.name.clone()
         };
+        let before = warnings.len();
         let mut data = MeshData::from_triangles(
             &name,
             &positions,
@@ -209,6 +210,11 @@ pub fn load_obj(path: &Path, textures: &mut TextureCache) -> Result<Model, Asset
             &mesh.indices,
             &mut warnings,
         );
+        // The mesh's notes name the OBJ file too (tobj calls a mesh without `o` or `g`
+        // `unnamed_object`, which alone says nothing of where it is).
+        for note in warnings.iter_mut().skip(before) {
+            *note = format!("{}: {note}", path.display());
+        }
         if data.indices.is_empty() {
             continue;
         }
