@@ -6,7 +6,7 @@ use std::path::Path;
 
 use super::{counts, speed_status, Status};
 use crate::golden::check::CheckRun;
-use crate::golden::speed::{SpeedOutcome, Tier};
+use crate::golden::speed::SpeedOutcome;
 
 /// The run as Markdown; `report` is where its review page was written.
 pub fn summary(run: &CheckRun, report: &Path) -> String {
@@ -101,22 +101,12 @@ fn speed_coverage(out: &mut String, run: &CheckRun) {
     if coverage.is_empty() {
         return;
     }
-    let _ = writeln!(
-        out,
-        "
-### What the speed checks catch on this host
-"
-    );
+    let _ = writeln!(out, "\n### What the speed checks catch on this host\n");
     for c in &coverage {
         let _ = writeln!(out, "- `{}`: {}", c.backend.name(), cell(&c.describe()));
     }
-    if coverage.iter().any(|c| c.tier == Tier::OtherHost) {
-        let _ = writeln!(
-            out,
-            "
-Note: {}.",
-            crate::golden::speed::verdict::RECORD_THIS_HOST
-        );
+    if let Some(advice) = crate::golden::speed::verdict::record_advice(&coverage) {
+        let _ = writeln!(out, "\nNote: {advice}.");
     }
 }
 

@@ -132,7 +132,7 @@ pub(crate) fn run(
     for note in &run.driver_notes {
         eprintln!("note: {note}");
     }
-    note_borrowed_limits(&cases);
+    note_borrowed_limits(&cases, &store);
     finish(
         &run,
         &outputs,
@@ -232,11 +232,10 @@ pub(crate) fn merge(shards: &[PathBuf], out: &Path, options: &Options) -> anyhow
 }
 
 /// Notes on stderr each scene whose limits are borrowed from the canonical scenes (or a
-/// fallback) because golden/noise.toml has no figures for it, and how to measure its own.
-fn note_borrowed_limits(cases: &[Case]) {
-    let model = harness::golden::GoldenStore::workspace()
-        .root()
-        .join(harness::golden::noise::NOISE_FILE);
+/// fallback) because golden/noise.toml has no figures for it, and how to measure its own; or,
+/// where `store` has no noise.toml at all, that every limit is a fallback.
+fn note_borrowed_limits(cases: &[Case], store: &harness::golden::GoldenStore) {
+    let model = store.root().join(harness::golden::noise::NOISE_FILE);
     if !cases.is_empty() && !model.exists() {
         eprintln!(
             "note: {} does not exist, so no limit is a measured one: each is the built-in \
@@ -420,16 +419,15 @@ fn print_speed(run: &CheckRun) {
     }
     let coverage = harness::golden::speed::coverage(&run.speed.checks);
     if !coverage.is_empty() {
-        println!("what the speed checks catch here (a pass slower than its golden by more than its limit \
-             fails):");
+        println!(
+            "what the speed checks catch here (a pass slower than its golden by more than its \
+             limit fails):"
+        );
         for c in &coverage {
             println!("  {:<12} {}", c.backend.name(), c.describe());
         }
     }
-    if coverage.iter().any(|c| c.tier == Tier::OtherHost) {
-        println!(
-            "note: {}",
-            harness::golden::speed::verdict::RECORD_THIS_HOST
-        );
+    if let Some(advice) = harness::golden::speed::verdict::record_advice(&coverage) {
+        println!("note: {advice}");
     }
 }

@@ -192,14 +192,7 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
         }
         out.push_str("</ul>");
     }
-    if coverage
-        .iter()
-        .any(|c| c.tier == crate::golden::speed::Tier::OtherHost)
-    {
-        let _ = write!(
-            out,
-            "<p class=\"note\">Note: {}.</p>",
-            escape(crate::golden::speed::verdict::RECORD_THIS_HOST)
-        );
+    if let Some(advice) = crate::golden::speed::verdict::record_advice(&coverage) {
+        let _ = write!(out, "<p class=\"note\">Note: {}.</p>", escape(advice));
     }
 }

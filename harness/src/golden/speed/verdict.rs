@@ -292,6 +292,15 @@ pub const RECORD_THIS_HOST: &str = "this host's driver fingerprint and CPU match
     and catch less. `harness noise --timing --record-host NAME` records it \
     (golden/evidence/NAME/timing.toml, to commit); its checks then read against its own ratios";
 
+/// [`RECORD_THIS_HOST`] where some of `coverage` ran at [`Tier::OtherHost`]: the advice every
+/// place that shows the coverage adds under it.
+pub fn record_advice(coverage: &[SpeedCoverage]) -> Option<&'static str> {
+    coverage
+        .iter()
+        .any(|c| c.tier == Tier::OtherHost)
+        .then_some(RECORD_THIS_HOST)
+}
+
 /// Per backend and tier, in the order the checks came: what the speed checks of a run can
 /// catch on this host. Checks without a golden count in neither column (they fail).
 pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
