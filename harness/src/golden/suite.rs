@@ -68,6 +68,19 @@ pub enum SuiteError {
         /// Golden passes of the scene.
         known: String,
     },
+    /// `[tolerances]` gives a float pass a FLIP metric, which compares 8-bit images only.
+    #[error(
+        "{path}: [tolerances.{pass}]: `{metric}` compares 8-bit images, and `{pass}` is a float \
+         pass: use max_abs, fraction_over, rmse, psnr or relative"
+    )]
+    FlipOnFloatPass {
+        /// Scene file.
+        path: PathBuf,
+        /// The pass.
+        pass: TargetId,
+        /// The FLIP metric named.
+        metric: String,
+    },
 }
 
 /// Where a pass's limits came from.
@@ -125,7 +138,7 @@ impl Case {
             .into_iter()
             .filter(|t| pass_kind(*t).is_some())
             .collect();
-        let targets = passes
+        let targets: BTreeMap<TargetId, TargetSpec> = passes
             .iter()
             .filter_map(|p| Some((*p, plan.target(*p)?.clone())))
             .collect();
@@ -143,6 +156,20 @@ impl Case {
                 path: loaded.path.clone(),
                 source,
             })?;
+            if let Some(metric) = rule.flip_metric() {
+                let format = targets.get(&pass).map(|t| t.format);
+                let eight_bit = matches!(
+                    format,
+                    Some(TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb)
+                );
+                if !eight_bit {
+                    return Err(SuiteError::FlipOnFloatPass {
+                        path: loaded.path.clone(),
+                        pass,
+                        metric: metric.to_string(),
+                    });
+                }
+            }
             rules.insert(pass, rule);
             limit_sources.insert(pass, LimitSource::SceneFile);
         }

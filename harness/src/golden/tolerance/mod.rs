@@ -192,6 +192,17 @@ impl Rule {
         }
     }
 
+    /// The first FLIP metric in the rule, if any: FLIP compares 8-bit images only, so such a
+    /// rule cannot judge a float pass.
+    pub fn flip_metric(&self) -> Option<&Metric> {
+        match self {
+            Rule::All(rules) | Rule::Any(rules) => rules.iter().find_map(Rule::flip_metric),
+            Rule::Check { metric, .. } => {
+                matches!(metric, Metric::FlipMean | Metric::FlipPercentile { .. }).then_some(metric)
+            }
+        }
+    }
+
     /// Evaluates the rule on `actual` against `golden`.
     pub fn evaluate(&self, actual: &Image, golden: &Image) -> Result<Verdict, MetricError> {
         let pair = Pair::new(actual, golden)?;

@@ -22,3 +22,49 @@ fn a_scene_outside_scenes_is_named_by_its_path() {
     let outside = Path::new("/tmp/elsewhere/arrow.toml");
     assert_eq!(scene_argument(outside), "/tmp/elsewhere/arrow.toml");
 }
+
+/// arrow.toml, written into `dir` with its assets found in scenes/ and `extra` appended.
+fn arrow_with(dir: &Path, extra: &str) -> std::path::PathBuf {
+    let assets = harness::scenes_dir().join("assets");
+    let text = std::fs::read_to_string(harness::scenes_dir().join("arrow.toml"))
+        .unwrap()
+        .replace("\"assets/", &format!("\"{}/", assets.display()));
+    let path = dir.join("arrow_tolerances.toml");
+    std::fs::write(&path, format!("{text}\n{extra}\n")).unwrap();
+    path
+}
+
+/// A scene file's `[tolerances.<pass>]` replaces the noise model's rule for that pass; a FLIP
+/// metric on a float pass is refused when the scene loads (FLIP compares 8-bit images, so the
+/// rule could only fail later, and only when the images differ), naming the file and the pass.
+#[test]
+fn a_scene_files_tolerances_are_read_and_flip_is_refused_on_a_float_pass() {
+    let dir = tempfile::tempdir().unwrap();
+    let final_flip = arrow_with(
+        dir.path(),
+        "[tolerances.final]\nall = [{ metric = \"flip_mean\", max = 0.01 }]",
+    );
+    let case = Case::load(final_flip.to_str().unwrap()).unwrap();
+    let pass = engine::plan::TargetId::Final;
+    assert_eq!(case.limit_sources[&pass], LimitSource::SceneFile);
+    assert!(case.rules[&pass].flip_metric().is_some());
+
+    let light_flip = arrow_with(
+        dir.path(),
+        "[tolerances.light]\nall = [{ metric = \"rmse\", max = 0.01 }, \
+         { metric = \"flip_percentile\", percentile = 0.99, max = 0.1 }]",
+    );
+    let error = Case::load(light_flip.to_str().unwrap()).err().unwrap();
+    let text = error.to_string();
+    assert!(
+        matches!(error, SuiteError::FlipOnFloatPass { .. }),
+        "{text}"
+    );
+    assert!(
+        text.contains("arrow_tolerances.toml")
+            && text.contains("[tolerances.light]")
+            && text.contains("flip(p99)")
+            && text.contains("float pass"),
+        "{text}"
+    );
+}
