@@ -44,6 +44,6 @@ pub use limits::{Budget, Limits};
 pub use obj::{load_mtl, load_obj, MaterialData, MaterialMaps, Model};
 pub use summary::{EnvironmentSummary, MaterialSummary, MeshSummary, ModelSummary, TextureSummary};
 pub use texture::{
-    generate_mips, generate_mips_f32, linear_to_srgb_u8, load_texture, srgb_to_linear, ColorSpace,
-    TexelFormat, TextureCache, TextureData, TextureId,
+    generate_mips, generate_mips_f32, linear_to_srgb_u8, load_texture, load_texture_with_limits,
+    srgb_to_linear, ColorSpace, TexelFormat, TextureCache, TextureData, TextureId,
 };

@@ -85,14 +85,42 @@ impl TextureData {
 }
 
 /// Decodes an image file and builds its mip chain: RGBA8 for 8-bit files, RGBA16F for 16-bit
-/// ones (see the module docs).
+/// ones (see the module docs), within the default [`Limits`].
 ///
 /// The format is detected from the file contents: PNG, JPEG, TGA or BMP.
 pub fn load_texture(path: &Path, color_space: ColorSpace) -> Result<TextureData, AssetError> {
-    // The format from the contents where they tell it, else from the extension (TGA has no
-    // signature).
+    load_texture_with_limits(path, color_space, Limits::DEFAULT)
+}
+
+/// [`load_texture`] held to `limits`: the image's sides (from its header, before decoding) and
+/// its decoded bytes with mips are checked against them, and the decoder gets no limit of its
+/// own (the `image` crate's default of 512 MiB would refuse a texture the limits allow, without
+/// saying which limit).
+pub fn load_texture_with_limits(
+    path: &Path,
+    color_space: ColorSpace,
+    limits: Limits,
+) -> Result<TextureData, AssetError> {
+    let (width, height, texel_bytes) = header(path)?;
+    let mut budget = Budget::new(limits);
+    budget.check_image(path, width, height)?;
+    budget.reserve(path, decoded_bytes(width, height, texel_bytes))?;
+    decode(path, color_space, limits)
+}
+
+/// Decodes a texture whose header has been checked against `limits`.
+fn decode(path: &Path, color_space: ColorSpace, limits: Limits) -> Result<TextureData, AssetError> {
+    let mut decoder_limits = image::Limits::no_limits();
+    decoder_limits.max_image_width = Some(limits.max_texture_side);
+    decoder_limits.max_image_height = Some(limits.max_texture_side);
+    // The decoder's own buffers on top of the output: a generous multiple, so that only a
+    // file whose decoder misbehaves meets it.
+    decoder_limits.max_alloc = Some(limits.max_total_bytes.saturating_mul(2));
     let bytes = std::fs::read(path).map_err(|e| AssetError::io(path, e))?;
     let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+    reader.limits(decoder_limits);
+    // The format from the contents where they tell it, else from the extension (TGA has no
+    // signature).
     if let Ok(format) = image::ImageFormat::from_path(path) {
         reader.set_format(format);
     }
@@ -358,6 +386,28 @@ pub fn linear_to_srgb_u8(l: f64) -> u8 {
     (s * 255.0 + 0.5).floor().clamp(0.0, 255.0) as u8
 }
 
+/// An image file's size and the bytes per texel it decodes to (RGBA8 or RGBA16F), from its
+/// header only.
+fn header(path: &Path) -> Result<(u32, u32, u64), AssetError> {
+    let decoder = image::ImageReader::open(path)
+        .map_err(|e| AssetError::io(path, e))?
+        .with_guessed_format()
+        .map_err(|e| AssetError::io(path, e))?
+        .into_decoder()
+        .map_err(|source| AssetError::ImageDecode {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    let (width, height) = image::ImageDecoder::dimensions(&decoder);
+    let color = image::ImageDecoder::color_type(&decoder);
+    Ok((width, height, if is_sixteen_bit(color) { 8 } else { 4 }))
+}
+
+/// The bytes a decoded texture takes with its full mip chain (4/3 of level 0).
+fn decoded_bytes(width: u32, height: u32, texel_bytes: u64) -> u64 {
+    u64::from(width) * u64::from(height) * texel_bytes * 4 / 3
+}
+
 /// Deduplicating texture store, keyed by (canonical path, colour space).
 ///
 /// A file referenced by several materials in the same colour space is decoded
@@ -402,28 +452,14 @@ impl TextureCache {
         let id = u32::try_from(self.textures.len())
             .map(TextureId)
             .map_err(|_| AssetError::invalid_image(path, "texture cache is full"))?;
-        // Size and bit depth from the header only, checked and reserved (RGBA8 or RGBA16F with
-        // a full mip chain, 4/3 of level 0) before anything is decoded.
-        let decoder = image::ImageReader::open(path)
-            .map_err(|e| AssetError::io(path, e))?
-            .with_guessed_format()
-            .map_err(|e| AssetError::io(path, e))?
-            .into_decoder()
-            .map_err(|source| AssetError::ImageDecode {
-                path: path.to_path_buf(),
-                source,
-            })?;
-        let (width, height) = image::ImageDecoder::dimensions(&decoder);
-        let color = image::ImageDecoder::color_type(&decoder);
-        let texel_bytes = if is_sixteen_bit(color) { 8 } else { 4 };
-        drop(decoder);
+        // Size and bit depth from the header only, checked and reserved against the whole
+        // load's budget before anything is decoded.
+        let (width, height, texel_bytes) = header(path)?;
         self.budget.check_image(path, width, height)?;
-        self.budget.reserve(
-            path,
-            u64::from(width) * u64::from(height) * texel_bytes * 4 / 3,
-        )?;
+        self.budget
+            .reserve(path, decoded_bytes(width, height, texel_bytes))?;
         self.decodes += 1;
-        let texture = load_texture(path, color_space)?;
+        let texture = decode(path, color_space, self.budget.limits())?;
         log::info!(
             "decoded texture {} ({}x{}, {} mips, {:?}, {:?})",
             path.display(),

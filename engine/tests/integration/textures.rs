@@ -1,7 +1,10 @@
 //! Texture decoding and CPU mip chain correctness.
 
 use crate::common::fixture;
-use engine::assets::{generate_mips, generate_mips_f32, load_texture, ColorSpace, TexelFormat};
+use engine::assets::{
+    generate_mips, generate_mips_f32, load_texture, load_texture_with_limits, ColorSpace, Limits,
+    TexelFormat,
+};
 
 /// R = 16x + 64y, G = 255 - R, B = 7, A = 255 except (3,3) = 0.
 fn ramp() -> Vec<u8> {
@@ -102,6 +105,34 @@ fn texture_errors_name_the_file() {
         e.to_string().contains("absent.png: cannot read file"),
         "{e}"
     );
+}
+
+/// A texture is checked against its limits from its header, before it is decoded, with errors
+/// that name the limit; within them, the decoder adds no limit of its own (the `image` crate's
+/// default of 512 MiB refused a 16384x16384 texture the default limits allow, as "Memory limit
+/// exceeded").
+#[test]
+fn a_texture_over_its_limits_is_refused_naming_the_limit() {
+    let checker = fixture("textures/checker.png");
+    let limits = |side, bytes| Limits {
+        max_texture_side: side,
+        max_total_bytes: bytes,
+        ..Limits::DEFAULT
+    };
+    let e = load_texture_with_limits(&checker, ColorSpace::Srgb, limits(1, u64::MAX)).unwrap_err();
+    assert!(e.to_string().contains("is above the limit of 1"), "{e}");
+    let e = load_texture_with_limits(&checker, ColorSpace::Srgb, limits(16384, 10)).unwrap_err();
+    assert!(
+        e.to_string().contains("total decoded bytes") && e.to_string().contains("limit of 10"),
+        "{e}"
+    );
+    let within = load_texture_with_limits(&checker, ColorSpace::Srgb, Limits::DEFAULT).unwrap();
+    assert_eq!(
+        within.mips,
+        load_texture(&checker, ColorSpace::Srgb).unwrap().mips
+    );
+    let e = load_texture(&fixture("textures/too_wide_16385x1.png"), ColorSpace::Srgb).unwrap_err();
+    assert!(e.to_string().contains("above the limit of 16384"), "{e}");
 }
 
 /// An odd size in sRGB averages in linear light, like the even sizes: 3x1 of 0, 255, 0 gives

@@ -24,6 +24,11 @@ fn inspect_fails_cleanly_on_every_malformed_fixture() {
         ("relative_out_of_range.obj", "relative_out_of_range.obj:"),
         ("corrupt.exr", "corrupt.exr"),
         ("textures/corrupt.png", "corrupt.png"),
+        // A lone texture is held to the default limits, as a scene's are.
+        (
+            "textures/too_wide_16385x1.png",
+            "too_wide_16385x1.png: image side (16385x1) 16385 is above the limit of 16384",
+        ),
         ("missing_texture.mtl", "missing_texture.mtl"),
         ("truncated.hdr", "truncated.hdr"),
     ];
