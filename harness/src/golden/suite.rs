@@ -157,12 +157,7 @@ impl Case {
                 source,
             })?;
             if let Some(metric) = rule.flip_metric() {
-                let format = targets.get(&pass).map(|t| t.format);
-                let eight_bit = matches!(
-                    format,
-                    Some(TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb)
-                );
-                if !eight_bit {
+                if !targets.get(&pass).is_some_and(eight_bit) {
                     return Err(SuiteError::FlipOnFloatPass {
                         path: loaded.path.clone(),
                         pass,
@@ -233,12 +228,7 @@ impl Case {
 
     /// Whether a pass's output is 8-bit (its golden a PNG).
     pub fn is_eight_bit(&self, pass: TargetId) -> bool {
-        self.targets.get(&pass).is_some_and(|t| {
-            matches!(
-                t.format,
-                TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb
-            )
-        })
+        self.targets.get(&pass).is_some_and(eight_bit)
     }
 
     /// Renders the golden passes on a new backend of this kind.
@@ -256,6 +246,14 @@ impl Case {
         let readback = Readback::Only(&self.passes);
         renderer::render_prepared(backend, &self.frame, readback)
     }
+}
+
+/// Whether a target is 8-bit (its golden a PNG, FLIP applicable).
+fn eight_bit(target: &TargetSpec) -> bool {
+    matches!(
+        target.format,
+        TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb
+    )
 }
 
 /// A canonical scene that did not load: one failed case of the run, which goes on with the
