@@ -6,6 +6,7 @@
 pub mod accept;
 pub mod bless;
 pub mod check;
+pub mod command_line;
 pub mod diagnosis;
 pub mod merge;
 pub mod metrics;

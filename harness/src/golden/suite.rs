@@ -12,6 +12,7 @@ use engine::renderer::{self, Frame, PreparedFrame, Readback, RenderError};
 use engine::scene_file::LoadedScene;
 use engine::Image;
 
+pub use crate::golden::command_line::bless_command;
 use crate::golden::noise::{NoiseError, NoiseModel};
 use crate::golden::pass_kind::{pass_kind, rule_shape};
 use crate::golden::tolerance::{Rule, RuleError};
@@ -345,21 +346,6 @@ pub fn scene_argument(path: &Path) -> String {
         Some(stem) if in_scenes_dir => stem.to_owned(),
         _ => path.display().to_string(),
     }
-}
-
-/// The `harness bless` command line that rewrites the goldens of a scene's changed or missing
-/// passes (`scene` as [`Case::argument`] gives it), quoted for a POSIX shell where needed.
-pub fn bless_command(scene: &str) -> String {
-    let plain = !scene.is_empty()
-        && scene
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || "_-./".contains(c));
-    let quoted = if plain {
-        scene.to_owned()
-    } else {
-        format!("'{}'", scene.replace('\'', "'\\''"))
-    };
-    format!("cargo run -p harness -- bless --scene {quoted}")
 }
 
 impl PassCheck {

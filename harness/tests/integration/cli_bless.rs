@@ -199,7 +199,11 @@ fn bless_after_a_light_change_rewrites_only_the_changed_passes() {
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&output.stdout);
-    let suggestion = format!("  cargo run -p harness -- bless --scene {}", copy.display());
+    let suggestion = format!(
+        "  HARNESS_ROOT={} cargo run -p harness -- bless --scene {}",
+        root.path().display(),
+        copy.display()
+    );
     assert!(stdout.lines().any(|l| l == suggestion), "{stdout}");
 }
 

@@ -314,7 +314,11 @@ fn check_reports_failures_with_images_and_the_bless_command() {
     // command in their advice).
     let suggestions: Vec<&str> = stdout
         .lines()
-        .filter(|l| l.trim_start().starts_with("cargo run") && l.contains("harness -- bless"))
+        .filter(|l| {
+            let l = l.trim_start();
+            (l.starts_with("cargo run") || l.starts_with("HARNESS_ROOT="))
+                && l.contains("harness -- bless")
+        })
         .collect();
     let verdict = |pass: &str| {
         stdout
@@ -327,11 +331,12 @@ fn check_reports_failures_with_images_and_the_bless_command() {
             && verdict("light").contains("nothing to compare with"),
         "{stdout}"
     );
-    assert_eq!(
-        suggestions,
-        ["  cargo run -p harness -- bless --scene arrow"],
-        "{stdout}"
+    // It names the workspace the check ran in: pasted without it, it would bless another.
+    let in_this_workspace = format!(
+        "  HARNESS_ROOT={} cargo run -p harness -- bless --scene arrow",
+        root.path().display()
     );
+    assert_eq!(suggestions, [in_this_workspace.as_str()], "{stdout}");
     assert!(line("mask").contains(" ok "), "{stdout}");
     // Under --out, not the workspace's target/.
     let failures = out.join("failures/arrow/gl");
