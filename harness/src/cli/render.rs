@@ -17,8 +17,16 @@ pub(crate) fn run(
     passes: &[String],
     out: Option<PathBuf>,
 ) -> anyhow::Result<ExitCode> {
-    let loaded = harness::load_scene(scene)?;
+    let mut loaded = harness::load_scene(scene)?;
     print_load_warnings(&loaded);
+    // A shadow term is a debug output, planned when asked for (the golden suite always asks).
+    let shadow_term = |name: &String| {
+        name.parse::<TargetId>()
+            .is_ok_and(|t| matches!(t, TargetId::ShadowTerm { .. }))
+    };
+    if passes.iter().any(shadow_term) {
+        loaded.scene.quality.debug_shadow_terms = true;
+    }
     // The scene as drawn and its plan: an extracted sun's light and shadow map are outputs too.
     let prepared = PreparedFrame::new(&loaded.scene)?;
     let (scene, plan) = (prepared.scene(), prepared.plan());

@@ -137,6 +137,28 @@ fn render_writes_every_pass_of_a_scene_file() {
     let (code, _, stderr) = harness(&["render", "--scene", "arrow", "--pass", "shadow"]);
     assert_eq!(code, 1);
     assert!(stderr.contains("no pass output `shadow`"), "{stderr}");
+    // A shadow term, a golden pass that is a debug output of the plan, is planned when asked
+    // for, so a failing shadow_term golden can be rendered again.
+    let term = dir.path().join("term.exr");
+    let (code, stdout, stderr) = harness(&[
+        "render",
+        "--scene",
+        "arrow",
+        "--pass",
+        "shadow_term_0",
+        "--out",
+        term.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    let golden = harness::images::read_exr(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../golden/arrow/shadow_term_0.exr"),
+    )
+    .unwrap();
+    let rendered = harness::images::read_exr(&term).unwrap();
+    assert_eq!(
+        (rendered.width, rendered.height),
+        (golden.width, golden.height)
+    );
 }
 
 /// With `[quality.ibl] extract_sun`, the environment's sun is lit as a shadowed directional
