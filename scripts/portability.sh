@@ -13,11 +13,11 @@
 # After an intended change to the pictures or the metrics, `harness noise --write` re-measures
 # every source and rewrites golden/noise.toml (review its diff like a golden's).
 #
-# HARNESS_PROFILE=dev builds the harness in cargo's dev profile instead of release (CI does, to
-# share the build with `cargo test`).
+# The harness is built in cargo's dev profile (every crate optimised; the build the README's
+# commands and `cargo test` share); HARNESS_PROFILE=release uses the release build instead.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-profile=${HARNESS_PROFILE:-release}
+profile=${HARNESS_PROFILE:-dev}
 case "${1:-}" in
   --cheap) exec cargo run --profile "$profile" -q -p harness -- noise --source cheap ;;
   "") ;;
