@@ -147,7 +147,7 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Mutation self-test: 15 small known changes (light x1.02, exposure x1.03, roughness +0.05,
+    /// Mutation self-test: 16 small known changes (light x1.02, exposure x1.03, roughness +0.05,
     /// shadow bias x4, a G-buffer channel swap, ...) must each fail in the pass where they
     /// originate by at least 3x its limit on every backend, while unchanged renders (every
     /// backend, synthetic rounding, and the sources golden/noise.toml recorded) stay at or
@@ -282,6 +282,7 @@ enum Command {
 const DEFAULT_LOG_FILTER: &str = "warn,wgpu_hal::gles::egl=off";
 
 fn main() -> ExitCode {
+    cli::end_quietly_on_closed_output();
     cli::private_runtime_dir();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(DEFAULT_LOG_FILTER))
         .init();

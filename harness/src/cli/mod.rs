@@ -46,6 +46,35 @@ pub(crate) fn private_runtime_dir() {
     }
 }
 
+/// Ends the process cleanly when its standard output or error cannot be written, instead of
+/// the panic `println!` raises: quietly with status 141 (as a program killed by SIGPIPE) when
+/// the reader went away (`harness check | head`), else with the cause and status 1
+/// (`> /dev/full`). Every other panic goes to the default hook. Runs first in `main`.
+pub(crate) fn end_quietly_on_closed_output() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let message = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        let stream = ["stdout", "stderr"]
+            .into_iter()
+            .find(|s| message.starts_with(&format!("failed printing to {s}: ")));
+        match stream {
+            Some(_) if message.contains("Broken pipe") => std::process::exit(141),
+            Some("stdout") => {
+                let cause = message.trim_start_matches("failed printing to stdout: ");
+                eprintln!("error: cannot write to standard output: {cause}");
+                std::process::exit(1);
+            }
+            Some(_) => std::process::exit(1),
+            None => default(info),
+        }
+    }));
+}
+
 /// The scenes named (every canonical one when none is), each that loads as a case and each that
 /// does not as a broken scene with its error (printed here), so that a run can go on with the
 /// others. Fails only when the noise model cannot be read.

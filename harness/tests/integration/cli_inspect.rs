@@ -114,3 +114,33 @@ fn inspect_lists_a_real_world_models_textures_and_warnings() {
         .iter()
         .any(|w| w.as_str().unwrap().contains("crate.mtl:1: not UTF-8")));
 }
+
+/// Output that cannot be written ends the run without a panic: quietly with status 141 when
+/// the reader went away (`harness inspect ... | head`), with the cause and status 1 on a full
+/// disk.
+#[test]
+fn a_closed_or_full_output_is_not_a_panic() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/chess.toml");
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let closed = common::harness_command()
+        .args(["inspect", scene.to_str().unwrap()])
+        .stdout(writer)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&closed.stderr);
+    assert_eq!(closed.status.code(), Some(141), "{stderr}");
+    assert!(stderr.is_empty(), "{stderr}");
+    let full = common::harness_command()
+        .args(["inspect", scene.to_str().unwrap()])
+        .stdout(std::fs::File::create("/dev/full").unwrap())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&full.stderr);
+    assert_eq!(full.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("error: cannot write to standard output: No space left")
+            && !stderr.contains("panicked"),
+        "{stderr}"
+    );
+}
