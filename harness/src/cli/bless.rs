@@ -25,7 +25,8 @@ pub(crate) struct BlessArgs {
     /// Backend to render the goldens with.
     #[arg(long, default_value = "gl")]
     backend: BackendKind,
-    /// Bless every pass of every canonical scene (required when no --scene is given).
+    /// Bless every canonical scene: the passes that moved beyond their limits or have no golden
+    /// (required when no --scene is given; with --every-pass, every pass).
     #[arg(long)]
     all: bool,
     /// Show what would change without writing anything.

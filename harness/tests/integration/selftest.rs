@@ -165,3 +165,12 @@ fn a_mutation_of_an_extracted_suns_shadow_fails_in_its_shadow_term() {
         bias.ratios
     );
 }
+
+/// `selftest --help` counts the mutations there are.
+#[test]
+fn the_help_counts_the_mutations() {
+    let (code, stdout, _) = common::cli::harness(&["selftest", "--help"]);
+    assert_eq!(code, 0);
+    let count = format!("{} small known changes", Mutation::ALL.len());
+    assert!(stdout.contains(&count), "{stdout}");
+}
