@@ -163,8 +163,8 @@ impl NoiseModel {
         let header = "# The noise model of the golden suite, written by `harness noise --write`.\n\
              # For every scene, golden pass and metric: the largest value measured on unchanged\n\
              # renders per source and backend, the metric's resolution, and the limit the suite\n\
-             # uses: margin x max(largest noise, resolution). See harness/src/golden/noise.rs and the\n\
-             # README's 'Goldens' section.\n\n";
+             # uses: margin x max(largest noise, resolution). See harness/src/golden/noise.rs and\n\
+             # docs/goldens.md.\n\n";
         crate::images::write_atomically(&path, format!("{header}{text}").as_bytes()).map_err(
             |e| NoiseError::File {
                 path: path.clone(),
