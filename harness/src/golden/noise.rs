@@ -180,17 +180,28 @@ impl NoiseModel {
     }
 
     /// The largest limit any scene has for this kind of pass and metric: what a scene without
-    /// figures of its own borrows.
-    pub fn borrowed_limit(&self, pass: TargetId, metric: &str) -> Option<f64> {
+    /// figures of its own borrows, for a pass of `pixels` pixels. A limit on a fraction of
+    /// pixels is borrowed as a number of pixels (its scene's size read from its resolution,
+    /// [`RESOLUTION_PIXELS`] over the pixels): a fraction taken from a smaller image would allow
+    /// more pixels (a 256x256 scene's 30 pixels are 120 of a 512x512 image).
+    pub fn borrowed_limit(&self, pass: TargetId, metric: &str, pixels: usize) -> Option<f64> {
         let kind = pass_kind(pass)?;
+        let in_pixels = metric.starts_with("fraction_over");
         self.scenes
             .values()
             .flat_map(|passes| passes.iter())
             // The file's keys are names (an edge); one that names no target is no pass.
             .filter(|(p, _)| p.parse().ok().and_then(pass_kind) == Some(kind))
             .filter_map(|(_, checks)| checks.get(metric))
-            .map(|f| f.limit)
+            .map(|f| {
+                if in_pixels && f.resolution > 0.0 {
+                    f.limit * RESOLUTION_PIXELS / f.resolution / pixels.max(1) as f64
+                } else {
+                    f.limit
+                }
+            })
             .fold(None, |m: Option<f64>, l| Some(m.map_or(l, |m| m.max(l))))
+            .map(round_up)
     }
 }
 

@@ -170,6 +170,11 @@ impl Case {
             limit_sources.insert(pass, LimitSource::SceneFile);
         }
         let scene = loaded.scene.name.clone();
+        let pass_pixels = |pass| {
+            targets
+                .get(&pass)
+                .map_or(0, |t| t.width as usize * t.height as usize)
+        };
         for &pass in &passes {
             if rules.contains_key(&pass) {
                 continue;
@@ -182,7 +187,7 @@ impl Case {
                     let key = metric.to_string();
                     let limit = match model.figures(&scene, pass, &key) {
                         Some(figures) => figures.limit,
-                        None => match model.borrowed_limit(pass, &key) {
+                        None => match model.borrowed_limit(pass, &key, pass_pixels(pass)) {
                             Some(limit) => {
                                 source = LimitSource::Borrowed;
                                 limit

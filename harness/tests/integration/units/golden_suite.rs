@@ -68,3 +68,23 @@ fn a_scene_files_tolerances_are_read_and_flip_is_refused_on_a_float_pass() {
         "{text}"
     );
 }
+
+/// A scene without figures of its own borrows each pass's largest limit as a number of pixels:
+/// corner's 30 pixels at 256x256 (a fraction of 4.58e-4) are 30 pixels of a 512x512 G-buffer
+/// target (1.15e-4), not 120; chess's light, 147 pixels at 512x512, is the light's largest.
+#[test]
+fn a_borrowed_limit_keeps_its_pixel_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = Case::load(arrow_with(dir.path(), "").to_str().unwrap()).unwrap();
+    let limit = |pass| match &case.rules[&pass] {
+        harness::golden::tolerance::Rule::All(checks) => match &checks[0] {
+            harness::golden::tolerance::Rule::Check { limit, .. } => *limit,
+            other => panic!("{other:?}"),
+        },
+        other => panic!("{other:?}"),
+    };
+    let albedo = engine::plan::TargetId::GBuffer(engine::plan::GBufferTarget::Albedo);
+    assert_eq!(case.limit_sources[&albedo], LimitSource::Borrowed);
+    assert_eq!(limit(albedo), 1.15e-4);
+    assert_eq!(limit(engine::plan::TargetId::Light), 5.61e-4);
+}
