@@ -259,6 +259,10 @@ enum Command {
         /// Only this backend (repeatable). Default: every available one.
         #[arg(long = "backend")]
         backends: Vec<BackendKind>,
+        /// Where to keep the table (hard_cases.json) for the check report (a `harness check`
+        /// with the same --out shows it).
+        #[arg(long, default_value_os_t = default_out_dir())]
+        out: PathBuf,
         /// Print JSON.
         #[arg(long)]
         json: bool,
@@ -359,7 +363,11 @@ fn main() -> ExitCode {
         Command::Plan { scene } => cli::info::plan(&scene),
         Command::Inspect { path, json } => cli::info::inspect(&path, json),
         Command::Scenes => cli::info::scenes(),
-        Command::Hard { backends, json } => cli::hard::run(&backends, json),
+        Command::Hard {
+            backends,
+            out,
+            json,
+        } => cli::hard::run(&backends, &out, json),
         Command::Selftest {
             json,
             speed,

@@ -1,15 +1,14 @@
 //! `harness hard`: the numerical hard cases (far from the origin, tiny and huge scales) on every
 //! backend, kept for the check report.
 
+use std::path::Path;
 use std::process::ExitCode;
 
 use engine::backend::BackendKind;
 
-use super::default_out_dir;
-
 /// Runs the hard cases on the backends asked for (every available one by default), keeps the
-/// table in target/harness/ and prints it; exits 1 when a case fails.
-pub(crate) fn run(backends: &[BackendKind], json: bool) -> anyhow::Result<ExitCode> {
+/// table in `out` (target/harness/ by default) and prints it; exits 1 when a case fails.
+pub(crate) fn run(backends: &[BackendKind], out: &Path, json: bool) -> anyhow::Result<ExitCode> {
     let kinds: Vec<BackendKind> = if backends.is_empty() {
         BackendKind::ALL
             .into_iter()
@@ -36,8 +35,8 @@ pub(crate) fn run(backends: &[BackendKind], json: bool) -> anyhow::Result<ExitCo
         );
     }
     let text = serde_json::to_string_pretty(&rows)?;
-    let path = default_out_dir().join(harness::measure::hard_cases::RESULTS_JSON);
-    match std::fs::create_dir_all(default_out_dir())
+    let path = out.join(harness::measure::hard_cases::RESULTS_JSON);
+    match std::fs::create_dir_all(out)
         .map_err(|e| e.to_string())
         .and_then(|_| {
             harness::images::write_atomically(&path, text.as_bytes()).map_err(|e| e.to_string())
