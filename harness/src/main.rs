@@ -285,6 +285,24 @@ enum Command {
 /// `RUST_LOG=warn` shows the probing again.
 const DEFAULT_LOG_FILTER: &str = "warn,wgpu_hal::gles::egl=off";
 
+impl Command {
+    /// What `harness` with no subcommand runs: `check` of every scene on every backend.
+    fn default_check() -> Command {
+        Command::Check {
+            out: default_out_dir(),
+            scenes: vec![],
+            backends: vec![],
+            passes: vec![],
+            json: false,
+            no_speed: false,
+            no_verify: false,
+            junit: None,
+            summary: None,
+            debug_unspecialised_lighting: false,
+        }
+    }
+}
+
 fn main() -> ExitCode {
     cli::end_quietly_on_closed_output();
     cli::private_runtime_dir();
@@ -292,18 +310,7 @@ fn main() -> ExitCode {
         .init();
     let args = Cli::parse();
     harness::use_ibl_cache();
-    let command = args.command.unwrap_or(Command::Check {
-        out: default_out_dir(),
-        scenes: vec![],
-        backends: vec![],
-        passes: vec![],
-        json: false,
-        no_speed: false,
-        no_verify: false,
-        junit: None,
-        summary: None,
-        debug_unspecialised_lighting: false,
-    });
+    let command = args.command.unwrap_or_else(Command::default_check);
     let result = match command {
         Command::Backends { json } => cli::info::backends(json),
         Command::Check {
