@@ -101,21 +101,39 @@ pub fn load_texture_with_limits(
     color_space: ColorSpace,
     limits: Limits,
 ) -> Result<TextureData, AssetError> {
-    let (width, height, texel_bytes) = header(path)?;
+    let header = header(path)?;
+    let (width, height, texel_bytes) = header;
     let mut budget = Budget::new(limits);
     budget.check_image(path, width, height)?;
     budget.reserve(path, decoded_bytes(width, height, texel_bytes))?;
-    decode(path, color_space, limits)
+    decode(path, color_space, limits, header)
 }
 
 /// Decodes a texture whose header has been checked against `limits`.
-fn decode(path: &Path, color_space: ColorSpace, limits: Limits) -> Result<TextureData, AssetError> {
+fn decode(
+    path: &Path,
+    color_space: ColorSpace,
+    limits: Limits,
+    (width, height, texel_bytes): (u32, u32, u64),
+) -> Result<TextureData, AssetError> {
+    // The decoder allocates its output (at most `texel_bytes` a texel) before reading the
+    // pixels, and an allocation that fails aborts the process: with the limits off, a header
+    // may claim any size, so a size this process cannot allocate is an error here.
+    let output = u64::from(width) * u64::from(height) * texel_bytes;
+    let allocatable = usize::try_from(output)
+        .is_ok_and(|bytes| Vec::<u8>::new().try_reserve_exact(bytes).is_ok());
+    if !allocatable {
+        return Err(AssetError::invalid_image(
+            path,
+            format!("{width}x{height} decodes to {output} bytes, more than can be allocated"),
+        ));
+    }
     let mut decoder_limits = image::Limits::no_limits();
     decoder_limits.max_image_width = Some(limits.max_texture_side);
     decoder_limits.max_image_height = Some(limits.max_texture_side);
-    // The decoder's own buffers on top of the output: a generous multiple, so that only a
-    // file whose decoder misbehaves meets it.
-    decoder_limits.max_alloc = Some(limits.max_total_bytes.saturating_mul(2));
+    // The decoder's own buffers on top of its output: a generous margin, so that only a file
+    // whose decoder misbehaves meets it.
+    decoder_limits.max_alloc = Some(output.saturating_mul(2).saturating_add(64 << 20));
     let bytes = std::fs::read(path).map_err(|e| AssetError::io(path, e))?;
     let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
     reader.limits(decoder_limits);
@@ -454,12 +472,13 @@ impl TextureCache {
             .map_err(|_| AssetError::invalid_image(path, "texture cache is full"))?;
         // Size and bit depth from the header only, checked and reserved against the whole
         // load's budget before anything is decoded.
-        let (width, height, texel_bytes) = header(path)?;
+        let header = header(path)?;
+        let (width, height, texel_bytes) = header;
         self.budget.check_image(path, width, height)?;
         self.budget
             .reserve(path, decoded_bytes(width, height, texel_bytes))?;
         self.decodes += 1;
-        let texture = decode(path, color_space, self.budget.limits())?;
+        let texture = decode(path, color_space, self.budget.limits(), header)?;
         log::info!(
             "decoded texture {} ({}x{}, {} mips, {:?}, {:?})",
             path.display(),

@@ -70,7 +70,8 @@ fn an_image_whose_header_is_too_large_is_refused_before_decoding() {
         message.contains("huge.png") && message.contains("100000x100000"),
         "{message}"
     );
-    // Without limits the decoder itself fails on the missing pixels: an error, not a panic.
+    // Without limits: an error, not an abort (the 40 GB the decoder would allocate are refused
+    // where the process cannot allocate them, else the decoder fails on the missing pixels).
     let error = TextureCache::with_limits(Limits::NONE)
         .load(&path, ColorSpace::Srgb)
         .unwrap_err();
