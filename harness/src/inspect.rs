@@ -273,7 +273,7 @@ pub fn to_text(value: &Value) -> String {
                 );
             }
             for w in m["warnings"].as_array().into_iter().flatten() {
-                line(&mut out, format!("  note: {}", w.as_str().unwrap_or("")));
+                line(&mut out, format!("  warning: {}", w.as_str().unwrap_or("")));
             }
         }
         Some("scene") => {
@@ -315,7 +315,7 @@ pub fn to_text(value: &Value) -> String {
                 ),
             );
             for w in value["warnings"].as_array().into_iter().flatten() {
-                line(&mut out, format!("  note: {}", w.as_str().unwrap_or("")));
+                line(&mut out, format!("  warning: {}", w.as_str().unwrap_or("")));
             }
             out.push_str(value["plan"].as_str().unwrap_or(""));
         }
