@@ -9,7 +9,7 @@ use engine::backend::BackendKind;
 use harness::golden::check::CheckRun;
 use harness::golden::suite::{Case, LimitSource};
 
-use super::load_cases_isolated;
+use super::{default_out_dir, load_cases_isolated};
 
 /// How `check` runs, beyond what it checks.
 pub(crate) struct Options {
@@ -311,6 +311,11 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
         for v in &run.verifications {
             println!("  {}", v.summary());
         }
+        let out = report.parent().filter(|dir| *dir != default_out_dir());
+        println!(
+            "  accept the reproduced ones without rendering: {}",
+            harness::golden::command_line::accept_command(out)
+        );
     }
     print_speed(run);
     let failed = run.results.iter().filter(|r| !r.outcome.passed()).count()
