@@ -93,9 +93,9 @@ pub fn load_texture(path: &Path, color_space: ColorSpace) -> Result<TextureData,
 }
 
 /// [`load_texture`] held to `limits`: the image's sides (from its header, before decoding) and
-/// its decoded bytes with mips are checked against them, and the decoder gets no limit of its
-/// own (the `image` crate's default of 512 MiB would refuse a texture the limits allow, without
-/// saying which limit).
+/// its decoded bytes with mips are checked against them. The decoder's own allocation cap
+/// follows the image's size (the `image` crate's default of 512 MiB would refuse a texture the
+/// limits allow, without saying which limit).
 pub fn load_texture_with_limits(
     path: &Path,
     color_space: ColorSpace,
