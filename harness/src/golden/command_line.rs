@@ -1,11 +1,10 @@
-//! The command lines the harness prints for a user to paste (a bless or an accept after a failing
-//! check),
-//! quoted for a POSIX shell and naming the workspace they were made in.
+//! The command lines the harness prints for a user to paste (a bless or an accept after a
+//! failing check), quoted for a POSIX shell and naming the workspace they were made in.
 
 /// The `harness bless` command line that rewrites the goldens of a scene's changed or missing
-/// passes (`scene` as [`crate::golden::suite::Case::argument`] gives it), quoted for a POSIX shell where needed. In a
-/// workspace named by `HARNESS_ROOT`, the command names it too: pasted without it, it would
-/// bless the checkout the shell stands in.
+/// passes (`scene` as [`crate::golden::suite::Case::argument`] gives it), quoted for a POSIX
+/// shell where needed. In a workspace named by `HARNESS_ROOT`, the command names it too:
+/// pasted without it, it would bless the checkout the shell stands in.
 pub fn bless_command(scene: &str) -> String {
     format!(
         "{}cargo run -p harness -- bless --scene {}",

@@ -180,28 +180,29 @@ impl NoiseModel {
     }
 
     /// The largest limit any scene has for this kind of pass and metric: what a scene without
-    /// figures of its own borrows, for a pass of `pixels` pixels. A limit on a fraction of
-    /// pixels is borrowed as a number of pixels (its scene's size read from its resolution,
-    /// [`RESOLUTION_PIXELS`] over the pixels): a fraction taken from a smaller image would allow
-    /// more pixels (a 256x256 scene's 30 pixels are 120 of a 512x512 image).
-    pub fn borrowed_limit(&self, pass: TargetId, metric: &str, pixels: usize) -> Option<f64> {
+    /// figures of its own borrows, for a pass of `pixels` pixels. Each limit is borrowed as the
+    /// same multiple of the metric's [`resolution`] at the borrowing pass's size: a limit on a
+    /// fraction of pixels keeps its number of pixels (a 256x256 scene's 30 pixels are 30 of a
+    /// 512x512 image, not the same fraction's 120); the other metrics' resolutions do not
+    /// depend on the size, so their limits are borrowed as they are.
+    pub fn borrowed_limit(&self, pass: TargetId, metric: &Metric, pixels: usize) -> Option<f64> {
         let kind = pass_kind(pass)?;
-        let in_pixels = metric.starts_with("fraction_over");
+        let key = metric.to_string();
+        let here = resolution(metric, pixels);
         self.scenes
             .values()
             .flat_map(|passes| passes.iter())
             // The file's keys are names (an edge); one that names no target is no pass.
             .filter(|(p, _)| p.parse().ok().and_then(pass_kind) == Some(kind))
-            .filter_map(|(_, checks)| checks.get(metric))
+            .filter_map(|(_, checks)| checks.get(&key))
             .map(|f| {
-                if in_pixels && f.resolution > 0.0 {
-                    f.limit * RESOLUTION_PIXELS / f.resolution / pixels.max(1) as f64
+                if f.resolution > 0.0 {
+                    f.limit * (here / f.resolution)
                 } else {
                     f.limit
                 }
             })
             .fold(None, |m: Option<f64>, l| Some(m.map_or(l, |m| m.max(l))))
-            .map(round_up)
     }
 }
 

@@ -187,7 +187,7 @@ impl Case {
                     let key = metric.to_string();
                     let limit = match model.figures(&scene, pass, &key) {
                         Some(figures) => figures.limit,
-                        None => match model.borrowed_limit(pass, &key, pass_pixels(pass)) {
+                        None => match model.borrowed_limit(pass, &metric, pass_pixels(pass)) {
                             Some(limit) => {
                                 source = LimitSource::Borrowed;
                                 limit

@@ -87,4 +87,13 @@ fn a_borrowed_limit_keeps_its_pixel_count() {
     assert_eq!(case.limit_sources[&albedo], LimitSource::Borrowed);
     assert_eq!(limit(albedo), 1.15e-4);
     assert_eq!(limit(engine::plan::TargetId::Light), 5.61e-4);
+    // Limits not on pixels are borrowed as they are: ibl's mean FLIP, the largest.
+    let flip = match &case.rules[&engine::plan::TargetId::Final] {
+        harness::golden::tolerance::Rule::All(checks) => checks.clone(),
+        other => panic!("{other:?}"),
+    };
+    assert!(flip.contains(&harness::golden::tolerance::Rule::Check {
+        metric: harness::golden::tolerance::Metric::FlipMean,
+        limit: 0.0208
+    }));
 }
