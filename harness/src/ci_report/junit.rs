@@ -6,7 +6,7 @@ use quick_junit::{NonSuccessKind, Report, TestCase, TestCaseStatus, TestSuite};
 
 use super::{speed_status, Status};
 use crate::golden::check::CheckRun;
-use crate::golden::suite::bless_command;
+use crate::golden::command_line::bless_command;
 
 /// The run as a JUnit XML document.
 pub fn junit(run: &CheckRun) -> Result<String, quick_junit::SerializeError> {

@@ -9,6 +9,7 @@ use engine::plan::{PassId, TargetId};
 use engine::renderer::Frame;
 use engine::Image;
 
+use crate::golden::command_line::bless_command;
 use crate::golden::metrics::Channels;
 use crate::golden::suite::{self, Case, PassCheck};
 use crate::golden::{self, GoldenStore};
@@ -112,7 +113,7 @@ impl CheckRun {
     pub fn bless_commands(&self) -> Vec<String> {
         let mut commands: Vec<String> = Vec::new();
         for r in self.results.iter().filter(|r| !r.outcome.passed()) {
-            let command = suite::bless_command(&r.scene_argument);
+            let command = bless_command(&r.scene_argument);
             if !commands.contains(&command) {
                 commands.push(command);
             }
@@ -123,9 +124,8 @@ impl CheckRun {
                 .iter()
                 .find(|r| r.scene == c.scene)
                 .map_or_else(|| c.scene.clone(), |r| r.scene_argument.clone());
-            let command = format!("{} --speed-only", suite::bless_command(&argument));
-            if !commands.contains(&command) && !commands.contains(&suite::bless_command(&argument))
-            {
+            let command = format!("{} --speed-only", bless_command(&argument));
+            if !commands.contains(&command) && !commands.contains(&bless_command(&argument)) {
                 commands.push(command);
             }
         }

@@ -19,8 +19,9 @@ use engine::backend::BackendKind;
 use engine::plan::{PassId, RenderPlan, TargetId};
 
 use super::check::CrossBackend;
+use super::command_line::bless_command;
 use super::noise::MAX_NOISE_RATIO;
-use super::suite::{bless_command, PassCheck};
+use super::suite::PassCheck;
 
 /// Where a failing output stands in its scene's failure.
 #[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

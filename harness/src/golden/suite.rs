@@ -12,7 +12,7 @@ use engine::renderer::{self, Frame, PreparedFrame, Readback, RenderError};
 use engine::scene_file::LoadedScene;
 use engine::Image;
 
-pub use crate::golden::command_line::bless_command;
+use crate::golden::command_line::bless_command;
 use crate::golden::noise::{NoiseError, NoiseModel};
 use crate::golden::pass_kind::{pass_kind, rule_shape};
 use crate::golden::tolerance::{Rule, RuleError};

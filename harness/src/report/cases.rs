@@ -113,7 +113,9 @@ impl Page<'_> {
             let _ = write!(
                 out,
                 "<p>If the change is intended: {}</p>",
-                bless_html(&crate::golden::suite::bless_command(&first.scene_argument))
+                bless_html(&crate::golden::command_line::bless_command(
+                    &first.scene_argument
+                ))
             );
         }
         for r in results_of(self.run, scene, pass) {

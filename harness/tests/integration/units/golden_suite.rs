@@ -1,6 +1,8 @@
 //! Tests of `harness::golden::suite`.
 
+use harness::golden::command_line::bless_command;
 use harness::golden::suite::*;
+use harness::golden::tolerance::{Metric, Rule};
 use std::path::Path;
 
 #[test]
@@ -77,8 +79,8 @@ fn a_borrowed_limit_keeps_its_pixel_count() {
     let dir = tempfile::tempdir().unwrap();
     let case = Case::load(arrow_with(dir.path(), "").to_str().unwrap()).unwrap();
     let limit = |pass| match &case.rules[&pass] {
-        harness::golden::tolerance::Rule::All(checks) => match &checks[0] {
-            harness::golden::tolerance::Rule::Check { limit, .. } => *limit,
+        Rule::All(checks) => match &checks[0] {
+            Rule::Check { limit, .. } => *limit,
             other => panic!("{other:?}"),
         },
         other => panic!("{other:?}"),
@@ -89,11 +91,11 @@ fn a_borrowed_limit_keeps_its_pixel_count() {
     assert_eq!(limit(engine::plan::TargetId::Light), 5.61e-4);
     // Limits not on pixels are borrowed as they are: ibl's mean FLIP, the largest.
     let flip = match &case.rules[&engine::plan::TargetId::Final] {
-        harness::golden::tolerance::Rule::All(checks) => checks.clone(),
+        Rule::All(checks) => checks.clone(),
         other => panic!("{other:?}"),
     };
-    assert!(flip.contains(&harness::golden::tolerance::Rule::Check {
-        metric: harness::golden::tolerance::Metric::FlipMean,
+    assert!(flip.contains(&Rule::Check {
+        metric: Metric::FlipMean,
         limit: 0.0208
     }));
 }
