@@ -9,7 +9,7 @@
 // shading languages let those be any approximation within thousands of ULP, and they differ
 // by compiler. With Mesa's, a sky pixel was up to 26% off the CPU's lookup
 // (`engine::ibl::cube::sample_equirect`) where the image changes fast, and on one NVIDIA GPU
-// the OpenGL and Vulkan compilers' disagreed with each other by up to 23%
+// the OpenGL and Vulkan compilers' disagreed with each other by up to 8%
 // (docs/2026-11-26-nvidia-gpu.md). Sums, products, quotients and square roots are within a few
 // ULP everywhere; `harness`'s test `the_sky_is_the_cpu_lookup_of_the_environment` holds it.
 
