@@ -58,6 +58,10 @@ pub(crate) struct BlessArgs {
     /// first (the default refuses one that does not reproduce); blessed.toml records it.
     #[arg(long)]
     unverified: bool,
+    /// Why the pictures changed (a sentence, as in a commit message): recorded as `reason` in
+    /// blessed.toml beside each image golden written, so the golden says why it is what it is.
+    #[arg(long, value_name = "TEXT", conflicts_with = "prune")]
+    reason: Option<String>,
 }
 
 /// `harness bless`, by mode: prune, accept from the last check, or render and bless.
@@ -77,6 +81,7 @@ pub(crate) fn command(args: BlessArgs) -> anyhow::Result<ExitCode> {
                 images: !args.speed_only,
                 speed: !args.no_speed,
                 unverified: args.unverified,
+                reason: args.reason.clone(),
             },
         );
     }
@@ -91,6 +96,7 @@ pub(crate) fn command(args: BlessArgs) -> anyhow::Result<ExitCode> {
             images: !args.speed_only,
             speed: !args.no_speed,
             unverified: args.unverified,
+            reason: args.reason,
         },
     )
 }
@@ -107,6 +113,8 @@ pub(crate) struct Options {
     pub speed: bool,
     /// Write new image goldens without verifying that they reproduce.
     pub unverified: bool,
+    /// Why the pictures changed, recorded in blessed.toml.
+    pub reason: Option<String>,
 }
 
 /// Renders each scene asked for on `kind` and rewrites the passes outside tolerance, without a
@@ -271,6 +279,7 @@ fn bless_images(
             every_pass,
             dry_run,
             unverified: options.unverified,
+            reason: options.reason.as_deref(),
         };
         let lock = &locks[case.name()];
         if !dry_run && !options.unverified {
@@ -414,7 +423,11 @@ pub(crate) fn from_last_check(
             &lock,
             case,
             &mine,
-            (dry_run, unverified),
+            accept::AcceptOptions {
+                dry_run,
+                unverified,
+                reason: options.reason.as_deref(),
+            },
             |source| eprintln!("verifying {}'s new goldens under {source} ...", case.name()),
         )
         .map_err(anyhow::Error::msg)?;

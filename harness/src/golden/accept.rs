@@ -127,8 +127,7 @@ pub fn accept(
     case: &Case,
     candidate: &Candidate,
     image: &engine::Image,
-    dry_run: bool,
-    unverified: bool,
+    options: AcceptOptions<'_>,
 ) -> Result<BlessedPass, String> {
     let check = &candidate.check;
     let named = [check.pass];
@@ -143,11 +142,23 @@ pub fn accept(
             // Failed in the check: written even where it would now be within tolerance.
             named: &named,
             every_pass: false,
-            dry_run,
-            unverified,
+            dry_run: options.dry_run,
+            unverified: options.unverified,
+            reason: options.reason,
         },
     )
     .map_err(|e| format!("{}/{} ({}): {e}", check.scene, check.pass, check.backend))
+}
+
+/// How accepted outputs are blessed: what `harness bless --from-last-check` was told.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct AcceptOptions<'a> {
+    /// Decide and print; write nothing.
+    pub dry_run: bool,
+    /// Write without verifying that the outputs reproduce (recorded in blessed.toml).
+    pub unverified: bool,
+    /// Why the pictures changed, recorded in blessed.toml (`--reason`).
+    pub reason: Option<&'a str>,
 }
 
 /// A kept output, as `check` wrote it (PNG for 8-bit passes, EXR for float ones).
@@ -260,7 +271,7 @@ pub struct SceneAcceptance {
 }
 
 /// Accepts `candidates`, failing passes of `case` from the last check, holding the scene's
-/// `lock`: their kept outputs, verified together (unless `unverified` or `dry_run`: by the
+/// `lock`: their kept outputs, verified together (unless `options` say unverified or dry run: by the
 /// check's own verification when it covers them and the scene's inputs are unchanged, which
 /// renders nothing; otherwise now, running `exe`, the harness binary, with `progress` told each
 /// source), then blessed. The one flow of `bless --from-last-check` and `harness review`.
@@ -270,7 +281,7 @@ pub fn accept_scene(
     lock: &SceneLock,
     case: &Case,
     candidates: &[&Candidate],
-    (dry_run, unverified): (bool, bool),
+    options: AcceptOptions<'_>,
     progress: impl FnMut(&str),
 ) -> Result<SceneAcceptance, String> {
     let mut done = SceneAcceptance::default();
@@ -281,7 +292,7 @@ pub fn accept_scene(
             Err(why) => done.refused.push((candidate.check.pass, why)),
         }
     }
-    if !dry_run && !unverified && !kept.is_empty() {
+    if !options.dry_run && !options.unverified && !kept.is_empty() {
         if let Some(recorded) = recorded_verification(store, case, &kept) {
             done.verified_by_check = true;
             done.disagreements = recorded;
@@ -298,7 +309,7 @@ pub fn accept_scene(
         }
     }
     for (candidate, image) in &kept {
-        match accept(store, lock, case, candidate, image, dry_run, unverified) {
+        match accept(store, lock, case, candidate, image, options) {
             Ok(blessed) => done.accepted.push(blessed),
             Err(why) => done.refused.push((candidate.check.pass, why)),
         }

@@ -24,6 +24,8 @@ pub struct BlessRequest<'a> {
     pub dry_run: bool,
     /// Written without verification (recorded in blessed.toml; see [`super::verify`]).
     pub unverified: bool,
+    /// Why the picture changed, recorded in blessed.toml beside each golden written.
+    pub reason: Option<&'a str>,
 }
 
 /// What blessing did to one pass.
@@ -95,6 +97,7 @@ pub fn bless_pass(
                 driver,
                 previous: &change.previous,
                 unverified: request.unverified,
+                reason: request.reason,
             },
         )?)
     };

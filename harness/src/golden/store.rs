@@ -93,6 +93,8 @@ pub struct Provenance<'a> {
     pub previous: &'a str,
     /// Written without verification.
     pub unverified: bool,
+    /// Why the picture changed, as the person blessing said it (`harness bless --reason`).
+    pub reason: Option<&'a str>,
 }
 
 /// The name of a scene folder's lock file.
@@ -157,6 +159,9 @@ pub struct BlessRecord {
     /// (`harness bless --unverified`; see [`crate::golden::verify`]).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub unverified: bool,
+    /// Why the picture changed (`harness bless --reason`), when the person blessing said.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
 }
 
 #[derive(Debug, Default, serde::Serialize, serde::Deserialize)]
@@ -335,6 +340,7 @@ impl GoldenStore {
             driver,
             previous,
             unverified,
+            reason,
         } = provenance;
         let scene = lock.scene();
         if let Some(values) = image.as_f32() {
@@ -365,6 +371,7 @@ impl GoldenStore {
                 driver: driver.to_owned(),
                 previous: previous.to_owned(),
                 unverified,
+                reason: reason.map(str::to_owned),
             },
         );
         self.write_records(lock, records)?;

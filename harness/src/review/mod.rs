@@ -262,7 +262,7 @@ impl Review {
             };
             let exe = std::env::current_exe().map_err(|e| e.to_string());
             let done = exe.and_then(|exe| {
-                accept::accept_scene(&exe, store, &lock, &case, &mine, (false, false), |_| {})
+                accept::accept_scene(&exe, store, &lock, &case, &mine, Default::default(), |_| {})
             });
             match done {
                 Ok(done) if !done.disagreements.is_empty() => {

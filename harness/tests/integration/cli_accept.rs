@@ -59,6 +59,8 @@ fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
                 "arrow",
                 "--pass",
                 pass,
+                "--reason",
+                "arrow's light moved on purpose",
             ])
             .args(["--out", out.to_str().unwrap()])
             .env("HARNESS_ROOT", root.path());
@@ -106,6 +108,10 @@ fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
     };
     let light = &records()["light"];
     assert_eq!(light.backend, engine::backend::BackendKind::Gl);
+    assert_eq!(
+        light.reason.as_deref(),
+        Some("arrow's light moved on purpose")
+    );
     assert!(light.driver.contains("llvmpipe"), "{}", light.driver);
     assert!(
         light

@@ -64,8 +64,9 @@ pub(crate) fn changed_files(
         .collect()
 }
 
-/// `bless --scene chess --pass final` rewrites that golden and chess's blessed.toml, and nothing
-/// else (run against a temporary copy of scenes/ and golden/ through HARNESS_ROOT).
+/// `bless --scene chess --pass final` rewrites that golden and chess's blessed.toml (with the
+/// `--reason` given), and nothing else (run against a temporary copy of scenes/ and golden/
+/// through HARNESS_ROOT).
 #[test]
 fn bless_rewrites_only_the_named_golden() {
     if !common::gl_available() {
@@ -77,7 +78,15 @@ fn bless_rewrites_only_the_named_golden() {
     std::thread::sleep(std::time::Duration::from_millis(20));
     let stdout = bless_in(
         root.path(),
-        &["--scene", "chess", "--pass", "final", "--unverified"],
+        &[
+            "--scene",
+            "chess",
+            "--pass",
+            "final",
+            "--unverified",
+            "--reason",
+            "tone mapping's white point moved",
+        ],
     );
     assert!(
         stdout.contains("chess/final: within tolerance vs old golden"),
@@ -97,6 +106,13 @@ fn bless_rewrites_only_the_named_golden() {
         record.contains("[passes.final]") && record.contains("driver = "),
         "{record}"
     );
+    // `--reason` is recorded beside the golden written, and only there.
+    let records: toml::Value = toml::from_str(&record).unwrap();
+    assert_eq!(
+        records["passes"]["final"]["reason"].as_str(),
+        Some("tone mapping's white point moved")
+    );
+    assert_eq!(record.matches("reason = ").count(), 1, "{record}");
 
     // Without --scene or --all, bless refuses.
     let output = common::harness_command()

@@ -30,6 +30,7 @@ fn a_rewritten_golden_is_decoded_again() {
             driver: "llvmpipe",
             previous: "new",
             unverified: false,
+            reason: None,
         };
         store
             .bless(&lock, TargetId::Light, &image(value), provenance)
@@ -70,6 +71,7 @@ fn bless_writes_the_golden_and_the_record_and_refuses_nan() {
                 driver: "llvmpipe",
                 previous: "new",
                 unverified: false,
+                reason: Some("the sky's \"atan2\" changed"),
             },
         )
         .unwrap();
@@ -84,6 +86,10 @@ fn bless_writes_the_golden_and_the_record_and_refuses_nan() {
     );
     let records = store.records("s").unwrap();
     assert_eq!(records["light"].backend, BackendKind::Gl);
+    assert_eq!(
+        records["light"].reason.as_deref(),
+        Some("the sky's \"atan2\" changed")
+    );
     let bad = Image {
         data: ImageData::F32(vec![f32::NAN, 0.0, 0.0, 1.0]),
         ..image.clone()
@@ -98,6 +104,7 @@ fn bless_writes_the_golden_and_the_record_and_refuses_nan() {
                 driver: "llvmpipe",
                 previous: "new",
                 unverified: false,
+                reason: None,
             },
         )
         .unwrap_err();
