@@ -59,8 +59,9 @@ pub(crate) struct BlessArgs {
     #[arg(long)]
     unverified: bool,
     /// Why the pictures changed (a sentence, as in a commit message): recorded as `reason` in
-    /// blessed.toml beside each image golden written, so the golden says why it is what it is.
-    #[arg(long, value_name = "TEXT", conflicts_with = "prune")]
+    /// blessed.toml beside each image golden written, so the golden says why it is what it is
+    /// (timing goldens record none: refused with --speed-only rather than dropped).
+    #[arg(long, value_name = "TEXT", conflicts_with_all = ["prune", "speed_only"])]
     reason: Option<String>,
 }
 

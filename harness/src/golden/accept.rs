@@ -271,10 +271,10 @@ pub struct SceneAcceptance {
 }
 
 /// Accepts `candidates`, failing passes of `case` from the last check, holding the scene's
-/// `lock`: their kept outputs, verified together (unless `options` say unverified or dry run: by the
-/// check's own verification when it covers them and the scene's inputs are unchanged, which
-/// renders nothing; otherwise now, running `exe`, the harness binary, with `progress` told each
-/// source), then blessed. The one flow of `bless --from-last-check` and `harness review`.
+/// `lock`: their kept outputs, verified together (unless `options` say unverified or dry run:
+/// by the check's own verification when it covers them and the scene's inputs are unchanged,
+/// which renders nothing; otherwise now, running `exe`, the harness binary, with `progress` told
+/// each source), then blessed. The one flow of `bless --from-last-check` and `harness review`.
 pub fn accept_scene(
     exe: &Path,
     store: &GoldenStore,

@@ -121,6 +121,25 @@ fn bless_rewrites_only_the_named_golden() {
         .output()
         .unwrap();
     assert_eq!(output.status.code(), Some(1));
+    // A reason with nothing to record it beside (timing goldens only) is refused, not dropped.
+    let output = common::harness_command()
+        .args([
+            "bless",
+            "--scene",
+            "chess",
+            "--speed-only",
+            "--reason",
+            "slower",
+        ])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&output.stderr).contains("cannot be used with"),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
 }
 
 /// After a change to one light's intensity, `bless --scene arrow` rewrites only the passes that
