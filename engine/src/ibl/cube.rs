@@ -212,27 +212,37 @@ pub fn equirect_uv(d: Vec3) -> (f32, f32) {
 
 /// Bilinear lookup of an equirectangular image (wrapping in u, clamping in v).
 pub fn sample_equirect(image: &EnvironmentImage, d: Vec3) -> [f32; 3] {
+    let mut out = [0.0; 3];
+    for (texel, weight) in equirect_footprint(image, d) {
+        for c in 0..3 {
+            out[c] += texel[c] * weight;
+        }
+    }
+    out
+}
+
+/// The four texels a bilinear lookup of an equirectangular image in direction `d` reads
+/// (wrapping in u, clamping in v), each with its weight: what [`sample_equirect`] sums, for a
+/// caller that needs the texels too (how far a GPU's fixed-point filter weights may move the
+/// result depends on their spread).
+pub fn equirect_footprint(image: &EnvironmentImage, d: Vec3) -> [([f32; 4], f32); 4] {
     let (w, h) = (image.width as i64, image.height as i64);
     let (u, v) = equirect_uv(d);
     let fx = u * w as f32 - 0.5;
     let fy = v * h as f32 - 0.5;
     let (x0, y0) = (floor(fx), floor(fy));
     let (tx, ty) = (fx - x0, fy - y0);
-    let mut out = [0.0; 3];
-    for (dx, dy, wgt) in [
+    [
         (0, 0, (1.0 - tx) * (1.0 - ty)),
         (1, 0, tx * (1.0 - ty)),
         (0, 1, (1.0 - tx) * ty),
         (1, 1, tx * ty),
-    ] {
+    ]
+    .map(|(dx, dy, weight)| {
         let x = (x0 as i64 + dx).rem_euclid(w);
         let y = (y0 as i64 + dy).clamp(0, h - 1);
-        let t = image.texels[(y * w + x) as usize];
-        for c in 0..3 {
-            out[c] += t[c] * wgt;
-        }
-    }
-    out
+        (image.texels[(y * w + x) as usize], weight)
+    })
 }
 
 /// Supersampling of the equirectangular image per cube texel (4 x 4), so that a small bright sun
