@@ -5,13 +5,13 @@
 // towards +X), v = acos(d.y) / pi (north pole at the top row). The environment is rotated about
 // +Y by `rotation` radians before the lookup.
 //
-// The angles come from arithmetic (`atan2_portable`), not from the built-in atan2 and acos: the
-// shading languages let those be any approximation within thousands of ULP, and they differ
-// by compiler. With Mesa's, a sky pixel was up to 26% off the CPU's lookup
-// (`engine::ibl::cube::sample_equirect`) where the image changes fast, and on one NVIDIA GPU
-// the OpenGL and Vulkan compilers' disagreed with each other by up to 8%
-// (docs/2026-11-26-nvidia-gpu.md). Sums, products, quotients and square roots are within a few
-// ULP everywhere; `harness`'s test `the_sky_is_the_cpu_lookup_of_the_environment` holds it.
+// The angles come from arithmetic written out here, not from the built-in atan2 and acos: the
+// shading languages let those be any approximation within thousands of ULP, and they differ by
+// compiler (on one NVIDIA GPU the OpenGL and Vulkan compilers' skies were up to 8% apart:
+// docs/2026-11-26-nvidia-gpu.md). The arithmetic is the approximation Mesa's compiler gives
+// both (NIR's atan2, and acos with Abramowitz and Stegun's asin form), so that llvmpipe's and
+// lavapipe's sky, which the goldens and the other hosts' recorded renders hold, is unchanged,
+// and every other compiler now computes the same sums, products, quotients and roots.
 
 const PI: f32 = 3.14159265358979;
 
@@ -34,31 +34,44 @@ fn vs_fullscreen(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f
     return vec4<f32>(corner * 2.0 - 1.0, 0.0, 1.0);
 }
 
-// atan on [0, 1]: t * P(t^2), least squares on Chebyshev nodes; at most 3.5e-7 rad off in f32.
-fn atan_unit(t: f32) -> f32 {
-    let s = t * t;
-    let p = 0.006842671 * s - 0.033726087;
-    let p1 = (p * s + 0.079811392) * s - 0.132475340;
-    let p2 = (p1 * s + 0.198132168) * s - 0.333183033;
-    return t * (p2 * s + 0.999996635);
+// atan(t) for t >= 0: reduced to [0, 1] and an odd polynomial of degree 11, its terms summed in
+// order (Mesa's NIR atan; about 1e-5 rad off).
+fn atan_positive(t: f32) -> f32 {
+    let x = min(t, 1.0) / max(t, 1.0);
+    let x2 = x * x;
+    let x3 = x2 * x;
+    let x5 = x3 * x2;
+    let x7 = x5 * x2;
+    let x9 = x7 * x2;
+    let x11 = x9 * x2;
+    let p = x * 0.9999793128310355 + x3 * -0.3326756418091246 + x5 * 0.1938924977115610
+        + x7 * -0.1173503194786851 + x9 * 0.0536813784310406 + x11 * -0.0121323213173444;
+    return select(p, 0.5 * PI - p, t > 1.0);
 }
 
-// atan2 from arithmetic alone (see the top of the file).
+// atan2(y, x): on the left half-plane the coordinates turn a quarter clockwise, so that no
+// quotient divides by zero there (Mesa's NIR atan2).
 fn atan2_portable(y: f32, x: f32) -> f32 {
-    let ax = abs(x);
-    let ay = abs(y);
-    let hi = max(ax, ay);
-    var a = atan_unit(select(min(ax, ay) / hi, 0.0, hi == 0.0));
-    a = select(a, 0.5 * PI - a, ay > ax);
-    a = select(a, PI - a, x < 0.0);
-    return select(a, -a, y < 0.0);
+    let flip = x <= 0.0;
+    let s = select(y, abs(x), flip);
+    let t = select(abs(x), y, flip);
+    let rcp_t = 1.0 / t;
+    let tangent = select(abs(s * rcp_t), 1.0, abs(x) == abs(y));
+    let arc = select(0.0, 0.5 * PI, flip) + atan_positive(tangent);
+    return select(arc, -arc, min(y, rcp_t) < 0.0);
+}
+
+// acos(y) = pi/2 - asin(y), asin(a) = pi/2 - sqrt(1 - a) (pi/2 + a (pi/4 - 1 + a (p0 + a p1)))
+// for a = |y| (Mesa's acos coefficients; about 1.6e-4 rad off).
+fn acos_portable(y: f32) -> f32 {
+    let a = abs(y);
+    let p = 0.5 * PI + a * ((0.25 * PI - 1.0) + a * (0.08132463 + a * -0.02363318));
+    let asin_a = 0.5 * PI - sqrt(1.0 - a) * p;
+    return 0.5 * PI - select(asin_a, -asin_a, y < 0.0);
 }
 
 fn equirect_uv(d: vec3<f32>) -> vec2<f32> {
-    // acos(y) = atan2(sqrt(1 - y^2), y), with 1 - y^2 as a product (no cancellation near the
-    // poles, nothing for a compiler to fuse).
-    let y = clamp(d.y, -1.0, 1.0);
-    let polar = atan2_portable(sqrt((1.0 - y) * (1.0 + y)), y);
+    let polar = acos_portable(clamp(d.y, -1.0, 1.0));
     return vec2<f32>(0.5 + atan2_portable(d.x, -d.z) / (2.0 * PI), polar / PI);
 }
 

@@ -226,8 +226,13 @@ pub fn sample_equirect(image: &EnvironmentImage, d: Vec3) -> [f32; 3] {
 /// caller that needs the texels too (how far a GPU's fixed-point filter weights may move the
 /// result depends on their spread).
 pub fn equirect_footprint(image: &EnvironmentImage, d: Vec3) -> [([f32; 4], f32); 4] {
+    equirect_footprint_at(image, equirect_uv(d))
+}
+
+/// [`equirect_footprint`] at texture coordinates `(u, v)` (the skybox computes its own: see
+/// skybox.wgsl).
+pub fn equirect_footprint_at(image: &EnvironmentImage, (u, v): (f32, f32)) -> [([f32; 4], f32); 4] {
     let (w, h) = (image.width as i64, image.height as i64);
-    let (u, v) = equirect_uv(d);
     let fx = u * w as f32 - 0.5;
     let fy = v * h as f32 - 0.5;
     let (x0, y0) = (floor(fx), floor(fy));

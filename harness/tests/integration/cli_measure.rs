@@ -182,7 +182,7 @@ fn noise_measures_sources_and_fails_when_a_golden_moved() {
         "--source",
         "host-b",
         "--scene",
-        "chess",
+        "ibl",
         "--json",
     ]);
     assert_eq!(code, 0, "{stdout}\n{stderr}");
@@ -220,9 +220,9 @@ fn noise_measures_sources_and_fails_when_a_golden_moved() {
     // A golden darkened by 2/255 is no noise: a source fails against it (host-b's recorded
     // renders: the same comparison as a rendering source's, without rendering again).
     let root = common::temp_workspace();
-    darken(&root.path().join("golden/chess/final.png"), 2);
+    darken(&root.path().join("golden/ibl/final.png"), 2);
     let output = common::harness_command()
-        .args(["noise", "--source", "host-b", "--scene", "chess"])
+        .args(["noise", "--source", "host-b", "--scene", "ibl"])
         .env("HARNESS_ROOT", root.path())
         .output()
         .unwrap();
@@ -231,7 +231,7 @@ fn noise_measures_sources_and_fails_when_a_golden_moved() {
     assert!(
         stdout
             .lines()
-            .any(|l| l.starts_with("FAILED: host-b chess final")),
+            .any(|l| l.starts_with("FAILED: host-b ibl final")),
         "{stdout}"
     );
 }

@@ -426,12 +426,12 @@ fn anisotropic_knobs_change_only_the_anisotropic_pixels() {
 }
 
 /// The sky is the environment looked up in each pixel's direction, and on every backend it is
-/// the CPU's bilinear lookup of it (`cube::sample_equirect`, Rust's atan2 and acos, over the
-/// texels as uploaded: clamped to 0..65000 and rounded to fp16) to within what the filter and
-/// the light buffer may round: the weights in fixed point (8 bits each way, as GPUs filter;
-/// llvmpipe weights in f32) and fp16. A shader compiler's own atan2 and acos (Mesa's; NVIDIA's
-/// OpenGL and Vulkan compilers, which disagree with each other) moved the sky by a fraction of
-/// a texel, beyond that, which skybox.wgsl's arithmetic atan2 does not.
+/// the CPU's bilinear lookup of it (`cube::equirect_footprint_at`, at the angles skybox.wgsl
+/// computes, mirrored below; over the texels as uploaded: clamped to 0..65000 and rounded to
+/// fp16) to within what the filter and the light buffer may round: the weights in fixed point
+/// (8 bits each way, as GPUs filter; llvmpipe weights in f32) and fp16. A compiler's own atan2
+/// and acos (NVIDIA's OpenGL and Vulkan compilers disagree with each other, and with Rust's)
+/// moved the sky by a fraction of a texel, beyond that.
 #[test]
 fn the_sky_is_the_cpu_lookup_of_the_environment() {
     harness::use_ibl_cache();
@@ -470,15 +470,16 @@ fn the_sky_is_the_cpu_lookup_of_the_environment() {
                 let far = inverse * glam::DVec4::new(ndc_x, ndc_y, 1.0, 1.0);
                 let d = (far.truncate() / far.w).normalize();
                 let rotated = glam::DVec3::new(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
-                let footprint = engine::ibl::cube::equirect_footprint(&uploaded, rotated.as_vec3());
-                let value = engine::ibl::cube::sample_equirect(&uploaded, rotated.as_vec3());
+                let uv = skybox_uv(rotated.as_vec3());
+                let footprint = engine::ibl::cube::equirect_footprint_at(&uploaded, uv);
                 std::array::from_fn(|k| {
                     let (low, high) = footprint
                         .iter()
                         .fold((f32::MAX, f32::MIN), |(l, h), (t, _)| {
                             (l.min(t[k]), h.max(t[k]))
                         });
-                    let want = (value[k] * scale).min(65000.0);
+                    let value: f32 = footprint.iter().map(|(t, weight)| t[k] * weight).sum();
+                    let want = (value * scale).min(65000.0);
                     (
                         want,
                         (high - low) * scale / 128.0 + want.abs() / 512.0 + 1e-6,
@@ -502,14 +503,57 @@ fn the_sky_is_the_cpu_lookup_of_the_environment() {
                 "{name} on {kind}: {off} pixels off the CPU's lookup by more than the filter's \
                  and fp16's rounding, the worst at {worst:.2} of it"
             );
-            // Measured (2026-11-27): none, the worst at 0.48 of the rounding on llvmpipe and
-            // lavapipe (Mesa 22.3.6 and 25.0.7, every code path) and 0.45 on an NVIDIA H200 (gl,
-            // wgpu-vulkan); with the compilers' atan2 and acos, 55921 (chess) and 6264 (ibl)
-            // pixels, up to 4.3 and 18 times it. The bound is 1 pixel in 10 000.
+            // Measured (2026-11-27): none, the worst at 0.49 of the rounding, on every backend under
+            // Mesa 22.3.6 and 25.0.7 and the SSE4.1 code path. The bound is 1 pixel in 10 000.
             assert!(
                 off <= w * h / 10_000,
                 "{name} on {kind}: the sky is not the environment's lookup: {off} pixels off"
             );
         }
     }
+}
+
+/// skybox.wgsl's `equirect_uv`, in f32 as the shader computes it: Mesa's NIR atan2 and its acos.
+fn skybox_uv(d: glam::Vec3) -> (f32, f32) {
+    use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+    let atan_positive = |t: f32| {
+        let x = t.min(1.0) / t.max(1.0);
+        let x2 = x * x;
+        let (x3, x5) = (x2 * x, x2 * x * x2);
+        let (x7, x9) = (x5 * x2, x5 * x2 * x2);
+        let x11 = x9 * x2;
+        let p = x * 0.999_979_3
+            + x3 * -0.332_675_64
+            + x5 * 0.193_892_5
+            + x7 * -0.117_350_32
+            + x9 * 0.053_681_38
+            + x11 * -0.012_132_321;
+        if t > 1.0 {
+            FRAC_PI_2 - p
+        } else {
+            p
+        }
+    };
+    let atan2 = |y: f32, x: f32| {
+        let flip = x <= 0.0;
+        let (s, t) = if flip { (x.abs(), y) } else { (y, x.abs()) };
+        let rcp_t = 1.0 / t;
+        let tangent = if x.abs() == y.abs() {
+            1.0
+        } else {
+            (s * rcp_t).abs()
+        };
+        let arc = if flip { FRAC_PI_2 } else { 0.0 } + atan_positive(tangent);
+        if y.min(rcp_t) < 0.0 {
+            -arc
+        } else {
+            arc
+        }
+    };
+    let y = d.y.clamp(-1.0, 1.0);
+    let a = y.abs();
+    let p = FRAC_PI_2 + a * ((FRAC_PI_4 - 1.0) + a * (0.081_324_63 + a * -0.023_633_18));
+    let asin_a = FRAC_PI_2 - (1.0 - a).sqrt() * p;
+    let polar = FRAC_PI_2 - if y < 0.0 { -asin_a } else { asin_a };
+    (0.5 + atan2(d.x, -d.z) / (2.0 * PI), polar / PI)
 }
