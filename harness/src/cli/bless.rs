@@ -58,10 +58,10 @@ pub(crate) struct BlessArgs {
     /// first (the default refuses one that does not reproduce); blessed.toml records it.
     #[arg(long)]
     unverified: bool,
-    /// Why the pictures changed (a sentence, as in a commit message): recorded as `reason` in
-    /// blessed.toml beside each image golden written, so the golden says why it is what it is
-    /// (timing goldens record none: refused with --speed-only rather than dropped).
-    #[arg(long, value_name = "TEXT", conflicts_with_all = ["prune", "speed_only"])]
+    /// Why the pictures or the timings changed (a sentence, as in a commit message): recorded as
+    /// `reason` beside each golden written (in blessed.toml for an image, in timing.toml for a
+    /// pass's speed ratio), so the golden says why it is what it is.
+    #[arg(long, value_name = "TEXT", conflicts_with = "prune")]
     reason: Option<String>,
 }
 
@@ -114,7 +114,7 @@ pub(crate) struct Options {
     pub speed: bool,
     /// Write new image goldens without verifying that they reproduce.
     pub unverified: bool,
-    /// Why the pictures changed, recorded in blessed.toml.
+    /// Why the pictures or timings changed, recorded beside each golden written.
     pub reason: Option<String>,
 }
 
@@ -190,8 +190,11 @@ fn bless_speed(
         store.root(),
         &scenes,
         &backends,
-        options.every_pass,
-        options.dry_run,
+        harness::golden::speed::TimingBless {
+            every_pass: options.every_pass,
+            dry_run: options.dry_run,
+            reason: options.reason.as_deref(),
+        },
         |what| eprintln!("{what} ..."),
     )?;
     for line in lines {
@@ -456,7 +459,8 @@ pub(crate) fn from_last_check(
         }
     }
     // The timing goldens, as the check measured them (a probe again would be a new measurement).
-    let timed = accept::accept_all_timings(&store, &timings, dry_run, |path| {
+    let reason = options.reason.as_deref();
+    let timed = accept::accept_all_timings(&store, &timings, dry_run, reason, |path| {
         eprintln!(
             "waiting for another `harness bless` to finish (it holds {})",
             path.display()

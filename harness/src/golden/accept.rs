@@ -196,15 +196,16 @@ pub fn speed_candidates(
 }
 
 /// Records `checks` (all of the locked scene) as its timing goldens: each pass's ratio as the
-/// check measured it (its fastest time and its floor's), the host being this one. Lines saying
-/// what was (or, with `dry_run`, would be) written.
+/// check measured it (its fastest time and its floor's), the host being this one, with `reason`
+/// beside each. Lines saying what was (or, with `dry_run`, would be) written.
 pub fn accept_timings(
     store: &GoldenStore,
     lock: &SceneLock,
     checks: &[crate::golden::speed::SpeedCheck],
     dry_run: bool,
+    reason: Option<&str>,
 ) -> Result<Vec<String>, String> {
-    use crate::golden::speed::TimingGoldens;
+    use crate::golden::speed::{Stamp, TimingGoldens};
     use crate::measure::speed::{PassSpeed, SceneSpeed};
     let scene = lock.scene();
     let mut goldens = TimingGoldens::load(store.root(), scene).map_err(|e| e.to_string())?;
@@ -235,7 +236,13 @@ pub fn accept_timings(
         } else {
             (driver, cpu)
         };
-        goldens.record(&probe, &[c.pass], &host, &cpu, &blessed);
+        let stamp = Stamp {
+            host: &host,
+            cpu: &cpu,
+            blessed: &blessed,
+            reason,
+        };
+        goldens.record(&probe, &[c.pass], &stamp);
         lines.push(format!(
             "{scene}/{} on {} (speed): ratio {:.3} as the check measured it; {}",
             c.pass,
@@ -347,11 +354,13 @@ fn recorded_verification(
 
 /// Accepts `checks` (speed checks of the last check, [`speed_candidates`]) as the timing
 /// goldens, scene by scene under each scene's lock (`on_wait` as for
-/// [`GoldenStore::lock_scene`]): per scene, the lines [`accept_timings`] says, or why not.
+/// [`GoldenStore::lock_scene`]), `reason` beside each: per scene, the lines
+/// [`accept_timings`] says, or why not.
 pub fn accept_all_timings(
     store: &GoldenStore,
     checks: &[crate::golden::speed::SpeedCheck],
     dry_run: bool,
+    reason: Option<&str>,
     on_wait: impl Fn(&Path),
 ) -> Vec<(String, Result<Vec<String>, String>)> {
     let mut scenes: Vec<&str> = checks.iter().map(|c| c.scene.as_str()).collect();
@@ -363,7 +372,7 @@ pub fn accept_all_timings(
             let result = store
                 .lock_scene(scene, &on_wait)
                 .map_err(|e| e.to_string())
-                .and_then(|lock| accept_timings(store, &lock, checks, dry_run));
+                .and_then(|lock| accept_timings(store, &lock, checks, dry_run, reason));
             (scene.to_owned(), result)
         })
         .collect()

@@ -1,13 +1,15 @@
 // The Accept buttons of `harness review` (served pages only; the page written by `check` has
 // none). Each failing row, each scene and the whole run get one; a click posts to /accept with
-// the run's token, and the rows of what was accepted are marked.
+// the run's token and the reason typed above them (recorded beside each golden written, as
+// `harness bless --reason` records it), and the rows of what was accepted are marked.
 (function () {
   const review = window.HARNESS_REVIEW;
   if (!review) return;
   const style = document.createElement('style');
   style.textContent =
     'button.accept{margin-right:.5em} tr.accepted td{background:#e3f4e3}' +
-    ' .accept-bar{margin:.5em 0} .accept-bar button{margin-right:.4em}';
+    ' .accept-bar{margin:.5em 0} .accept-bar button{margin-right:.4em}' +
+    ' .accept-bar input.accept-reason{width:36em;margin:0 .4em .4em 0}';
   document.head.appendChild(style);
 
   // A speed row's pass is a plan pass; the server names an accepted timing `speed <pass>`.
@@ -30,13 +32,22 @@
     }
   }
 
+  // Why the pictures or timings changed: one field for the page, sent with every Accept.
+  const reason = document.createElement('input');
+  reason.type = 'text';
+  reason.className = 'accept-reason';
+  reason.placeholder = 'optional: a sentence, as in a commit message, kept beside each golden';
+  reason.setAttribute('aria-label', 'why it changed');
+
   function accept(filter, button) {
     button.disabled = true;
     button.textContent = 'accepting…';
+    const body = Object.assign({}, filter);
+    if (reason.value.trim()) body.reason = reason.value.trim();
     fetch('/accept', {
       method: 'POST',
       headers: { 'Content-Type': 'application/json', 'X-Harness-Token': review.token },
-      body: JSON.stringify(filter),
+      body: JSON.stringify(body),
     })
       .then((response) => response.json())
       .then((answer) => {
@@ -77,7 +88,9 @@
   if (scenes.length) {
     const bar = document.createElement('div');
     bar.className = 'accept-bar';
-    bar.append('Accept every failing pass of: ');
+    const label = document.createElement('label');
+    label.append('Why it changed: ', reason);
+    bar.append(label, document.createElement('br'), 'Accept every failing pass of: ');
     for (const scene of scenes) {
       const button = document.createElement('button');
       button.className = 'accept-scene';

@@ -57,6 +57,10 @@ pub struct AcceptRequest {
     /// backend given, or every backend).
     #[serde(default)]
     pub speed: bool,
+    /// Why the pictures or timings changed, as the reviewer typed it: recorded beside each
+    /// golden written, as `harness bless --reason` does.
+    #[serde(default)]
+    pub reason: Option<String>,
 }
 
 /// The answer to an accept request.
@@ -205,10 +209,20 @@ impl Review {
     /// Accepts what `ask` names from the last check: verified, then blessed, scene by scene.
     fn accept(&mut self, ask: &AcceptRequest, store: &GoldenStore) -> AcceptAnswer {
         let mut answer = AcceptAnswer::default();
+        // An empty field is no reason.
+        let reason = ask
+            .reason
+            .as_deref()
+            .map(str::trim)
+            .filter(|r| !r.is_empty());
+        let options = accept::AcceptOptions {
+            reason,
+            ..Default::default()
+        };
         if ask.speed {
             let scenes: Vec<String> = ask.scene.iter().cloned().collect();
             let passes: Vec<String> = ask.pass.iter().cloned().collect();
-            self.accept_timings(&scenes, &passes, ask.backend, store, &mut answer);
+            self.accept_timings(&scenes, &passes, ask.backend, reason, store, &mut answer);
             if answer.accepted.is_empty() && answer.refused.is_empty() {
                 let what = format!("{} {}", scenes.join(","), passes.join(","));
                 answer.refused.push((
@@ -262,7 +276,7 @@ impl Review {
             };
             let exe = std::env::current_exe().map_err(|e| e.to_string());
             let done = exe.and_then(|exe| {
-                accept::accept_scene(&exe, store, &lock, &case, &mine, Default::default(), |_| {})
+                accept::accept_scene(&exe, store, &lock, &case, &mine, options, |_| {})
             });
             match done {
                 Ok(done) if !done.disagreements.is_empty() => {
@@ -290,18 +304,19 @@ impl Review {
         }
         // A scene's or the run's Accept takes its timing goldens too, as the check measured.
         if ask.pass.is_none() {
-            self.accept_timings(&scenes, &[], None, store, &mut answer);
+            self.accept_timings(&scenes, &[], None, reason, store, &mut answer);
         }
         answer
     }
 
     /// Accepts the last check's speed checks beyond their limits of `scenes` and `passes` (plan
-    /// passes; all when empty), on `backend` (every one when None).
+    /// passes; all when empty), on `backend` (every one when None), with `reason` beside each.
     fn accept_timings(
         &mut self,
         scenes: &[String],
         passes: &[String],
         backend: Option<BackendKind>,
+        reason: Option<&str>,
         store: &GoldenStore,
         answer: &mut AcceptAnswer,
     ) {
@@ -317,7 +332,7 @@ impl Review {
                 return;
             }
         };
-        for (scene, result) in accept::accept_all_timings(store, &checks, false, |_| {}) {
+        for (scene, result) in accept::accept_all_timings(store, &checks, false, reason, |_| {}) {
             match result {
                 Ok(_) => {
                     for c in checks.iter().filter(|c| c.scene == scene) {

@@ -234,6 +234,8 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
             "arrow",
             "--pass",
             "lighting_pbr",
+            "--reason",
+            "the lighting got slower on purpose",
             "--out",
         ])
         .arg(&out)
@@ -248,11 +250,30 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
             && !stdout.contains("geometry"),
         "{stdout}"
     );
+    // The reason is recorded beside the ratio written, and only there.
+    let reason_of = |pass: &str| {
+        let goldens =
+            harness::golden::speed::TimingGoldens::load(&root.path().join("golden"), "arrow");
+        goldens.unwrap().backends[&engine::backend::BackendKind::Gl].passes
+            [&pass.parse::<engine::plan::PassId>().unwrap()]
+            .reason
+            .clone()
+    };
+    assert_eq!(
+        reason_of("lighting_pbr").as_deref(),
+        Some("the lighting got slower on purpose")
+    );
+    assert_eq!(reason_of("geometry"), None);
     let server = crate::review::Server::start(root.path(), &out);
+    let why = "the G-buffer got slower on purpose";
     if let Some(executable) = crate::report::chromium() {
-        // The speed row's own Accept button, clicked in a browser.
+        // The speed row's own Accept button, clicked in a browser, with a reason typed.
         let mut browser = crate::report::Browser::launch(executable);
         browser.open(&server.url);
+        browser.eval(&format!(
+            "document.querySelector('.accept-bar input.accept-reason').value = {}",
+            serde_json::json!(why)
+        ));
         let row = "tr[data-speed='1'][data-scene=arrow][data-pass=geometry][data-backend=gl]";
         browser.click_on(&format!("{row} button.accept"));
         let marked = browser.eval(&crate::review::wait_for(
@@ -263,7 +284,7 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
         assert_eq!(marked, serde_json::json!("ACCEPTED"));
     } else {
         let answer = server.accept(&serde_json::json!({
-            "scene": "arrow", "pass": "geometry", "backend": "gl", "speed": true
+            "scene": "arrow", "pass": "geometry", "backend": "gl", "speed": true, "reason": why
         }));
         assert_eq!(
             answer,
@@ -271,5 +292,6 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
         );
     }
     drop(server);
+    assert_eq!(reason_of("geometry").as_deref(), Some(why));
     assert_eq!(check(), (Some(0), vec![]));
 }

@@ -121,16 +121,10 @@ fn bless_rewrites_only_the_named_golden() {
         .output()
         .unwrap();
     assert_eq!(output.status.code(), Some(1));
-    // A reason with nothing to record it beside (timing goldens only) is refused, not dropped.
+    // A reason with nothing to record it beside (pruning writes no golden) is refused, not
+    // dropped.
     let output = common::harness_command()
-        .args([
-            "bless",
-            "--scene",
-            "chess",
-            "--speed-only",
-            "--reason",
-            "slower",
-        ])
+        .args(["bless", "--scene", "chess", "--prune", "--reason", "gone"])
         .env("HARNESS_ROOT", root.path())
         .output()
         .unwrap();

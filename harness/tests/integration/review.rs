@@ -1,8 +1,9 @@
 //! `harness review` in a real browser: after a change to the arrow scene's light and a failing
-//! check, the served page's Accept button on the light buffer (gl) blesses what the check kept,
-//! the page marks that row accepted, and the next check passes the light buffer and still fails
-//! the final image; the scene's Accept then takes the rest, and golden/ ends exactly as
-//! `harness bless --scene arrow` leaves it from the same change (the blessing times aside). The
+//! check, the served page's Accept button on the light buffer (gl), with a reason typed once for
+//! the page, blesses what the check kept and records the reason, the page marks that row
+//! accepted, and the next check passes the light buffer and still fails the final image; the
+//! scene's Accept then takes the rest, and golden/ ends exactly as `harness bless --scene arrow
+//! --reason` (the same words) leaves it from the same change (the blessing times aside). The
 //! server runs with rendering forbidden (`HARNESS_NO_RENDER`, which its children inherit): it
 //! accepts on the checks' own verification and renders nothing. Requests without the page's
 //! token, or naming another host, are refused.
@@ -130,8 +131,16 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
     );
     // The same change blessed the usual way, in a second workspace.
     let blessed_root = workspace_with_a_light_change();
+    let reason = "arrow's light brightened on purpose";
     let output = common::harness_command()
-        .args(["bless", "--scene", "arrow", "--no-speed"])
+        .args([
+            "bless",
+            "--scene",
+            "arrow",
+            "--no-speed",
+            "--reason",
+            reason,
+        ])
         .env("HARNESS_ROOT", blessed_root.path())
         .output()
         .unwrap();
@@ -182,6 +191,11 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
         )),
         json!(1)
     );
+    // The reviewer says why, once for the page; each Accept sends it.
+    browser.eval(&format!(
+        "document.querySelector('.accept-bar input.accept-reason').value = {}",
+        json!(reason)
+    ));
     browser.click_on(&format!("{row} button.accept"));
     let marked = browser.eval(&wait_for(
         &format!("document.querySelector('{row}')"),
@@ -206,6 +220,7 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
         .records("arrow")
         .unwrap()["light"];
     assert!(!record.unverified && record.previous.starts_with("CHANGED vs old golden"));
+    assert_eq!(record.reason.as_deref(), Some(reason));
 
     // The scene's Accept (the page is the first check's; the server accepts from the last).
     let scene = ".accept-bar button.accept-scene[data-scene=arrow]";

@@ -74,17 +74,27 @@ impl std::fmt::Display for SpeedBlessed {
     }
 }
 
+/// Which timing goldens a bless rewrites, and what it records beside them.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TimingBless<'a> {
+    /// Every pass, also those within their limit.
+    pub every_pass: bool,
+    /// Decide and print; write nothing.
+    pub dry_run: bool,
+    /// Why the passes written changed (`--reason`), recorded beside each.
+    pub reason: Option<&'a str>,
+}
+
 /// Probes `scenes` (name, command-line argument) on each of `backends` (with its driver
 /// fingerprint) [`BLESS_PROBES`] times in child processes of `exe` and rewrites the timing
 /// goldens under `root` that moved beyond their limit or are missing (every one with
-/// `every_pass`; none with `dry_run`).
+/// `options.every_pass`; none with `options.dry_run`).
 pub fn bless_scenes(
     exe: &std::path::Path,
     root: &std::path::Path,
     scenes: &[(String, String)],
     backends: &[(BackendKind, String)],
-    every_pass: bool,
-    dry_run: bool,
+    options: TimingBless<'_>,
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<SpeedBlessed>, SpeedError> {
     let noise = TimingNoise::load(root)?;
@@ -127,7 +137,7 @@ pub fn bless_scenes(
                     check.outcome,
                     SpeedOutcome::Slower | SpeedOutcome::Faster | SpeedOutcome::MissingGolden
                 );
-                let written = every_pass || moved;
+                let written = options.every_pass || moved;
                 if written {
                     rewrite.push(check.pass);
                 }
@@ -139,8 +149,15 @@ pub fn bless_scenes(
                     written,
                 });
             }
-            if !rewrite.is_empty() && !dry_run {
-                goldens.record(&probe, &rewrite, &host, &super::cpu_signature(), &blessed);
+            if !rewrite.is_empty() && !options.dry_run {
+                let cpu = super::cpu_signature();
+                let stamp = super::Stamp {
+                    host: &host,
+                    cpu: &cpu,
+                    blessed: &blessed,
+                    reason: options.reason,
+                };
+                goldens.record(&probe, &rewrite, &stamp);
                 goldens.save(root, scene)?;
             }
         }

@@ -30,6 +30,23 @@ pub struct PassTiming {
     pub ms: f64,
     /// Its floor's fastest time, ms (information).
     pub floor_ms: f64,
+    /// Why the pass's cost changed, as the person blessing said it (`harness bless --reason`);
+    /// dropped when the pass is recorded again without one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+}
+
+/// Who, where and why a timing bless records ([`TimingGoldens::record`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Stamp<'a> {
+    /// The blessing host's fingerprint ([`super::host_fingerprint`]).
+    pub host: &'a str,
+    /// Its CPU signature ([`super::cpu_signature`]).
+    pub cpu: &'a str,
+    /// UTC time of the bless (RFC 3339).
+    pub blessed: &'a str,
+    /// Why the passes written changed (`--reason`), recorded beside each.
+    pub reason: Option<&'a str>,
 }
 
 /// One backend's timing goldens.
@@ -83,29 +100,21 @@ impl TimingGoldens {
     }
 
     /// Records `probe`'s passes for its backend: every pass (`only` empty) or those in `only`,
-    /// keeping the others' goldens. `host` is the blessing host's fingerprint, `cpu` its CPU
-    /// signature.
-    pub fn record(
-        &mut self,
-        probe: &SceneSpeed,
-        only: &[PassId],
-        host: &str,
-        cpu: &str,
-        blessed: &str,
-    ) {
+    /// keeping the others' goldens, stamped with `stamp` (its reason beside each pass written).
+    pub fn record(&mut self, probe: &SceneSpeed, only: &[PassId], stamp: &Stamp<'_>) {
         let entry = self
             .backends
             .entry(probe.backend)
             .or_insert_with(|| BackendTimings {
-                blessed: blessed.to_owned(),
-                host: host.to_owned(),
-                cpu: cpu.to_owned(),
+                blessed: String::new(),
+                host: String::new(),
+                cpu: String::new(),
                 rounds: probe.rounds,
                 passes: BTreeMap::new(),
             });
-        entry.blessed = blessed.to_owned();
-        entry.host = host.to_owned();
-        entry.cpu = cpu.to_owned();
+        entry.blessed = stamp.blessed.to_owned();
+        entry.host = stamp.host.to_owned();
+        entry.cpu = stamp.cpu.to_owned();
         entry.rounds = probe.rounds;
         for pass in &probe.passes {
             if !only.is_empty() && !only.contains(&pass.pass) {
@@ -124,6 +133,7 @@ impl TimingGoldens {
                     ratio: round(ratio, 4),
                     ms: round(ms, 3),
                     floor_ms: round(floor_ms, 3),
+                    reason: stamp.reason.map(str::to_owned),
                 },
             );
         }

@@ -39,8 +39,8 @@ pub mod verdict;
 
 use engine::backend::BackendKind;
 
-pub use bless::{bless_scenes, median_probe, SpeedBlessed};
-pub use goldens::{BackendTimings, PassTiming, TimingGoldens, TIMING_FILE};
+pub use bless::{bless_scenes, median_probe, SpeedBlessed, TimingBless};
+pub use goldens::{BackendTimings, PassTiming, Stamp, TimingGoldens, TIMING_FILE};
 pub use model::{PassNoise, Tier, TimingNoise, TIMING_NOISE_FILE};
 pub use verdict::{
     check_speed, check_speed_with, coverage, SpeedCheck, SpeedCoverage, SpeedOutcome,

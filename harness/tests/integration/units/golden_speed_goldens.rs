@@ -27,26 +27,36 @@ fn goldens_round_trip_and_a_partial_bless_keeps_the_other_passes() {
         ],
     };
     let mut goldens = TimingGoldens::default();
-    goldens.record(
-        &probe(2.0),
-        &[],
-        "host a",
-        "family 1 model 2 stepping 3",
-        "t0",
-    );
+    let stamp = Stamp {
+        host: "host a",
+        cpu: "family 1 model 2 stepping 3",
+        blessed: "t0",
+        reason: Some("the G-buffer packs normals now"),
+    };
+    goldens.record(&probe(2.0), &[], &stamp);
     goldens.save(dir.path(), "s").unwrap();
     let mut loaded = TimingGoldens::load(dir.path(), "s").unwrap();
     assert_eq!(loaded, goldens);
-    loaded.record(
-        &probe(3.0),
-        &[PassId::ToneMap],
-        "host b",
-        "family 4 model 5 stepping 6",
-        "t1",
+    assert_eq!(
+        loaded.backends[&BackendKind::Gl].passes[&PassId::ToneMap]
+            .reason
+            .as_deref(),
+        Some("the G-buffer packs normals now")
     );
+    let stamp = Stamp {
+        host: "host b",
+        cpu: "family 4 model 5 stepping 6",
+        blessed: "t1",
+        reason: None,
+    };
+    loaded.record(&probe(3.0), &[PassId::ToneMap], &stamp);
     let gl = &loaded.backends[&BackendKind::Gl];
     assert_eq!(gl.passes[&PassId::Geometry].ratio, 2.0);
     assert_eq!(gl.passes[&PassId::ToneMap].ratio, 3.0);
+    // A pass recorded again without a reason drops the old one (it was about the old ratio);
+    // the pass not recorded keeps its own.
+    assert_eq!(gl.passes[&PassId::ToneMap].reason, None);
+    assert!(gl.passes[&PassId::Geometry].reason.is_some());
     assert_eq!(gl.host, "host b");
     assert_eq!(gl.cpu, "family 4 model 5 stepping 6");
     assert!(gl.blessed_on("host b", "family 4 model 5 stepping 6"));

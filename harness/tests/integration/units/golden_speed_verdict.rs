@@ -53,7 +53,7 @@ fn model() -> TimingNoise {
 fn a_slower_pass_fails_a_faster_one_is_a_note_and_noise_decides_what_is_timed() {
     // Tone mapping takes 3 ms (its floor 0.5 ms), geometry 4 ms (its floor 1 ms).
     let mut goldens = TimingGoldens::default();
-    goldens.record(&probe(3.0, 4.0), &[], "here", &cpu_signature(), "t");
+    goldens.record(&probe(3.0, 4.0), &[], &stamp("here", &cpu_signature()));
     let noise = model();
     let verdict = |p: &SceneSpeed, host: &str, pass: PassId| {
         check_speed(p, &goldens, &noise, host)
@@ -99,7 +99,7 @@ fn a_slower_pass_fails_a_faster_one_is_a_note_and_noise_decides_what_is_timed() 
     );
     // A short pass (under 2 ms) has a noise floor of 1.3: limit 1.69 even here.
     let mut short_goldens = TimingGoldens::default();
-    short_goldens.record(&probe(1.0, 4.0), &[], "here", &cpu_signature(), "t");
+    short_goldens.record(&probe(1.0, 4.0), &[], &stamp("here", &cpu_signature()));
     let short_pass = |ms: f64| {
         check_speed(&probe(ms, 4.0), &short_goldens, &noise, "here")
             .into_iter()
@@ -126,7 +126,7 @@ fn a_recorded_host_is_checked_against_its_own_recording_while_it_is_current() {
     use std::collections::BTreeMap;
     // The goldens: tone mapping 6, geometry 4 (blessed "there").
     let mut goldens = TimingGoldens::default();
-    goldens.record(&probe(3.0, 4.0), &[], "there", &cpu_signature(), "t");
+    goldens.record(&probe(3.0, 4.0), &[], &stamp("there", &cpu_signature()));
     let recorded = |golden: f64, runs: &[f64], busy: &[f64]| RecordedPass {
         ratios: BTreeMap::from([
             ("runs".to_owned(), runs.to_vec()),
@@ -234,7 +234,7 @@ fn the_blessing_host_is_its_fingerprint_and_its_cpu() {
     let noise = model();
     let tier = |cpu: &str| {
         let mut goldens = TimingGoldens::default();
-        goldens.record(&probe(3.0, 4.0), &[], "here", cpu, "t");
+        goldens.record(&probe(3.0, 4.0), &[], &stamp("here", cpu));
         check_speed(&probe(3.0, 4.0), &goldens, &noise, "here")[0].tier
     };
     assert_eq!(tier(&cpu_signature()), Tier::SameHost);
@@ -301,4 +301,14 @@ fn coverage_counts_the_timed_and_untimed_passes_per_backend_and_tier() {
         "0 passes timed on a host that did not bless; 1 untimed"
     );
     assert!(coverage(&[]).is_empty());
+}
+
+/// A timing bless's stamp at time "t", without a reason.
+fn stamp<'a>(host: &'a str, cpu: &'a str) -> harness::golden::speed::Stamp<'a> {
+    harness::golden::speed::Stamp {
+        host,
+        cpu,
+        blessed: "t",
+        reason: None,
+    }
 }
