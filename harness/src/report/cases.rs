@@ -118,6 +118,9 @@ impl Page<'_> {
                 ))
             );
         }
+        if golden_image.is_some() {
+            self.golden_record(out, scene, pass);
+        }
         for r in results_of(self.run, scene, pass) {
             self.result_line(out, r);
             if r.outcome.passed() {
@@ -126,6 +129,35 @@ impl Page<'_> {
             self.comparison(out, blobs, r, golden_image.as_ref(), &mut golden_blob);
         }
         out.push_str("</section>");
+    }
+
+    /// What blessed.toml says of the pass's golden: when, from which backend and driver, whether
+    /// it was verified, and why it changed when the person blessing said (`bless --reason`).
+    fn golden_record(&self, out: &mut String, scene: &str, pass: TargetId) {
+        let Ok(records) = self.store.records(scene) else {
+            return;
+        };
+        let Some(record) = records.get(&pass.to_string()) else {
+            return;
+        };
+        let _ = write!(
+            out,
+            "<p class=\"golden-record\">The golden: blessed {} from {} ({}){}",
+            escape(&record.blessed),
+            escape(record.backend.name()),
+            escape(&record.driver),
+            if record.unverified {
+                ", unverified"
+            } else {
+                ""
+            }
+        );
+        match &record.reason {
+            Some(reason) => {
+                let _ = write!(out, ", because: <q>{}</q></p>", escape(reason));
+            }
+            None => out.push_str("; no reason recorded.</p>"),
+        }
     }
 
     /// One backend's result: its verdict, checks and the files the run wrote.

@@ -243,6 +243,17 @@ fn check_reports_failures_with_images_and_the_bless_command() {
     // Darken the golden final image of `arrow` by 3/255: a change the tolerance must catch.
     darken(&root.path().join("golden/arrow/final.png"), 3);
     std::fs::remove_file(root.path().join("golden/arrow/light.exr")).unwrap();
+    // The golden's record says why it was blessed (as `bless --reason` writes it): the page
+    // quotes it, escaped.
+    let records = root.path().join("golden/arrow/blessed.toml");
+    let text = std::fs::read_to_string(&records).unwrap();
+    assert!(text.contains("[passes.final]\n"), "{text}");
+    let text = text.replacen(
+        "[passes.final]\n",
+        "[passes.final]\nreason = \"the <b>tone curve</b> moved\"\n",
+        1,
+    );
+    std::fs::write(&records, text).unwrap();
     let out = root.path().join("out");
     let output = common::harness_command()
         .args([
@@ -351,6 +362,21 @@ fn check_reports_failures_with_images_and_the_bless_command() {
     assert!(!root.path().join("target/harness/failures").exists());
     let report = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(report.contains("data:image/png;base64,") && report.contains("FAILED"));
+    // Only final's failing case has a golden to say it of (light's was removed).
+    let records: Vec<&str> = report
+        .split("<p class=\"golden-record\">")
+        .skip(1)
+        .filter_map(|rest| rest.split("</p>").next())
+        .collect();
+    let [record] = records[..] else {
+        panic!("one golden record expected: {records:?}");
+    };
+    assert!(
+        record.starts_with("The golden: blessed ")
+            && record.contains(" from gl (")
+            && record.ends_with(", because: <q>the &lt;b&gt;tone curve&lt;/b&gt; moved</q>"),
+        "{record}"
+    );
 }
 
 /// Per pixel, in row order, the largest absolute channel difference of two 8-bit images (in
