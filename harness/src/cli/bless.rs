@@ -467,8 +467,12 @@ pub(crate) fn from_last_check(
         );
     });
     for (_, lines) in timed {
-        for line in lines.map_err(anyhow::Error::msg)? {
-            println!("{line}");
+        match lines {
+            Ok(lines) => lines.iter().for_each(|line| println!("{line}")),
+            Err(why) => {
+                refused += 1;
+                println!("REFUSED {why}");
+            }
         }
     }
     Ok(if refused == 0 {

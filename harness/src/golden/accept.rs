@@ -196,8 +196,12 @@ pub fn speed_candidates(
 }
 
 /// Records `checks` (all of the locked scene) as its timing goldens: each pass's ratio as the
-/// check measured it (its fastest time and its floor's), the host being this one, with `reason`
-/// beside each. Lines saying what was (or, with `dry_run`, would be) written.
+/// check measured it (its fastest time and its floor's), with `reason` beside each. Lines saying
+/// what was (or, with `dry_run`, would be) written; or, writing nothing, why not: a check on a
+/// host that did not bless the backend's timing goldens measured another host's ratio (one
+/// backend's goldens are one host's, see [`crate::golden::speed::kept_as_another_hosts`]), and
+/// a backend without timing goldens gets its first from a bless's three probes, not from one
+/// check.
 pub fn accept_timings(
     store: &GoldenStore,
     lock: &SceneLock,
@@ -205,13 +209,39 @@ pub fn accept_timings(
     dry_run: bool,
     reason: Option<&str>,
 ) -> Result<Vec<String>, String> {
-    use crate::golden::speed::{Stamp, TimingGoldens};
+    use crate::golden::speed::{Stamp, Tier, TimingGoldens};
     use crate::measure::speed::{PassSpeed, SceneSpeed};
     let scene = lock.scene();
     let mut goldens = TimingGoldens::load(store.root(), scene).map_err(|e| e.to_string())?;
     let blessed = humantime::format_rfc3339_seconds(SystemTime::now()).to_string();
+    let mine: Vec<_> = checks.iter().filter(|c| c.scene == scene).collect();
+    let bless =
+        |c: &crate::golden::speed::SpeedCheck| crate::golden::command_line::bless_command(&c.scene);
+    for c in &mine {
+        let Some(section) = goldens.backends.get(&c.backend) else {
+            return Err(format!(
+                "{scene} on {} (speed): no timing goldens there yet, and one check's probe is \
+                 not one: bless them with `{} --speed-only`",
+                c.backend,
+                bless(c)
+            ));
+        };
+        if c.tier != Tier::SameHost {
+            return Err(format!(
+                "{scene}/{} on {} (speed): the check ran on a host that did not bless {}'s \
+                 timing goldens (blessed {}), and a backend's timing goldens are one host's \
+                 ratios; nothing written. To move them all to this host: `{} --speed-only \
+                 --every-pass`",
+                c.pass,
+                c.backend,
+                c.backend,
+                section.blessed,
+                bless(c)
+            ));
+        }
+    }
     let mut lines = Vec::new();
-    for c in checks.iter().filter(|c| c.scene == scene) {
+    for c in mine {
         // The check's figures as a probe of one sample: its fastest time over its floor's.
         let probe = SceneSpeed {
             scene: scene.to_owned(),
@@ -223,19 +253,12 @@ pub fn accept_timings(
                 floor_ms: vec![c.ms / c.ratio],
             }],
         };
-        let (driver, cpu) = goldens
+        // This host blessed the section (the check's tier says so): its host stays.
+        let (host, cpu) = goldens
             .backends
             .get(&c.backend)
             .map(|b| (b.host.clone(), b.cpu.clone()))
             .unwrap_or_default();
-        let (host, cpu) = if driver.is_empty() {
-            (
-                crate::golden::speed::host_fingerprint(c.backend.name()),
-                crate::golden::speed::cpu_signature(),
-            )
-        } else {
-            (driver, cpu)
-        };
         let stamp = Stamp {
             host: &host,
             cpu: &cpu,

@@ -136,3 +136,23 @@ pub fn ibl_with_extracted_sun(dir: &std::path::Path, name: &str) -> std::path::P
     std::fs::write(&path, text).unwrap();
     path
 }
+
+/// Makes this host the one that blessed `scene`'s timing goldens on `kind` in the workspace
+/// `root` (its fingerprint and CPU signature written into the backend's section of
+/// timing.toml, the ratios left as they are): a test that accepts a timing golden from a check
+/// needs the check to run on the blessing host, since a backend's timing goldens are one
+/// host's and another host's accept is refused.
+pub fn bless_timings_here(root: &std::path::Path, scene: &str, kind: BackendKind) {
+    use harness::golden::speed::{cpu_signature, host_fingerprint, TimingGoldens};
+    let info = backend::probe(kind).info.expect("the backend is available");
+    let host = host_fingerprint(&harness::golden::fingerprint(&info));
+    let golden = root.join("golden");
+    let mut goldens = TimingGoldens::load(&golden, scene).unwrap();
+    let section = goldens
+        .backends
+        .get_mut(&kind)
+        .expect("timing goldens there");
+    section.host = host;
+    section.cpu = cpu_signature();
+    goldens.save(&golden, scene).unwrap();
+}

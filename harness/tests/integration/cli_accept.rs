@@ -159,8 +159,10 @@ fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
     );
 }
 
-/// The timing goldens are accepted from the last check too: arrow's geometry and lighting
-/// goldens on gl divided by 3 make the check fail those passes' speed checks (SLOWER); `bless
+/// The timing goldens are accepted from the last check too, on the host that blessed them
+/// (this one is made so; another host's accept is refused, see `units::golden_accept`): arrow's
+/// geometry and lighting goldens on gl divided by 3 make the check fail those passes' speed
+/// checks (SLOWER); `bless
 /// --from-last-check --speed-only --pass lighting_pbr` records the ratio the check measured,
 /// without probing again, and so does the review page's Accept on the geometry pass's speed row
 /// (clicked in Chromium, or posted as the page would without it; rendering forbidden); the next
@@ -171,6 +173,7 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
         return;
     }
     let root = common::temp_workspace();
+    common::bless_timings_here(root.path(), "arrow", engine::backend::BackendKind::Gl);
     let timing = root.path().join("golden/arrow/timing.toml");
     let mut goldens: toml::Table = std::fs::read_to_string(&timing).unwrap().parse().unwrap();
     for pass in ["geometry", "lighting_pbr"] {

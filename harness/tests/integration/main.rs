@@ -16,6 +16,7 @@ mod backends;
 mod cli_accept;
 mod cli_bless;
 mod cli_check;
+mod cli_check_shards;
 mod cli_inspect;
 mod cli_measure;
 mod cli_render;

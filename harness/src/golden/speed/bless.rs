@@ -9,8 +9,8 @@ use engine::backend::BackendKind;
 use engine::plan::PassId;
 
 use super::{
-    check_speed, host_fingerprint, SpeedError, SpeedOutcome, TimingGoldens, TimingNoise,
-    BLESS_PROBES, CHECK_ROUNDS,
+    check_speed, host_fingerprint, BackendTimings, SpeedError, SpeedOutcome, TimingGoldens,
+    TimingNoise, BLESS_PROBES, CHECK_ROUNDS,
 };
 use crate::measure::speed::{PassSpeed, SceneSpeed};
 
@@ -45,33 +45,84 @@ pub fn median_probe(probes: &[SceneSpeed]) -> Option<SceneSpeed> {
     })
 }
 
-/// One line of a timing bless: a pass, its check against the old golden, and whether it was
-/// (or in a dry run would be) written.
+/// One line of a timing bless: a pass (or every pass of a scene on a backend), its check
+/// against the old golden or why its goldens are kept, and what became of it.
 pub struct SpeedBlessed {
     /// Scene.
     pub scene: String,
     /// Backend.
     pub backend: BackendKind,
-    /// Pass.
-    pub pass: PassId,
-    /// The new ratio against the old golden.
+    /// The pass; None for a line about every pass of the scene on the backend.
+    pub pass: Option<PassId>,
+    /// The new ratio against the old golden, or why the goldens are kept.
     pub previous: String,
-    /// Whether it is rewritten.
-    pub written: bool,
+    /// What became of the golden.
+    pub fate: Fate,
+}
+
+/// What a timing bless did, or in a dry run would do, with a golden.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fate {
+    /// Written.
+    Rewritten,
+    /// Would be written (a dry run).
+    WouldBeRewritten,
+    /// Left as it was.
+    Kept,
+}
+
+impl std::fmt::Display for Fate {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Fate::Rewritten => "rewritten",
+            Fate::WouldBeRewritten => "would be rewritten (dry run)",
+            Fate::Kept => "kept",
+        })
+    }
 }
 
 impl std::fmt::Display for SpeedBlessed {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "{}/{} on {} (speed): {}; {}",
-            self.scene,
-            self.pass,
-            self.backend,
-            self.previous,
-            if self.written { "rewritten" } else { "kept" }
-        )
+        match self.pass {
+            Some(pass) => write!(
+                f,
+                "{}/{pass} on {} (speed): {}; {}",
+                self.scene, self.backend, self.previous, self.fate
+            ),
+            // A line about a whole backend says what became of it first: the why is long.
+            None => write!(
+                f,
+                "{} on {} (speed): {}: {}",
+                self.scene, self.backend, self.fate, self.previous
+            ),
+        }
     }
+}
+
+/// Why a bless on this host (fingerprint `host`, CPU signature `cpu`) keeps the timing goldens
+/// `existing` of a scene (its command-line `argument`) on one backend as they are, or None when
+/// it may rewrite them: where there are none yet, where this host blessed them, or where every
+/// pass is asked for (the backend's goldens then move to this host whole). A backend's goldens
+/// are one host's ratios: another CPU puts a pass x0.4 to x1.75 away, so a few passes blessed
+/// here among another host's would be judged against the wrong host's figures.
+pub fn kept_as_another_hosts(
+    existing: Option<&BackendTimings>,
+    host: &str,
+    cpu: &str,
+    every_pass: bool,
+    argument: &str,
+) -> Option<String> {
+    let existing = existing?;
+    if every_pass || existing.blessed_on(host, cpu) {
+        return None;
+    }
+    Some(format!(
+        "blessed on another host ({}); a backend's timing goldens are one host's ratios, so \
+         none is rewritten from here. To move them all to this host: {} --speed-only \
+         --every-pass",
+        existing.blessed,
+        crate::golden::command_line::bless_command(argument)
+    ))
 }
 
 /// Which timing goldens a bless rewrites, and what it records beside them.
@@ -98,11 +149,36 @@ pub fn bless_scenes(
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<SpeedBlessed>, SpeedError> {
     let noise = TimingNoise::load(root)?;
-    let arguments: Vec<String> = scenes.iter().map(|(_, a)| a.clone()).collect();
     let blessed = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string();
+    let cpu = super::cpu_signature();
+    let fate = if options.dry_run {
+        Fate::WouldBeRewritten
+    } else {
+        Fate::Rewritten
+    };
     let mut lines = Vec::new();
     for (kind, driver) in backends {
         let host = host_fingerprint(driver);
+        // Decided before probing: a backend whose goldens are all another host's is not probed.
+        let mut writable = Vec::new();
+        for (scene, argument) in scenes {
+            let goldens = TimingGoldens::load(root, scene)?;
+            let existing = goldens.backends.get(kind);
+            match kept_as_another_hosts(existing, &host, &cpu, options.every_pass, argument) {
+                Some(why) => lines.push(SpeedBlessed {
+                    scene: scene.clone(),
+                    backend: *kind,
+                    pass: None,
+                    previous: why,
+                    fate: Fate::Kept,
+                }),
+                None => writable.push((scene.clone(), argument.clone())),
+            }
+        }
+        if writable.is_empty() {
+            continue;
+        }
+        let arguments: Vec<String> = writable.iter().map(|(_, a)| a.clone()).collect();
         let mut probes: BTreeMap<String, Vec<SceneSpeed>> = BTreeMap::new();
         for round in 1..=BLESS_PROBES {
             progress(&format!(
@@ -123,7 +199,7 @@ pub fn bless_scenes(
                 probes.entry(result.scene.clone()).or_default().push(result);
             }
         }
-        for (scene, _) in scenes {
+        for (scene, _) in &writable {
             let Some(probe) = probes.get(scene).and_then(|p| median_probe(p)) else {
                 return Err(SpeedError::Probe(format!(
                     "{kind}: scene {scene} was not probed"
@@ -144,13 +220,17 @@ pub fn bless_scenes(
                 lines.push(SpeedBlessed {
                     scene: scene.clone(),
                     backend: *kind,
-                    pass: check.pass,
+                    pass: Some(check.pass),
                     previous: check.describe(),
-                    written,
+                    fate: if written { fate } else { Fate::Kept },
                 });
             }
             if !rewrite.is_empty() && !options.dry_run {
-                let cpu = super::cpu_signature();
+                if options.every_pass {
+                    // Every pass is this probe's: none of another host's (or of a pass gone
+                    // from the plan) stays beside them.
+                    goldens.backends.remove(kind);
+                }
                 let stamp = super::Stamp {
                     host: &host,
                     cpu: &cpu,

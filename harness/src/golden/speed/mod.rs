@@ -39,7 +39,9 @@ pub mod verdict;
 
 use engine::backend::BackendKind;
 
-pub use bless::{bless_scenes, median_probe, SpeedBlessed, TimingBless};
+pub use bless::{
+    bless_scenes, kept_as_another_hosts, median_probe, Fate, SpeedBlessed, TimingBless,
+};
 pub use goldens::{BackendTimings, PassTiming, Stamp, TimingGoldens, TIMING_FILE};
 pub use model::{PassNoise, Tier, TimingNoise, TIMING_NOISE_FILE};
 pub use verdict::{

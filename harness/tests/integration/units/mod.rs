@@ -7,6 +7,7 @@
 //! test from being written where it would never run.
 
 mod faults;
+mod golden_accept;
 mod golden_check;
 mod golden_diagnosis;
 mod golden_metrics;

@@ -1,0 +1,179 @@
+//! `check` split into shards (`--scene` per job, each with its own `--out`) and joined by
+//! `report --merge`: one run equal to the unsharded check.
+
+use crate::common;
+
+/// Shards: `check --scene` on three "jobs" (arrow after a light change, corner, ibl), each with
+/// its own `--out`, joined by `report --merge` into one run that equals the unsharded check of
+/// the three scenes (its results, verdicts, verification of arrow's new outputs and
+/// cross-backend comparisons, its JUnit file and its summary, with the GPU times and the output
+/// folders' names aside); one page; a
+/// last-check.json whose failure images resolve into the shards (accepting from it works); a
+/// scene checked in two shards, or a shard given twice, is refused.
+#[test]
+fn sharded_checks_merge_into_one_report() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    let scene = root.path().join("scenes/arrow.toml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(&scene, text.replace("intensity = 2.5", "intensity = 3.0")).unwrap();
+    let run = |args: &[&str]| {
+        let output = common::harness_command()
+            .args(args)
+            .env("HARNESS_ROOT", root.path())
+            .output()
+            .unwrap();
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&output.stdout),
+            String::from_utf8_lossy(&output.stderr)
+        );
+        (output.status.code(), text)
+    };
+    // A shard's check; `verify` as a job would (the default), or not (`--no-verify`).
+    let shard_with = |scene: &str, name: &str, verify: bool| {
+        let out = root.path().join(name);
+        let args = [
+            "check",
+            "--no-speed",
+            "--backend",
+            "gl",
+            "--scene",
+            scene,
+            "--out",
+        ];
+        let no_verify: &[&str] = if verify { &[] } else { &["--no-verify"] };
+        let (code, text) = run(&[&args[..], &[out.to_str().unwrap()], no_verify].concat());
+        (code, text, out)
+    };
+    let shard = |scene: &str, name: &str| shard_with(scene, name, true);
+    let (code, _, arrow) = shard("arrow", "shard-arrow");
+    assert_eq!(code, Some(1));
+    let (code, _, corner) = shard("corner", "shard-corner");
+    assert_eq!(code, Some(0));
+    let (code, _, ibl) = shard("ibl", "shard-ibl");
+    assert_eq!(code, Some(0));
+    let merged = root.path().join("merged");
+    let junit = merged.join("junit.xml");
+    let (code, text) = run(&[
+        "report",
+        "--merge",
+        arrow.to_str().unwrap(),
+        corner.to_str().unwrap(),
+        ibl.to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+        "--junit",
+        junit.to_str().unwrap(),
+        "--summary",
+        merged.join("summary.md").to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(1), "{text}");
+    let whole = root.path().join("unsharded");
+    let (code, whole_text) = run(&[
+        "check",
+        "--no-speed",
+        "--backend",
+        "gl",
+        "--scene",
+        "arrow",
+        "--scene",
+        "corner",
+        "--scene",
+        "ibl",
+        "--out",
+        whole.to_str().unwrap(),
+        "--junit",
+        whole.join("junit.xml").to_str().unwrap(),
+        "--summary",
+        whole.join("summary.md").to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(1), "{whole_text}");
+    // The verified section says how to accept from this check's folder (not the default one).
+    let accept = format!("bless --from-last-check --out {}", whole.display());
+    assert!(whole_text.contains(&accept), "{whole_text}");
+    let shards = [&arrow, &corner, &ibl];
+    let comparable = |dir: &std::path::Path, file: &str| {
+        let mut text = std::fs::read_to_string(dir.join(file)).unwrap();
+        if file == "last-check.json" {
+            let mut run: serde_json::Value = serde_json::from_str(&text).unwrap();
+            run.as_object_mut().unwrap().remove("timings");
+            text = serde_json::to_string_pretty(&run).unwrap();
+        }
+        for out in shards.iter().copied().chain([&whole, &merged]) {
+            text = text.replace(out.to_str().unwrap(), "OUT");
+        }
+        without_attributes(&text, &["time", "timestamp"])
+    };
+    for file in ["last-check.json", "junit.xml", "summary.md"] {
+        assert_eq!(
+            comparable(&merged, file),
+            comparable(&whole, file),
+            "the merged {file} differs from the unsharded one"
+        );
+    }
+    let joined: harness::golden::check::CheckRun =
+        serde_json::from_slice(&std::fs::read(merged.join("last-check.json")).unwrap()).unwrap();
+    let verified: Vec<&str> = joined
+        .verifications
+        .iter()
+        .map(|v| v.scene.as_str())
+        .collect();
+    assert_eq!(verified, ["arrow"]);
+    let report =
+        quick_junit::Report::deserialize_from_str(&std::fs::read_to_string(&junit).unwrap())
+            .unwrap();
+    let suites: Vec<&str> = report.test_suites.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(suites, ["arrow", "corner", "ibl"]);
+    let lines = text.lines().filter(|l| {
+        ["arrow ", "corner ", "ibl "]
+            .iter()
+            .any(|s| l.starts_with(s))
+    });
+    assert_eq!(report.tests, lines.count(), "{text}");
+    assert_eq!(report.failures, 2, "{text}");
+    let page = std::fs::read_to_string(merged.join("report.html")).unwrap();
+    assert!(page.contains("data-scene=\"corner\"") && page.contains("id=\"case-arrow-light\""));
+    let (code, text) = run(&[
+        "bless",
+        "--from-last-check",
+        "--unverified",
+        "--scene",
+        "arrow",
+        "--pass",
+        "light",
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0), "{text}");
+    assert!(
+        text.contains("arrow/light: CHANGED vs old golden"),
+        "{text}"
+    );
+
+    // Only there to overlap: not verified.
+    let (_, _, again) = shard_with("arrow", "shard-arrow-again", false);
+    let twice = [arrow.to_str().unwrap(), again.to_str().unwrap()];
+    let (code, text) = run(&[&["report", "--merge"][..], &twice].concat());
+    assert_eq!(code, Some(1), "{text}");
+    assert!(text.contains("in two shards"), "{text}");
+    let (code, text) = run(&["report", "--merge", twice[0], twice[0]]);
+    assert_eq!(code, Some(1), "{text}");
+    assert!(text.contains("given twice"), "{text}");
+}
+
+/// `xml` without the attributes named (` name="..."`): JUnit's times, which no two runs share.
+fn without_attributes(xml: &str, names: &[&str]) -> String {
+    let mut out = xml.to_owned();
+    for name in names {
+        let marker = format!(" {name}=\"");
+        while let Some(start) = out.find(&marker) {
+            let value = start + marker.len();
+            let end = value + out[value..].find('"').unwrap() + 1;
+            out.replace_range(start..end, "");
+        }
+    }
+    out
+}
