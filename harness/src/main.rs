@@ -39,7 +39,7 @@ enum Command {
         /// Only these scenes (canonical names or scene files; repeatable).
         #[arg(long = "scene")]
         scenes: Vec<String>,
-        /// Only this backend (repeatable). Default: every available one.
+        /// Only this backend: gl, wgpu-vulkan or wgpu-gl (repeatable). Default: every available one.
         #[arg(long = "backend")]
         backends: Vec<BackendKind>,
         /// Only these golden passes' image checks (repeatable; the renders run only what they
@@ -157,8 +157,8 @@ enum Command {
         #[arg(long)]
         json: bool,
         /// The speed self-test instead: each pass slowed down x1.5 and x2 in turn must fail
-        /// its own speed check and no other (run it on the host that blessed the timing
-        /// goldens).
+        /// its own speed check and no other (run it on a host that blessed the timing goldens
+        /// or is recorded in golden/evidence/: elsewhere most passes are untimed).
         #[arg(long)]
         speed: bool,
         /// With --speed: only these scenes (repeatable).
@@ -214,7 +214,7 @@ enum Command {
         /// Only these scenes (canonical names or scene files; repeatable).
         #[arg(long = "scene")]
         scenes: Vec<String>,
-        /// Only this backend (repeatable). Default: every available one.
+        /// Only this backend: gl, wgpu-vulkan or wgpu-gl (repeatable). Default: every available one.
         #[arg(long = "backend")]
         backends: Vec<BackendKind>,
         /// Frames timed per scene and backend, after one warm-up frame [default: 5, or 21 per
@@ -256,7 +256,7 @@ enum Command {
     /// 0.001/1000) on every available backend: no NaN/Inf, the light buffer in range, and each
     /// case's own check. Prints the table, keeps it for the check report, exits 1 on a failure.
     Hard {
-        /// Only this backend (repeatable). Default: every available one.
+        /// Only this backend: gl, wgpu-vulkan or wgpu-gl (repeatable). Default: every available one.
         #[arg(long = "backend")]
         backends: Vec<BackendKind>,
         /// Where to keep the table (hard_cases.json) for the check report (a `harness check`

@@ -189,20 +189,61 @@ fn check_object(object: &Object, texture_count: usize) -> Result<(), String> {
 
 /// Light `i`: finite parameters, and shadow settings its type supports.
 fn check_light(i: usize, light: &Light) -> Result<(), String> {
-    let ok = match light {
+    if let Some(problem) = light_value_problem(light) {
+        return Err(format!("light {i}: {problem}"));
+    }
+    if let Some(problem) = light.shadow_problem() {
+        return Err(format!("light {i}: {problem}"));
+    }
+    Ok(())
+}
+
+/// The first of a light's values that is out of range, named as in the scene file with the
+/// value read (a number beyond f32's range reads as infinite).
+fn light_value_problem(light: &Light) -> Option<String> {
+    let finite = |name: &str, value: f64| {
+        (!value.is_finite()).then(|| {
+            let beyond = if value.is_nan() {
+                ""
+            } else {
+                " (beyond f32's range, about 3.4e38)"
+            };
+            format!("{name} must be a finite number, not {value}{beyond}")
+        })
+    };
+    let finite_all = |name: &str, values: &[f64]| {
+        values
+            .iter()
+            .find_map(|&v| finite(name, v))
+            .map(|problem| format!("{problem} in {values:?}"))
+    };
+    let positive = |name: &str, value: f32| {
+        finite(name, value.into())
+            .or_else(|| (value <= 0.0).then(|| format!("{name} must be positive, not {value}")))
+    };
+    let widen = |c: &[f32; 3]| c.map(f64::from);
+    match light {
         Light::Directional {
             direction,
             color,
             intensity,
             angular_radius,
             ..
-        } => {
-            direction.is_finite()
-                && direction.length() > 1e-12
-                && color.iter().all(|c| c.is_finite())
-                && intensity.is_finite()
-                && (0.0..1.5).contains(angular_radius)
-        }
+        } => finite_all("direction", &direction.to_array())
+            .or_else(|| {
+                (direction.length() <= 1e-12)
+                    .then(|| format!("direction must not be zero, not {:?}", direction.to_array()))
+            })
+            .or_else(|| finite_all("color", &widen(color)))
+            .or_else(|| finite("intensity", (*intensity).into()))
+            .or_else(|| {
+                (!(0.0..1.5).contains(angular_radius)).then(|| {
+                    format!(
+                        "angular_radius must be at least 0 and under 1.5 (radians), not \
+                         {angular_radius}"
+                    )
+                })
+            }),
         Light::Point {
             position,
             color,
@@ -210,26 +251,12 @@ fn check_light(i: usize, light: &Light) -> Result<(), String> {
             radius,
             falloff,
             ..
-        } => {
-            position.is_finite()
-                && color.iter().all(|c| c.is_finite())
-                && intensity.is_finite()
-                && *radius > 0.0
-                && radius.is_finite()
-                && *falloff > 0.0
-                && falloff.is_finite()
-        }
-    };
-    if !ok {
-        return Err(format!(
-            "light {i}: parameters must be finite, with a non-zero direction, and radius and \
-             falloff positive"
-        ));
+        } => finite_all("position", &position.to_array())
+            .or_else(|| finite_all("color", &widen(color)))
+            .or_else(|| finite("intensity", (*intensity).into()))
+            .or_else(|| positive("radius", *radius))
+            .or_else(|| positive("falloff", *falloff)),
     }
-    if let Some(problem) = light.shadow_problem() {
-        return Err(format!("light {i}: {problem}"));
-    }
-    Ok(())
 }
 
 /// The IBL settings, and the environment's intensity, rotation and image.

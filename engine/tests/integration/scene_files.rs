@@ -261,6 +261,34 @@ fn bad_values_and_missing_assets_are_errors_naming_the_file() {
     )
     .to_string();
     assert!(e.contains("nan.toml") && e.contains("finite"), "{e}");
+    // A light's value out of range is named, with the value read (1e39 is beyond f32's range).
+    for (body, problem) in [
+        (
+            "type = \"directional\"\ndirection = [0, 1, 0]\nintensity = nan",
+            "light 0: intensity must be a finite number, not NaN",
+        ),
+        (
+            "type = \"directional\"\ndirection = [0, 1, 0]\nintensity = 1e39",
+            "light 0: intensity must be a finite number, not inf (beyond f32's range",
+        ),
+        (
+            "type = \"directional\"\ndirection = [0, 0, 0]",
+            "light 0: direction must not be zero, not [0.0, 0.0, 0.0]",
+        ),
+        (
+            "type = \"point\"\nposition = [0, 0, 0]\nradius = 0",
+            "light 0: radius must be positive, not 0",
+        ),
+        (
+            "type = \"point\"\nposition = [0, inf, 0]\nradius = 1",
+            "light 0: position must be a finite number, not inf (beyond f32's range, about \
+             3.4e38) in [0.0, inf, 0.0]",
+        ),
+    ] {
+        let text = format!("{CAMERA}[[lights]]\n{body}\n");
+        let e = load_error(dir, "light.toml", &text).to_string();
+        assert!(e.contains("light.toml") && e.contains(problem), "{e}");
+    }
     let bias =
         "[[lights]]\ntype = \"directional\"\ndirection = [0, 1, 0]\nshadow = { bias = -1.0 }\n";
     let e = load_error(dir, "bias.toml", &format!("{CAMERA}{bias}")).to_string();

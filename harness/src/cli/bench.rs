@@ -298,7 +298,7 @@ pub(crate) struct SpeedArgs {
     /// Only these scenes (canonical names or scene files; repeatable).
     #[arg(long = "scene")]
     pub scenes: Vec<String>,
-    /// Only this backend (repeatable). Default: every available one.
+    /// Only this backend: gl, wgpu-vulkan or wgpu-gl (repeatable). Default: every available one.
     #[arg(long = "backend")]
     pub backends: Vec<BackendKind>,
     /// The most rounds per scene and backend (a pass stops once it has settled).

@@ -27,7 +27,7 @@ pub(crate) struct BlessArgs {
     backend: BackendKind,
     /// Bless every canonical scene: the passes that moved beyond their limits or have no golden
     /// (required when no --scene is given; with --every-pass, every pass).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "scenes")]
     all: bool,
     /// Show what would change without writing anything.
     #[arg(long)]

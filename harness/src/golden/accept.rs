@@ -31,6 +31,64 @@ pub enum AcceptError {
         /// What went wrong.
         message: String,
     },
+    /// The request names what the last check did not check (a typo, or another check's).
+    #[error("the last check did not check {what} (it checked {checked}); nothing accepted")]
+    NotChecked {
+        /// The scene, pass or backend named.
+        what: String,
+        /// What it did check, of that kind.
+        checked: String,
+    },
+}
+
+/// Refuses a request naming a backend, scene or pass the last check `run` did not check, so a
+/// typo is an error rather than "nothing to accept". `backend` None: any (timing goldens);
+/// a pass may be an output (`final`) or a plan pass (`lighting_pbr`, for the speed checks).
+fn check_request(
+    run: &CheckRun,
+    backend: Option<BackendKind>,
+    scenes: &[String],
+    passes: &[String],
+) -> Result<(), AcceptError> {
+    fn listed<T: ToString>(items: impl Iterator<Item = T>) -> String {
+        let mut names: Vec<String> = items.map(|i| i.to_string()).collect();
+        names.sort();
+        names.dedup();
+        if names.is_empty() {
+            "nothing".to_owned()
+        } else {
+            names.join(", ")
+        }
+    }
+    let not_checked = |what: String, checked: String| AcceptError::NotChecked { what, checked };
+    if let Some(backend) = backend {
+        if !run.results.iter().any(|r| r.backend == backend) {
+            let checked = listed(run.results.iter().map(|r| r.backend.name()));
+            return Err(not_checked(format!("backend {backend}"), checked));
+        }
+    }
+    for scene in scenes {
+        let known = run
+            .results
+            .iter()
+            .any(|r| &r.scene == scene || &r.scene_argument == scene)
+            || run.speed.checks.iter().any(|c| &c.scene == scene);
+        if !known {
+            let checked = listed(run.results.iter().map(|r| &r.scene));
+            return Err(not_checked(format!("scene {scene}"), checked));
+        }
+    }
+    for pass in passes {
+        let known = run.results.iter().any(|r| &r.pass.to_string() == pass)
+            || run.speed.checks.iter().any(|c| &c.pass.to_string() == pass);
+        if !known {
+            let outputs = run.results.iter().map(|r| r.pass.to_string());
+            let plan = run.speed.checks.iter().map(|c| c.pass.to_string());
+            let checked = listed(outputs.chain(plan));
+            return Err(not_checked(format!("a pass named {pass}"), checked));
+        }
+    }
+    Ok(())
 }
 
 /// One failing pass of the last check, to accept.
@@ -69,6 +127,7 @@ pub fn candidates(
     passes: &[String],
 ) -> Result<Vec<Candidate>, AcceptError> {
     let (run, checked_at) = last_check(out)?;
+    check_request(&run, Some(backend), scenes, passes)?;
     let driver = run
         .backends
         .iter()
@@ -180,6 +239,7 @@ pub fn speed_candidates(
 ) -> Result<Vec<crate::golden::speed::SpeedCheck>, AcceptError> {
     use crate::golden::speed::SpeedOutcome;
     let (run, _) = last_check(out)?;
+    check_request(&run, None, scenes, passes)?;
     Ok(run
         .speed
         .checks

@@ -82,6 +82,8 @@ fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
     assert_eq!(check(false), (Some(1), light_final.clone()));
     let golden = root.path().join("golden");
     let before = snapshot(&golden);
+    refuses_what_the_check_did_not_check(root.path(), &out);
+    assert_eq!(snapshot(&golden), before);
     std::thread::sleep(std::time::Duration::from_millis(20));
     let (code, stdout) = accept("light", false, false);
     assert_eq!(code, Some(0), "{stdout}");
@@ -157,6 +159,38 @@ fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
             && stdout.contains("changed after the last check"),
         "{stdout}"
     );
+}
+
+/// A typo, or what the last check (arrow on gl, under `out`) did not check, is an error naming
+/// it, not "nothing to accept".
+fn refuses_what_the_check_did_not_check(root: &std::path::Path, out: &std::path::Path) {
+    for (flag, value, why) in [
+        (
+            "--pass",
+            "finall",
+            "did not check a pass named finall (it checked ",
+        ),
+        (
+            "--backend",
+            "wgpu-gl",
+            "did not check backend wgpu-gl (it checked gl)",
+        ),
+        (
+            "--scene",
+            "chess",
+            "did not check scene chess (it checked arrow)",
+        ),
+    ] {
+        let output = common::harness_command()
+            .args(["bless", "--from-last-check", flag, value, "--out"])
+            .arg(out)
+            .env("HARNESS_ROOT", root)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{flag} {value}: {stderr}");
+        assert!(stderr.contains(why), "{flag} {value}: {stderr}");
+    }
 }
 
 /// The timing goldens are accepted from the last check too, on the host that blessed them
