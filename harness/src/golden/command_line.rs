@@ -1,5 +1,6 @@
 //! The command lines the harness prints for a user to paste (a bless or an accept after a
-//! failing check), quoted for a POSIX shell and naming the workspace they were made in.
+//! failing check), quoted for a POSIX shell, naming the workspace they were made in and run
+//! the way this process was run (through cargo, or the executable itself).
 
 /// The `harness bless` command line that rewrites the goldens of a scene's changed or missing
 /// passes (`scene` as [`crate::golden::suite::Case::argument`] gives it), quoted for a POSIX
@@ -7,8 +8,9 @@
 /// pasted without it, it would bless the checkout the shell stands in.
 pub fn bless_command(scene: &str) -> String {
     format!(
-        "{}cargo run -p harness -- bless --scene {}",
+        "{}{} bless --scene {}",
         workspace(),
+        harness(),
         shell_quote(scene)
     )
 }
@@ -20,9 +22,27 @@ pub fn accept_command(out: Option<&std::path::Path>) -> String {
     let out = out.map_or(String::new(), |dir| {
         format!(" --out {}", shell_quote(&dir.to_string_lossy()))
     });
-    format!(
-        "{}cargo run -p harness -- bless --from-last-check{out}",
-        workspace()
+    format!("{}{} bless --from-last-check{out}", workspace(), harness())
+}
+
+/// The harness as this process was started: `cargo run -p harness --` under cargo (which sets
+/// `CARGO_PKG_NAME` for what it runs: `cargo run`, `cargo test` and their children; with
+/// `--release` where this executable is a release build), else the executable as it was
+/// invoked (`target/release/harness`, or `harness` found on the PATH). A suggestion that
+/// named cargo to someone running a release binary would start a second, dev-profile build.
+fn harness() -> String {
+    if std::env::var("CARGO_PKG_NAME").is_ok_and(|name| name == "harness") {
+        let release = std::env::current_exe()
+            .is_ok_and(|exe| exe.components().any(|c| c.as_os_str() == "release"));
+        return if release {
+            "cargo run --release -p harness --".to_owned()
+        } else {
+            "cargo run -p harness --".to_owned()
+        };
+    }
+    std::env::args_os().next().map_or_else(
+        || "harness".to_owned(),
+        |argv0| shell_quote(&argv0.to_string_lossy()),
     )
 }
 

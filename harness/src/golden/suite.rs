@@ -220,7 +220,8 @@ impl Case {
     }
 
     /// How to name this scene on the command line: its file stem when it lives in scenes/ (so
-    /// `--scene arrow` finds it again), otherwise the path it was loaded from.
+    /// `--scene arrow` finds it again), otherwise the absolute path it was loaded from (a
+    /// command printed for pasting then works from any folder).
     pub fn argument(&self) -> String {
         scene_argument(&self.loaded.path)
     }
@@ -340,7 +341,7 @@ pub struct PassCheck {
 }
 
 /// How to name the scene file at `path` on the command line: its file stem when it lives in
-/// scenes/, otherwise the path.
+/// scenes/, otherwise its absolute path.
 pub fn scene_argument(path: &Path) -> String {
     let in_scenes_dir = path
         .parent()
@@ -349,7 +350,10 @@ pub fn scene_argument(path: &Path) -> String {
         .is_some_and(|(dir, scenes)| dir == scenes);
     match path.file_stem().and_then(|s| s.to_str()) {
         Some(stem) if in_scenes_dir => stem.to_owned(),
-        _ => path.display().to_string(),
+        _ => std::path::absolute(path)
+            .unwrap_or_else(|_| path.to_owned())
+            .display()
+            .to_string(),
     }
 }
 

@@ -227,7 +227,10 @@ fn ci_formats_name_the_failures(out: &std::path::Path, stdout: &str) {
     assert!(
         failing.contains("| arrow | final | gl | FAILED | **origin: the tonemap pass")
             && failing.contains("| arrow | light | gl | MISSING | **nothing to compare with**")
-            && failing.contains("cargo run -p harness -- bless --scene arrow"),
+            && failing.contains(&format!(
+                "{} bless --scene arrow",
+                env!("CARGO_BIN_EXE_harness")
+            )),
         "{summary}"
     );
 }
@@ -270,6 +273,8 @@ fn check_reports_failures_with_images_and_the_bless_command() {
             out.join("summary.md").to_str().unwrap(),
         ])
         .env("HARNESS_ROOT", root.path())
+        // Run as the executable itself, not through cargo: the commands it prints say so.
+        .env_remove("CARGO_PKG_NAME")
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&output.stdout);
@@ -327,8 +332,7 @@ fn check_reports_failures_with_images_and_the_bless_command() {
         .lines()
         .filter(|l| {
             let l = l.trim_start();
-            (l.starts_with("cargo run") || l.starts_with("HARNESS_ROOT="))
-                && l.contains("harness -- bless")
+            l.starts_with("HARNESS_ROOT=") && l.contains(" bless --scene ")
         })
         .collect();
     let verdict = |pass: &str| {
@@ -344,8 +348,9 @@ fn check_reports_failures_with_images_and_the_bless_command() {
     );
     // It names the workspace the check ran in: pasted without it, it would bless another.
     let in_this_workspace = format!(
-        "  HARNESS_ROOT={} cargo run -p harness -- bless --scene arrow",
-        root.path().display()
+        "  HARNESS_ROOT={} {} bless --scene arrow",
+        root.path().display(),
+        env!("CARGO_BIN_EXE_harness")
     );
     assert_eq!(suggestions, [in_this_workspace.as_str()], "{stdout}");
     assert!(line("mask").contains(" ok "), "{stdout}");

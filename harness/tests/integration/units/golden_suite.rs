@@ -23,6 +23,10 @@ fn a_scene_outside_scenes_is_named_by_its_path() {
     assert_eq!(scene_argument(&inside), "arrow");
     let outside = Path::new("/tmp/elsewhere/arrow.toml");
     assert_eq!(scene_argument(outside), "/tmp/elsewhere/arrow.toml");
+    // A relative path is made absolute: a printed command then works from any folder.
+    let relative = Path::new("elsewhere/arrow.toml");
+    let absolute = std::env::current_dir().unwrap().join(relative);
+    assert_eq!(scene_argument(relative), absolute.display().to_string());
 }
 
 /// arrow.toml, written into `dir` with its assets found in scenes/ and `extra` appended.
