@@ -132,6 +132,9 @@ pub(crate) fn run(
         anyhow::bail!("name what to bless with --scene (and optionally --pass), or bless everything with --all");
     }
     let cases = load_cases(scenes)?;
+    if let Some(why) = cases.iter().find_map(harness::golden::bless::refusal) {
+        anyhow::bail!("{why}");
+    }
     let store = harness::golden::GoldenStore::workspace();
     // Every scene's folder held for the whole run, images and timing goldens, taken in name
     // order (two runs over overlapping scenes cannot each wait for the other).

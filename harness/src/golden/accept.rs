@@ -374,6 +374,9 @@ pub fn accept_scene(
     options: AcceptOptions<'_>,
     progress: impl FnMut(&str),
 ) -> Result<SceneAcceptance, String> {
+    if let Some(why) = crate::golden::bless::refusal(case) {
+        return Err(why);
+    }
     let mut done = SceneAcceptance::default();
     let mut kept = Vec::new();
     for &candidate in candidates {

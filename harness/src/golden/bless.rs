@@ -13,6 +13,30 @@ use engine::Image;
 use super::suite::{bless_change, Case};
 use super::{GoldenError, GoldenStore, SceneLock};
 
+/// Why `case`'s goldens may not be written, when it is a file outside scenes/ that
+/// shares a canonical scene's name: its goldens would be written over that scene's (a
+/// scene's name is its golden folder), which the next check of the canonical scene would
+/// fail. Checking such a copy against the canonical goldens is fine; blessing it is not.
+pub fn refusal(case: &Case) -> Option<String> {
+    let canonical = crate::scenes_dir().join(format!("{}.toml", case.name()));
+    let same = canonical
+        .canonicalize()
+        .ok()
+        .zip(case.loaded.path.canonicalize().ok())
+        .is_some_and(|(a, b)| a == b);
+    (canonical.is_file() && !same).then(|| {
+        format!(
+            "{} shares its name with the canonical scene {}: its goldens would be written \
+             over golden/{}/, which are that scene's. Edit {} instead, or give this file \
+             a name of its own (a scene's name is its golden folder)",
+            case.loaded.path.display(),
+            canonical.display(),
+            case.name(),
+            canonical.display()
+        )
+    })
+}
+
 /// Which of a case's golden passes to rewrite beyond those that changed.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct BlessRequest<'a> {

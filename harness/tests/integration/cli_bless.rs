@@ -114,6 +114,28 @@ fn bless_rewrites_only_the_named_golden() {
     );
     assert_eq!(record.matches("reason = ").count(), 1, "{record}");
 
+    // A copy of a canonical scene elsewhere, under its name, is checked against its goldens but
+    // never blessed over them.
+    let elsewhere = root.path().join("elsewhere/arrow.toml");
+    std::fs::create_dir_all(elsewhere.parent().unwrap()).unwrap();
+    let text = std::fs::read_to_string(root.path().join("scenes/arrow.toml")).unwrap();
+    std::fs::write(&elsewhere, text.replace("\"assets/", "\"../scenes/assets/")).unwrap();
+    let before = snapshot(&golden);
+    let output = common::harness_command()
+        .args(["bless", "--no-speed", "--every-pass", "--scene"])
+        .arg(&elsewhere)
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("shares its name with the canonical scene")
+            && stderr.contains("golden/arrow/"),
+        "{stderr}"
+    );
+    assert_eq!(snapshot(&golden), before);
+
     // Without --scene or --all, bless refuses.
     let output = common::harness_command()
         .arg("bless")
