@@ -308,7 +308,7 @@ fn main() -> ExitCode {
     cli::private_runtime_dir();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(DEFAULT_LOG_FILTER))
         .init();
-    let args = Cli::parse();
+    let args = Cli::parse_from(with_default_command(std::env::args_os().collect()));
     harness::use_ibl_cache();
     let command = args.command.unwrap_or_else(Command::default_check);
     let result = match command {
@@ -447,6 +447,18 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// The command line with `check`, the default command, put first when it starts with an
+/// option other than help or version: `harness --scene arrow` is `harness check --scene arrow`
+/// (clap alone would refuse `--scene` as an argument of no command).
+fn with_default_command(mut args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
+    let first = args.get(1).and_then(|a| a.to_str());
+    let global = ["-h", "--help", "-V", "--version"];
+    if first.is_some_and(|a| a.starts_with('-') && !global.contains(&a)) {
+        args.insert(1, "check".into());
+    }
+    args
 }
 
 /// A count of at least one (`--frames 0` would time nothing, and ran one frame instead).

@@ -84,6 +84,7 @@ pub(crate) fn run(
             harness::golden::verify::verify_failing(&exe, &store, &cases, &run, &outputs, |what| {
                 bar.set_message(what.to_owned())
             });
+        harness::golden::diagnosis::after_verification(&mut run.diagnoses, &run.verifications);
     }
     if let Some(started) = speed {
         let available: Vec<(BackendKind, String)> = run
@@ -254,7 +255,8 @@ fn note_borrowed_limits(cases: &[Case], store: &harness::golden::GoldenStore) {
         if !borrowed.is_empty() {
             eprintln!(
                 "note: golden/noise.toml has no figures for {} ({}): its limits are the \
-                 canonical scenes' largest; measure its own with `harness noise --scene {} --write`",
+                 canonical scenes' largest; measure its own with `harness noise --scene {} --write` (it needs the second \
+                 Mesa: scripts/mesa-backports.sh)",
                 case.name(),
                 borrowed.join(", "),
                 case.loaded.path.display()
@@ -313,7 +315,8 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
         }
         let out = report.parent().filter(|dir| *dir != default_out_dir());
         println!(
-            "  accept the reproduced ones without rendering: {}",
+            "  to accept exactly these outputs (nothing rendered again; or the review page's \
+             Accept): {}",
             harness::golden::command_line::accept_command(out)
         );
     }
@@ -336,7 +339,9 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
         println!("failure images: {failures}");
         println!(
             "after reviewing the report, bless what changed on purpose (one command per \
-             scene; it rewrites only the passes outside tolerance or without a golden):"
+             scene; it renders again and rewrites only the passes outside tolerance or without \
+             a golden; add --reason \"why\" to record why; or accept what this check kept, \
+             as above):"
         );
         for command in run.bless_commands() {
             println!("  {command}");
@@ -371,7 +376,9 @@ fn print_speed(run: &CheckRun) {
     println!(
         "\nspeed: each pass alone over its floor, against its timing golden \
          (golden/<scene>/timing.toml; limits from golden/timing-noise.toml), or on a recorded \
-         host against its own recording (golden/evidence/<host>/timing.toml)"
+         host against its own recording (golden/evidence/<host>/timing.toml); \"s of it\" places \
+         the ratio on the way to its limit, ln(ratio / golden) / ln(limit): 0 unchanged, 1 at the \
+         limit (fails above), negative faster"
     );
     println!(
         "{:<8} {:<22} {:<12} {:<8} value",

@@ -41,11 +41,16 @@ pub(crate) fn run(
             .map(|name| plan.target_named(name))
             .collect::<Result<_, _>>()
             .map_err(|e| {
+                // The shadow terms are outputs too, planned only when named: listed as well.
+                let mut with_terms = loaded.scene.clone();
+                with_terms.quality.debug_shadow_terms = true;
+                let available = PreparedFrame::new(&with_terms)
+                    .map(|p| harness::names(&p.plan().target_ids()))
+                    .unwrap_or(e.available);
                 anyhow::anyhow!(
-                    "scene `{}` has no pass output `{}` (its outputs: {}, or `all`)",
+                    "scene `{}` has no pass output `{}` (its outputs: {available}, or `all`)",
                     e.scene,
                     e.name,
-                    e.available
                 )
             })?
     };

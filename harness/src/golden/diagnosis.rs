@@ -293,9 +293,41 @@ fn advice(
                 r.scene
             )
         }
-        (Role::Origin { .. }, Agreement::OneBackend) => format!(
-            "run the other backends to tell a renderer change from a driver's; bless if \
-             intended: `{bless}`"
-        ),
+        (Role::Origin { .. }, Agreement::OneBackend) => {
+            format!("{ONE_BACKEND_ADVICE}; bless if intended: `{bless}`")
+        }
+    }
+}
+
+/// The advice on a change seen on one backend only, before a verification answers it.
+const ONE_BACKEND_ADVICE: &str = "run the other backends to tell a renderer change from a driver's";
+
+/// Updates the advice on changes seen on one backend with what the check's verification of
+/// the new outputs found: rendered again on every available backend, they reproduce (a change
+/// in the renderer or the scene, not one driver's) or they do not (a driver's difference or a
+/// render that is not deterministic). Without this the check printed \"run the other
+/// backends\" above the verification that had just run them.
+pub fn after_verification(
+    diagnoses: &mut [Diagnosis],
+    verifications: &[crate::golden::verify::Verification],
+) {
+    for d in diagnoses
+        .iter_mut()
+        .filter(|d| d.agreement == Agreement::OneBackend)
+    {
+        let Some(v) = verifications
+            .iter()
+            .find(|v| v.scene == d.scene && v.backend == d.backend && v.passes.contains(&d.pass))
+        else {
+            continue;
+        };
+        let found = if v.verified() {
+            "the verification rendered it again on every backend, where it reproduces: a \
+             change in the renderer or the scene, not one driver's"
+        } else {
+            "the verification rendered it again on every backend, where it does not reproduce \
+             (below): a driver's difference, or a render that is not deterministic"
+        };
+        d.advice = d.advice.replacen(ONE_BACKEND_ADVICE, found, 1);
     }
 }

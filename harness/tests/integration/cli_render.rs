@@ -55,6 +55,8 @@ fn render_rejects_an_unknown_pass_before_rendering() {
         stderr.contains("no pass output `finall`") && stderr.contains("final"),
         "{stderr}"
     );
+    // The shadow terms, planned only when named, are listed with the other outputs.
+    assert!(stderr.contains("shadow_0, shadow_term_0"), "{stderr}");
     assert!(!stderr.contains("rendering"), "rendered first:\n{stderr}");
 }
 

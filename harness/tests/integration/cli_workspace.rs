@@ -42,6 +42,13 @@ fn unknown_scene_names_list_the_canonical_scenes() {
         "{stderr}"
     );
     assert!(stdout.contains("(0 of speed)"), "{stdout}");
+    // The default command takes its options without its name: `harness --scene X` is `check`.
+    let (code, stdout, stderr) = harness(&["--scene", "chesss", "--out", out]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("scene `chesss` did not load") && stdout.contains("(0 of speed)"),
+        "{stderr}"
+    );
 }
 
 /// The committed scene assets are exactly what the generator writes, so they can be regenerated.

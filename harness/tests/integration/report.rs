@@ -305,6 +305,13 @@ pub(crate) fn check_after_a_light_change(verify: bool) -> (tempfile::TempDir, Pa
         .unwrap();
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert_eq!(output.status.code(), Some(1), "{stdout}");
+    // One backend checked: the verdict says to run the others, unless the verification just
+    // did (then it says what it found).
+    let (asked, answered) = (
+        stdout.contains("run the other backends to tell"),
+        stdout.contains("rendered it again on every backend, where it reproduces"),
+    );
+    assert_eq!((asked, answered), (!verify, verify), "{stdout}");
     (root, out)
 }
 

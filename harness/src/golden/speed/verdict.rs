@@ -273,6 +273,9 @@ impl SpeedCoverage {
             Tier::OtherHost => "on a host that did not bless",
         };
         let limits = match self.limits {
+            Some([low, _, high]) if format!("{low:.2}") == format!("{high:.2}") => {
+                format!(", limits x{low:.2}")
+            }
             Some([low, median, high]) => {
                 format!(", limits x{low:.2} to x{high:.2} (median x{median:.2})")
             }
