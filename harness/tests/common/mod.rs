@@ -138,21 +138,55 @@ pub fn ibl_with_extracted_sun(dir: &std::path::Path, name: &str) -> std::path::P
 }
 
 /// Makes this host the one that blessed `scene`'s timing goldens on `kind` in the workspace
-/// `root` (its fingerprint and CPU signature written into the backend's section of
-/// timing.toml, the ratios left as they are): a test that accepts a timing golden from a check
-/// needs the check to run on the blessing host, since a backend's timing goldens are one
-/// host's and another host's accept is refused.
-pub fn bless_timings_here(root: &std::path::Path, scene: &str, kind: BackendKind) {
-    use harness::golden::speed::{cpu_signature, host_fingerprint, TimingGoldens};
+/// `root`: one probe here (`harness speed`, as a check probes), written as that backend's
+/// section with this host's fingerprint and CPU signature, each pass's ratio times `scale`
+/// (its pass) or `others` (every other pass). A test that accepts a timing golden needs its
+/// check to run on the blessing host (another host's accept is refused), and ratios measured
+/// here, so that the passes it leaves alone are not judged against another CPU's.
+pub fn bless_timings_here(
+    root: &std::path::Path,
+    scene: &str,
+    kind: BackendKind,
+    scale: &[(engine::plan::PassId, f64)],
+    others: f64,
+) {
+    use harness::golden::speed::{cpu_signature, host_fingerprint, Stamp, TimingGoldens};
+    use harness::measure::speed::SceneSpeed;
+    let output = harness_command()
+        .args([
+            "speed",
+            "--json",
+            "--scene",
+            scene,
+            "--backend",
+            kind.name(),
+        ])
+        .env("HARNESS_ROOT", root)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{output:?}");
+    let mut probes: Vec<SceneSpeed> = serde_json::from_slice(&output.stdout).unwrap();
+    let mut probe = probes.pop().expect("one probe");
+    for pass in &mut probe.passes {
+        let factor = scale
+            .iter()
+            .find(|(p, _)| *p == pass.pass)
+            .map_or(others, |(_, f)| *f);
+        // The ratio is the fastest pass over the fastest floor: scale the floors.
+        pass.floor_ms.iter_mut().for_each(|ms| *ms /= factor);
+    }
     let info = backend::probe(kind).info.expect("the backend is available");
     let host = host_fingerprint(&harness::golden::fingerprint(&info));
+    let cpu = cpu_signature();
     let golden = root.join("golden");
     let mut goldens = TimingGoldens::load(&golden, scene).unwrap();
-    let section = goldens
-        .backends
-        .get_mut(&kind)
-        .expect("timing goldens there");
-    section.host = host;
-    section.cpu = cpu_signature();
+    goldens.backends.remove(&kind);
+    let stamp = Stamp {
+        host: &host,
+        cpu: &cpu,
+        blessed: "2026-11-27T00:00:00Z",
+        reason: None,
+    };
+    goldens.record(&probe, &[], &stamp);
     goldens.save(&golden, scene).unwrap();
 }
