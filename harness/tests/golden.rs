@@ -130,12 +130,22 @@ impl Suite {
             Ok(())
         } else {
             Err(format!(
-                "no timing golden on {kind} for {}; bless them: harness bless --scene {} --speed-only",
+                "no timing golden on {kind} for {}; bless them: {}",
                 harness::names(&missing),
-                self.cases[case].argument()
+                self.speed_bless(case, &checks[0])
             )
             .into())
         }
+    }
+
+    /// The command that blesses a deliberate change of a speed check's timing: on the host that
+    /// blessed, the timings that moved; elsewhere (where a bless keeps another host's timing
+    /// goldens) every pass, moving the backend's timing goldens to this host.
+    fn speed_bless(&self, case: usize, check: &harness::golden::speed::SpeedCheck) -> String {
+        harness::golden::command_line::speed_bless_command(
+            &self.cases[case].argument(),
+            check.tier == harness::golden::speed::Tier::SameHost,
+        )
     }
 
     fn run_speed(&self, case: usize, pass: PassId, kind: BackendKind) -> Result<(), Failed> {
@@ -145,10 +155,10 @@ impl Suite {
         };
         if check.failed() {
             return Err(format!(
-                "{} on {kind}: {}\n  bless a deliberate change: harness bless --scene {} --speed-only",
+                "{} on {kind}: {}\n  bless a deliberate change: {}",
                 check.pass,
                 check.describe(),
-                self.cases[case].argument()
+                self.speed_bless(case, check)
             )
             .into());
         }

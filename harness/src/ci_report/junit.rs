@@ -6,7 +6,7 @@ use quick_junit::{NonSuccessKind, Report, TestCase, TestCaseStatus, TestSuite};
 
 use super::{speed_status, Status};
 use crate::golden::check::CheckRun;
-use crate::golden::command_line::bless_command;
+use crate::golden::command_line::speed_bless_command;
 
 /// The run as a JUnit XML document.
 pub fn junit(run: &CheckRun) -> Result<String, quick_junit::SerializeError> {
@@ -60,9 +60,9 @@ pub fn junit(run: &CheckRun) -> Result<String, quick_junit::SerializeError> {
             let status = speed_status(c);
             let details = (status == Status::Failed).then(|| {
                 format!(
-                    "{}\nif the slowdown is intended, bless the timing goldens with:\n  {} --speed-only",
+                    "{}\nif the slowdown is intended, bless the timing goldens with:\n  {}",
                     c.describe(),
-                    bless_command(&c.scene)
+                    speed_bless_command(&c.scene, c.tier == crate::golden::speed::Tier::SameHost)
                 )
             });
             suite.add_test_case(case(

@@ -124,7 +124,8 @@ impl CheckRun {
                 .iter()
                 .find(|r| r.scene == c.scene)
                 .map_or_else(|| c.scene.clone(), |r| r.scene_argument.clone());
-            let command = format!("{} --speed-only", bless_command(&argument));
+            let same_host = c.tier == crate::golden::speed::Tier::SameHost;
+            let command = crate::golden::command_line::speed_bless_command(&argument, same_host);
             if !commands.contains(&command) && !commands.contains(&bless_command(&argument)) {
                 commands.push(command);
             }

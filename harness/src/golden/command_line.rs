@@ -15,6 +15,18 @@ pub fn bless_command(scene: &str) -> String {
     )
 }
 
+/// The command that blesses a deliberate change of `scene`'s timings: `--speed-only` on the
+/// host that blessed its timing goldens; elsewhere, where a bless keeps another host's timing
+/// goldens, with `--every-pass`, which moves a backend's to this host whole.
+pub fn speed_bless_command(scene: &str, on_blessing_host: bool) -> String {
+    let every_pass = if on_blessing_host {
+        ""
+    } else {
+        " --every-pass"
+    };
+    format!("{} --speed-only{every_pass}", bless_command(scene))
+}
+
 /// The command that accepts what the last check rendered and verified, without rendering
 /// again (`bless --from-last-check`), naming the check's `--out` folder when it was not the
 /// default (`None`), and the workspace as [`bless_command`] does.

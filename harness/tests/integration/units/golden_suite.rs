@@ -15,6 +15,17 @@ fn bless_commands_quote_paths_a_shell_would_split() {
         bless_command("my scenes/it's.toml"),
         "cargo run -p harness -- bless --scene 'my scenes/it'\\''s.toml'"
     );
+    // A deliberate change of timings: elsewhere than on the blessing host, every pass (a bless
+    // there keeps another host's timing goldens unless they all move).
+    use harness::golden::command_line::speed_bless_command;
+    assert_eq!(
+        speed_bless_command("chess", true),
+        "cargo run -p harness -- bless --scene chess --speed-only"
+    );
+    assert_eq!(
+        speed_bless_command("chess", false),
+        "cargo run -p harness -- bless --scene chess --speed-only --every-pass"
+    );
 }
 
 #[test]
