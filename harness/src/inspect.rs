@@ -181,6 +181,12 @@ fn object_json(o: &Object) -> Value {
     })
 }
 
+/// `x` as the decimal it was written as: an f32 widened to f64 as it is prints its binary
+/// rounding (0.93 as 0.9300000071525574); its shortest decimal is what the scene file said.
+fn decimal(x: f32) -> f64 {
+    x.to_string().parse().unwrap_or(f64::from(x))
+}
+
 /// One light of a scene.
 fn light_json(l: &Light) -> Value {
     match l {
@@ -191,8 +197,8 @@ fn light_json(l: &Light) -> Value {
             angular_radius,
             shadow,
         } => json!({
-            "type": "directional", "direction": direction.to_array(), "color": color,
-            "intensity": intensity, "angular_radius": angular_radius,
+            "type": "directional", "direction": direction.to_array(), "color": color.map(decimal),
+            "intensity": decimal(*intensity), "angular_radius": decimal(*angular_radius),
             "shadow_map": shadow.map(|s| s.map_size),
         }),
         Light::Point {
@@ -203,8 +209,8 @@ fn light_json(l: &Light) -> Value {
             falloff,
             shadow,
         } => json!({
-            "type": "point", "position": position.to_array(), "color": color,
-            "intensity": intensity, "radius": radius, "falloff": falloff,
+            "type": "point", "position": position.to_array(), "color": color.map(decimal),
+            "intensity": decimal(*intensity), "radius": decimal(*radius), "falloff": decimal(*falloff),
             "shadow_map": shadow.map(|s| s.map_size),
         }),
     }

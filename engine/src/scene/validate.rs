@@ -199,43 +199,45 @@ fn check_light(i: usize, light: &Light) -> Result<(), String> {
 }
 
 /// The first of a light's values that is out of range, named as in the scene file with the
-/// value read (a number beyond f32's range reads as infinite).
+/// value read.
 fn light_value_problem(light: &Light) -> Option<String> {
-    let finite = |name: &str, value: f64| {
+    // Colors and scalars are f32: a number written beyond its range reads as infinite.
+    let f32_value = |name: &str, value: f32| {
         (!value.is_finite()).then(|| {
             let beyond = if value.is_nan() {
                 ""
             } else {
-                " (beyond f32's range, about 3.4e38)"
+                " (a number beyond f32's range, about 3.4e38, reads as inf)"
             };
             format!("{name} must be a finite number, not {value}{beyond}")
         })
     };
-    let finite_all = |name: &str, values: &[f64]| {
-        values
-            .iter()
-            .find_map(|&v| finite(name, v))
-            .map(|problem| format!("{problem} in {values:?}"))
+    let color = |c: &[f32; 3]| {
+        c.iter()
+            .find_map(|&v| f32_value("color", v))
+            .map(|problem| format!("{problem} in {c:?}"))
+    };
+    let vector = |name: &str, v: &DVec3| {
+        (!v.is_finite()).then(|| format!("{name} must be finite numbers, not {:?}", v.to_array()))
     };
     let positive = |name: &str, value: f32| {
-        finite(name, value.into())
+        f32_value(name, value)
             .or_else(|| (value <= 0.0).then(|| format!("{name} must be positive, not {value}")))
     };
-    let widen = |c: &[f32; 3]| c.map(f64::from);
     match light {
         Light::Directional {
             direction,
-            color,
+            color: c,
             intensity,
             angular_radius,
             ..
-        } => finite_all("direction", &direction.to_array())
+        } => vector("direction", direction)
             .or_else(|| {
                 (direction.length() <= 1e-12)
                     .then(|| format!("direction must not be zero, not {:?}", direction.to_array()))
             })
-            .or_else(|| finite_all("color", &widen(color)))
-            .or_else(|| finite("intensity", (*intensity).into()))
+            .or_else(|| color(c))
+            .or_else(|| f32_value("intensity", *intensity))
             .or_else(|| {
                 (!(0.0..1.5).contains(angular_radius)).then(|| {
                     format!(
@@ -246,14 +248,14 @@ fn light_value_problem(light: &Light) -> Option<String> {
             }),
         Light::Point {
             position,
-            color,
+            color: c,
             intensity,
             radius,
             falloff,
             ..
-        } => finite_all("position", &position.to_array())
-            .or_else(|| finite_all("color", &widen(color)))
-            .or_else(|| finite("intensity", (*intensity).into()))
+        } => vector("position", position)
+            .or_else(|| color(c))
+            .or_else(|| f32_value("intensity", *intensity))
             .or_else(|| positive("radius", *radius))
             .or_else(|| positive("falloff", *falloff)),
     }

@@ -261,7 +261,8 @@ fn bad_values_and_missing_assets_are_errors_naming_the_file() {
     )
     .to_string();
     assert!(e.contains("nan.toml") && e.contains("finite"), "{e}");
-    // A light's value out of range is named, with the value read (1e39 is beyond f32's range).
+    // A light's value out of range is named, with the value read (1e39 is beyond f32's range;
+    // a color is listed as written).
     for (body, problem) in [
         (
             "type = \"directional\"\ndirection = [0, 1, 0]\nintensity = nan",
@@ -269,7 +270,7 @@ fn bad_values_and_missing_assets_are_errors_naming_the_file() {
         ),
         (
             "type = \"directional\"\ndirection = [0, 1, 0]\nintensity = 1e39",
-            "light 0: intensity must be a finite number, not inf (beyond f32's range",
+            "light 0: intensity must be a finite number, not inf (a number beyond f32's range",
         ),
         (
             "type = \"directional\"\ndirection = [0, 0, 0]",
@@ -280,9 +281,12 @@ fn bad_values_and_missing_assets_are_errors_naming_the_file() {
             "light 0: radius must be positive, not 0",
         ),
         (
+            "type = \"point\"\nposition = [0, 0, 0]\nradius = 1\ncolor = [0.1, nan, 1]",
+            "light 0: color must be a finite number, not NaN in [0.1, NaN, 1.0]",
+        ),
+        (
             "type = \"point\"\nposition = [0, inf, 0]\nradius = 1",
-            "light 0: position must be a finite number, not inf (beyond f32's range, about \
-             3.4e38) in [0.0, inf, 0.0]",
+            "light 0: position must be finite numbers, not [0.0, inf, 0.0]",
         ),
     ] {
         let text = format!("{CAMERA}[[lights]]\n{body}\n");

@@ -61,8 +61,18 @@ pub(crate) struct BlessArgs {
     /// Why the pictures or the timings changed (a sentence, as in a commit message): recorded as
     /// `reason` beside each golden written (in blessed.toml for an image, in timing.toml for a
     /// pass's speed ratio), so the golden says why it is what it is.
-    #[arg(long, value_name = "TEXT", conflicts_with = "prune")]
+    #[arg(long, value_name = "TEXT", conflicts_with = "prune", value_parser = reason_text)]
     reason: Option<String>,
+}
+
+/// A `--reason` as recorded: trimmed, and not empty (an empty reason would read as one given).
+fn reason_text(text: &str) -> Result<String, String> {
+    let text = text.trim();
+    if text.is_empty() {
+        Err("say why the goldens changed (the text is empty)".to_owned())
+    } else {
+        Ok(text.to_owned())
+    }
 }
 
 /// `harness bless`, by mode: prune, accept from the last check, or render and bless.

@@ -39,23 +39,28 @@ pub fn accept_command(out: Option<&std::path::Path>) -> String {
 
 /// The harness as this process was started: `cargo run -p harness --` under cargo (which sets
 /// `CARGO_PKG_NAME` for what it runs: `cargo run`, `cargo test` and their children; with
-/// `--release` where this executable is a release build), else the executable as it was
-/// invoked (`target/release/harness`, or `harness` found on the PATH). A suggestion that
-/// named cargo to someone running a release binary would start a second, dev-profile build.
+/// `--release` where this executable was built without debug assertions), else the executable
+/// as it was invoked, made absolute when it was named by a path (`harness` found on the PATH
+/// stays as it is). A suggestion that named cargo to someone running a release binary would
+/// start a second, dev-profile build.
 fn harness() -> String {
     if std::env::var("CARGO_PKG_NAME").is_ok_and(|name| name == "harness") {
-        let release = std::env::current_exe()
-            .is_ok_and(|exe| exe.components().any(|c| c.as_os_str() == "release"));
-        return if release {
-            "cargo run --release -p harness --".to_owned()
-        } else {
+        return if cfg!(debug_assertions) {
             "cargo run -p harness --".to_owned()
+        } else {
+            "cargo run --release -p harness --".to_owned()
         };
     }
-    std::env::args_os().next().map_or_else(
-        || "harness".to_owned(),
-        |argv0| shell_quote(&argv0.to_string_lossy()),
-    )
+    let Some(argv0) = std::env::args_os().next() else {
+        return "harness".to_owned();
+    };
+    let path = std::path::Path::new(&argv0);
+    let path = if path.components().count() > 1 {
+        std::path::absolute(path).unwrap_or_else(|_| path.to_owned())
+    } else {
+        path.to_owned()
+    };
+    shell_quote(&path.to_string_lossy())
 }
 
 /// `HARNESS_ROOT=<root> ` when the workspace is named by `HARNESS_ROOT`, else nothing.

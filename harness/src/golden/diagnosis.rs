@@ -303,10 +303,11 @@ fn advice(
 const ONE_BACKEND_ADVICE: &str = "run the other backends to tell a renderer change from a driver's";
 
 /// Updates the advice on changes seen on one backend with what the check's verification of
-/// the new outputs found: rendered again on every available backend, they reproduce (a change
-/// in the renderer or the scene, not one driver's) or they do not (a driver's difference or a
-/// render that is not deterministic). Without this the check printed \"run the other
-/// backends\" above the verification that had just run them.
+/// the new outputs found about that output: rendered again on every available backend and CPU
+/// code path, it reproduces (a change in the renderer or the scene, not one driver's), or it
+/// does not under a named source (a bless would be refused). A verification that stopped at
+/// another output's disagreement says nothing of this one, which keeps its advice. Without
+/// this the check printed "run the other backends" above the verification that had just.
 pub fn after_verification(
     diagnoses: &mut [Diagnosis],
     verifications: &[crate::golden::verify::Verification],
@@ -321,13 +322,25 @@ pub fn after_verification(
         else {
             continue;
         };
-        let found = if v.verified() {
-            "the verification rendered it again on every backend, where it reproduces: a \
-             change in the renderer or the scene, not one driver's"
-        } else {
-            "the verification rendered it again on every backend, where it does not reproduce \
-             (below): a driver's difference, or a render that is not deterministic"
-        };
-        d.advice = d.advice.replacen(ONE_BACKEND_ADVICE, found, 1);
+        let mine = v
+            .disagreements
+            .iter()
+            .find(|x| x.pass.is_none_or(|p| p == d.pass));
+        if let Some(x) = mine {
+            d.advice = format!(
+                "the verification rendered it again and it does not reproduce under {} on {}: \
+                 that driver or CPU code path, or a render that is not deterministic; a bless \
+                 would be refused (`--unverified` records it anyway)",
+                x.source,
+                x.backend.map_or("every backend", BackendKind::name)
+            );
+        } else if v.verified() {
+            d.advice = d.advice.replacen(
+                ONE_BACKEND_ADVICE,
+                "the verification rendered it again on every backend and CPU code path, where it \
+                 reproduces: a change in the renderer or the scene, not one driver's",
+                1,
+            );
+        }
     }
 }

@@ -220,8 +220,7 @@ impl Case {
     }
 
     /// How to name this scene on the command line: its file stem when it lives in scenes/ (so
-    /// `--scene arrow` finds it again), otherwise the absolute path it was loaded from (a
-    /// command printed for pasting then works from any folder).
+    /// `--scene arrow` finds it again), otherwise the path it was loaded from.
     pub fn argument(&self) -> String {
         scene_argument(&self.loaded.path)
     }
@@ -341,7 +340,8 @@ pub struct PassCheck {
 }
 
 /// How to name the scene file at `path` on the command line: its file stem when it lives in
-/// scenes/, otherwise its absolute path.
+/// scenes/, otherwise the path (as given: what a user typed, matched again by `--from-last-check
+/// --scene`, and relative in a CI job's last-check.json reviewed in another checkout).
 pub fn scene_argument(path: &Path) -> String {
     let in_scenes_dir = path
         .parent()
@@ -350,10 +350,7 @@ pub fn scene_argument(path: &Path) -> String {
         .is_some_and(|(dir, scenes)| dir == scenes);
     match path.file_stem().and_then(|s| s.to_str()) {
         Some(stem) if in_scenes_dir => stem.to_owned(),
-        _ => std::path::absolute(path)
-            .unwrap_or_else(|_| path.to_owned())
-            .display()
-            .to_string(),
+        _ => path.display().to_string(),
     }
 }
 

@@ -144,18 +144,21 @@ fn bless_rewrites_only_the_named_golden() {
         .unwrap();
     assert_eq!(output.status.code(), Some(1));
     // A reason with nothing to record it beside (pruning writes no golden) is refused, not
-    // dropped.
-    let output = common::harness_command()
-        .args(["bless", "--scene", "chess", "--prune", "--reason", "gone"])
-        .env("HARNESS_ROOT", root.path())
-        .output()
-        .unwrap();
-    assert_eq!(output.status.code(), Some(2));
-    assert!(
-        String::from_utf8_lossy(&output.stderr).contains("cannot be used with"),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    // dropped; so is an empty one (it would read as one given).
+    for (args, why) in [
+        (["--prune", "--reason", "gone"], "cannot be used with"),
+        (["--no-speed", "--reason", "  "], "the text is empty"),
+    ] {
+        let output = common::harness_command()
+            .args(["bless", "--scene", "chess"])
+            .args(args)
+            .env("HARNESS_ROOT", root.path())
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains(why), "{stderr}");
+    }
 }
 
 /// After a change to one light's intensity, `bless --scene arrow` rewrites only the passes that

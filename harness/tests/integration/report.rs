@@ -309,7 +309,8 @@ pub(crate) fn check_after_a_light_change(verify: bool) -> (tempfile::TempDir, Pa
     // did (then it says what it found).
     let (asked, answered) = (
         stdout.contains("run the other backends to tell"),
-        stdout.contains("rendered it again on every backend, where it reproduces"),
+        stdout
+            .contains("rendered it again on every backend and CPU code path, where it reproduces"),
     );
     assert_eq!((asked, answered), (!verify, verify), "{stdout}");
     (root, out)
