@@ -22,9 +22,10 @@ pub(crate) struct BlessArgs {
     /// Rewrite every pass considered, also those within tolerance (after a driver change).
     #[arg(long)]
     every_pass: bool,
-    /// Backend to render the goldens with.
-    #[arg(long, default_value = "gl")]
-    backend: BackendKind,
+    /// Backend to render the goldens with (default gl); with --from-last-check, whose outputs
+    /// to accept (default: the reference among those the check checked, gl when it did).
+    #[arg(long)]
+    backend: Option<BackendKind>,
     /// Bless every canonical scene: the passes that moved beyond their limits or have no golden
     /// (required when no --scene is given; with --every-pass, every pass).
     #[arg(long, conflicts_with = "scenes")]
@@ -99,7 +100,7 @@ pub(crate) fn command(args: BlessArgs) -> anyhow::Result<ExitCode> {
     run(
         &args.scenes,
         &args.passes,
-        args.backend,
+        args.backend.unwrap_or(BackendKind::Gl),
         args.all,
         Options {
             every_pass: args.every_pass,
@@ -205,6 +206,8 @@ fn bless_speed(
         &backends,
         harness::golden::speed::TimingBless {
             every_pass: options.every_pass,
+            // Another host's timing goldens move here only when timings alone were asked for.
+            move_here: options.every_pass && !options.images,
             dry_run: options.dry_run,
             reason: options.reason.as_deref(),
         },
@@ -348,6 +351,10 @@ fn bless_images(
 /// those of the scenes named) and removes them unless `dry_run`.
 pub(crate) fn prune(scenes: &[String], dry_run: bool) -> anyhow::Result<ExitCode> {
     let cases = load_cases(scenes)?;
+    // A scene copy named like a canonical scene would prune that scene's goldens by its own.
+    if let Some(why) = cases.iter().find_map(harness::golden::bless::refusal) {
+        anyhow::bail!("{why}");
+    }
     let store = harness::golden::GoldenStore::workspace();
     let canonical = scenes
         .is_empty()
@@ -379,7 +386,7 @@ pub(crate) fn from_last_check(
     out: &std::path::Path,
     scenes: &[String],
     passes: &[String],
-    backend: BackendKind,
+    backend: Option<BackendKind>,
     options: &Options,
 ) -> anyhow::Result<ExitCode> {
     use harness::golden::accept;
@@ -395,9 +402,10 @@ pub(crate) fn from_last_check(
         Vec::new()
     };
     if candidates.is_empty() && timings.is_empty() {
+        let on = backend.map_or("its reference backend".to_owned(), |b| b.to_string());
         println!(
-            "nothing to accept: the last check ({}) has no failing pass on {backend} and no \
-             speed check beyond its limit{}",
+            "nothing to accept: the last check ({}) has no failing pass on {on} and no speed \
+             check beyond its limit{}",
             out.join(accept::LAST_CHECK).display(),
             if scenes.is_empty() && passes.is_empty() {
                 ""
@@ -419,6 +427,10 @@ pub(crate) fn from_last_check(
     } else {
         load_cases(&arguments)?
     };
+    // Before anything is written: a scene copy named like a canonical scene blesses nothing.
+    if let Some(why) = cases.iter().find_map(harness::golden::bless::refusal) {
+        anyhow::bail!("{why}");
+    }
     let store = harness::golden::GoldenStore::workspace();
     let exe = std::env::current_exe()?;
     let on_wait = |scene: &str, path: &std::path::Path| {
@@ -479,9 +491,22 @@ pub(crate) fn from_last_check(
             path.display()
         );
     });
-    for (_, lines) in timed {
-        match lines {
-            Ok(lines) => lines.iter().for_each(|line| println!("{line}")),
+    // A timing kept out is a refusal where timings were all that was asked for (--speed-only),
+    // and a note beside the images otherwise (ratios from a host that did not bless are common).
+    let timings_asked = !options.images;
+    for (_, done) in timed {
+        match done {
+            Ok(done) => {
+                done.written.iter().for_each(|line| println!("{line}"));
+                for why in &done.kept {
+                    if timings_asked {
+                        refused += 1;
+                        println!("REFUSED {why}");
+                    } else {
+                        println!("note: {why}");
+                    }
+                }
+            }
             Err(why) => {
                 refused += 1;
                 println!("REFUSED {why}");

@@ -31,6 +31,9 @@ pub enum AcceptError {
         /// What went wrong.
         message: String,
     },
+    /// A scene file outside scenes/ named like a canonical scene: its goldens are not written.
+    #[error("{0}")]
+    SharesACanonicalName(String),
     /// The request names what the last check did not check (a typo, or another check's).
     #[error("the last check did not check {what} (it checked {checked}); nothing accepted")]
     NotChecked {
@@ -119,15 +122,20 @@ fn last_check(out: &Path) -> Result<(CheckRun, SystemTime), AcceptError> {
     Ok((run, checked_at))
 }
 
-/// The last check's failing passes on `backend`, of `scenes` and `passes` (all when empty).
+/// The last check's failing passes on `backend` (by default the reference among the backends
+/// it checked: gl, or the first), of `scenes` and `passes` (all when empty).
 pub fn candidates(
     out: &Path,
-    backend: BackendKind,
+    backend: Option<BackendKind>,
     scenes: &[String],
     passes: &[String],
 ) -> Result<Vec<Candidate>, AcceptError> {
     let (run, checked_at) = last_check(out)?;
-    check_request(&run, Some(backend), scenes, passes)?;
+    check_request(&run, backend, scenes, passes)?;
+    let checked: Vec<BackendKind> = run.results.iter().map(|r| r.backend).collect();
+    let Some(backend) = backend.or_else(|| crate::golden::suite::reference_among(&checked)) else {
+        return Ok(Vec::new());
+    };
     let driver = run
         .backends
         .iter()
@@ -240,7 +248,7 @@ pub fn speed_candidates(
     use crate::golden::speed::SpeedOutcome;
     let (run, _) = last_check(out)?;
     check_request(&run, None, scenes, passes)?;
-    Ok(run
+    let checks: Vec<_> = run
         .speed
         .checks
         .into_iter()
@@ -252,56 +260,72 @@ pub fn speed_candidates(
         })
         .filter(|c| scenes.is_empty() || scenes.contains(&c.scene))
         .filter(|c| passes.is_empty() || passes.contains(&c.pass.to_string()))
-        .collect())
+        .collect();
+    // A scene file named like a canonical scene writes none of that scene's timing goldens.
+    for c in &checks {
+        let argument = run.results.iter().find(|r| r.scene == c.scene);
+        if let Some(why) =
+            argument.and_then(|r| crate::golden::bless::refusal_for(&r.scene, &r.scene_argument))
+        {
+            return Err(AcceptError::SharesACanonicalName(why));
+        }
+    }
+    Ok(checks)
 }
 
-/// Records `checks` (all of the locked scene) as its timing goldens: each pass's ratio as the
-/// check measured it (its fastest time and its floor's), with `reason` beside each. Lines saying
-/// what was (or, with `dry_run`, would be) written; or, writing nothing, why not: a check on a
-/// host that did not bless the backend's timing goldens measured another host's ratio (one
-/// backend's goldens are one host's, see [`crate::golden::speed::kept_as_another_hosts`]), and
-/// a backend without timing goldens gets its first from a bless's three probes, not from one
-/// check.
+/// What accepting a scene's speed checks did ([`accept_timings`]).
+#[derive(Debug, Default)]
+pub struct TimingAcceptance {
+    /// A line per timing golden written (or, in a dry run, that would be).
+    pub written: Vec<String>,
+    /// A line per speed check not accepted, and why.
+    pub kept: Vec<String>,
+}
+
+/// Records `checks` (those of the locked scene) as its timing goldens: each pass's ratio as the
+/// check measured it (its fastest time and its floor's), with `reason` beside each; nothing with
+/// `dry_run`. A check is kept out, with why, where it ran on a host that did not bless the
+/// backend's timing goldens (it measured another host's ratio, and one backend's goldens are one
+/// host's, see [`crate::golden::speed::kept_as_another_hosts`]) and where the backend has no
+/// timing goldens yet (a first golden is a bless's three probes, not one check).
 pub fn accept_timings(
     store: &GoldenStore,
     lock: &SceneLock,
     checks: &[crate::golden::speed::SpeedCheck],
     dry_run: bool,
     reason: Option<&str>,
-) -> Result<Vec<String>, String> {
+) -> Result<TimingAcceptance, String> {
     use crate::golden::speed::{Stamp, Tier, TimingGoldens};
     use crate::measure::speed::{PassSpeed, SceneSpeed};
     let scene = lock.scene();
     let mut goldens = TimingGoldens::load(store.root(), scene).map_err(|e| e.to_string())?;
     let blessed = humantime::format_rfc3339_seconds(SystemTime::now()).to_string();
-    let mine: Vec<_> = checks.iter().filter(|c| c.scene == scene).collect();
-    let bless =
-        |c: &crate::golden::speed::SpeedCheck| crate::golden::command_line::bless_command(&c.scene);
-    for c in &mine {
+    let command =
+        |every_pass: bool| crate::golden::command_line::speed_bless_command(scene, !every_pass);
+    let mut done = TimingAcceptance::default();
+    for c in checks.iter().filter(|c| c.scene == scene) {
+        let name = format!("{scene}/{} on {} (speed)", c.pass, c.backend);
         let Some(section) = goldens.backends.get(&c.backend) else {
-            return Err(format!(
-                "{scene} on {} (speed): no timing goldens there yet, and one check's probe is \
-                 not one: bless them with `{} --speed-only`",
-                c.backend,
-                bless(c)
+            done.kept.push(format!(
+                "{name}: not accepted: no timing goldens there yet, and one check's probe is \
+                 not one; bless them with `{}`",
+                command(false)
             ));
+            continue;
         };
         if c.tier != Tier::SameHost {
-            return Err(format!(
-                "{scene}/{} on {} (speed): the check ran on a host that did not bless {}'s \
-                 timing goldens (blessed {}), and a backend's timing goldens are one host's \
-                 ratios; nothing written. To move them all to this host: `{} --speed-only \
-                 --every-pass`",
-                c.pass,
+            done.kept.push(format!(
+                "{name}: not accepted: the check ran on a host that did not bless {}'s timing \
+                 goldens (they are {}'s), and a backend's timing goldens are one host's ratios. \
+                 To move them all to this host: `{}`",
                 c.backend,
-                c.backend,
-                section.blessed,
-                bless(c)
+                section.host,
+                command(true)
             ));
+            continue;
         }
-    }
-    let mut lines = Vec::new();
-    for c in mine {
+        // This host blessed the section (the check's tier says so): its host stays.
+        let (host, cpu) = (section.host.clone(), section.cpu.clone());
         // The check's figures as a probe of one sample: its fastest time over its floor's.
         let probe = SceneSpeed {
             scene: scene.to_owned(),
@@ -313,12 +337,6 @@ pub fn accept_timings(
                 floor_ms: vec![c.ms / c.ratio],
             }],
         };
-        // This host blessed the section (the check's tier says so): its host stays.
-        let (host, cpu) = goldens
-            .backends
-            .get(&c.backend)
-            .map(|b| (b.host.clone(), b.cpu.clone()))
-            .unwrap_or_default();
         let stamp = Stamp {
             host: &host,
             cpu: &cpu,
@@ -326,10 +344,8 @@ pub fn accept_timings(
             reason,
         };
         goldens.record(&probe, &[c.pass], &stamp);
-        lines.push(format!(
-            "{scene}/{} on {} (speed): ratio {:.3} as the check measured it; {}",
-            c.pass,
-            c.backend,
+        done.written.push(format!(
+            "{name}: ratio {:.3} as the check measured it; {}",
             c.ratio,
             if dry_run {
                 "would be written"
@@ -338,12 +354,12 @@ pub fn accept_timings(
             }
         ));
     }
-    if !dry_run && !lines.is_empty() {
+    if !dry_run && !done.written.is_empty() {
         goldens
             .save(store.root(), scene)
             .map_err(|e| e.to_string())?;
     }
-    Ok(lines)
+    Ok(done)
 }
 
 /// What accepting one scene's candidates did ([`accept_scene`]).
@@ -448,7 +464,7 @@ pub fn accept_all_timings(
     dry_run: bool,
     reason: Option<&str>,
     on_wait: impl Fn(&Path),
-) -> Vec<(String, Result<Vec<String>, String>)> {
+) -> Vec<(String, Result<TimingAcceptance, String>)> {
     let mut scenes: Vec<&str> = checks.iter().map(|c| c.scene.as_str()).collect();
     scenes.sort_unstable();
     scenes.dedup();

@@ -14,24 +14,35 @@ use super::suite::{bless_change, Case};
 use super::{GoldenError, GoldenStore, SceneLock};
 
 /// Why `case`'s goldens may not be written, when it is a file outside scenes/ that
-/// shares a canonical scene's name: its goldens would be written over that scene's (a
-/// scene's name is its golden folder), which the next check of the canonical scene would
-/// fail. Checking such a copy against the canonical goldens is fine; blessing it is not.
+/// shares a canonical scene's name ([`refusal_for`]).
 pub fn refusal(case: &Case) -> Option<String> {
-    let canonical = crate::scenes_dir().join(format!("{}.toml", case.name()));
+    refusal_for(case.name(), &case.loaded.path.to_string_lossy())
+}
+
+/// Why the goldens of the scene `name`, loaded from `argument` (a canonical name or a scene
+/// file's path), may not be written: when it is a file outside scenes/ that shares a canonical
+/// scene's name, its goldens would be written over that scene's (a scene's name is its golden
+/// folder), which the next check of the canonical scene would fail. Checking such a copy
+/// against the canonical goldens is fine; blessing it is not.
+pub fn refusal_for(name: &str, argument: &str) -> Option<String> {
+    let canonical = crate::scenes_dir().join(format!("{name}.toml"));
+    let path = std::path::Path::new(argument);
+    if !path.is_file() || !canonical.is_file() {
+        // A canonical name, or no canonical scene of that name.
+        return None;
+    }
     let same = canonical
         .canonicalize()
         .ok()
-        .zip(case.loaded.path.canonicalize().ok())
+        .zip(path.canonicalize().ok())
         .is_some_and(|(a, b)| a == b);
-    (canonical.is_file() && !same).then(|| {
+    (!same).then(|| {
         format!(
             "{} shares its name with the canonical scene {}: its goldens would be written \
-             over golden/{}/, which are that scene's. Edit {} instead, or give this file \
-             a name of its own (a scene's name is its golden folder)",
-            case.loaded.path.display(),
+             over golden/{name}/, which are that scene's. Edit {} instead, or give this file a \
+             name of its own (a scene's name is its golden folder)",
+            path.display(),
             canonical.display(),
-            case.name(),
             canonical.display()
         )
     })

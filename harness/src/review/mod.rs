@@ -233,10 +233,9 @@ impl Review {
             }
             return answer;
         }
-        let backend = ask.backend.unwrap_or(suite::REFERENCE_BACKEND);
         let scenes: Vec<String> = ask.scene.iter().cloned().collect();
         let passes: Vec<String> = ask.pass.iter().cloned().collect();
-        let candidates = match accept::candidates(&self.out, backend, &scenes, &passes) {
+        let candidates = match accept::candidates(&self.out, ask.backend, &scenes, &passes) {
             Ok(candidates) => candidates,
             Err(e) => {
                 answer.refused.push(("-".into(), "-".into(), e.to_string()));
@@ -289,6 +288,9 @@ impl Review {
                     for blessed in done.accepted {
                         let pass = blessed.pass.to_string();
                         self.accepted.insert((case.name().to_owned(), pass.clone()));
+                        // The candidates' backend: the one asked for, or the check's reference.
+                        let backend = mine.first().map(|c| c.check.backend);
+                        let backend = backend.unwrap_or(suite::REFERENCE_BACKEND);
                         answer
                             .accepted
                             .push((case.name().to_owned(), pass, backend));
@@ -302,9 +304,12 @@ impl Review {
                 Err(why) => refuse(&mut answer, why),
             }
         }
-        // A scene's or the run's Accept takes its timing goldens too, as the check measured.
+        // A scene's or the run's Accept takes its timing goldens too, as the check measured
+        // (those it cannot take are not refusals of the images: left out of the answer).
         if ask.pass.is_none() {
-            self.accept_timings(&scenes, &[], None, reason, store, &mut answer);
+            let mut timings = AcceptAnswer::default();
+            self.accept_timings(&scenes, &[], None, reason, store, &mut timings);
+            answer.accepted.extend(timings.accepted);
         }
         answer
     }
@@ -334,11 +339,17 @@ impl Review {
         };
         for (scene, result) in accept::accept_all_timings(store, &checks, false, reason, |_| {}) {
             match result {
-                Ok(_) => {
+                Ok(done) => {
+                    // Each check is written or kept out with its line (which names it).
                     for c in checks.iter().filter(|c| c.scene == scene) {
+                        let name = format!("{scene}/{} on {} (speed)", c.pass, c.backend);
                         let pass = format!("speed {}", c.pass);
-                        self.accepted.insert((scene.clone(), pass.clone()));
-                        answer.accepted.push((scene.clone(), pass, c.backend));
+                        if let Some(why) = done.kept.iter().find(|k| k.starts_with(&name)) {
+                            answer.refused.push((scene.clone(), pass, why.clone()));
+                        } else {
+                            self.accepted.insert((scene.clone(), pass.clone()));
+                            answer.accepted.push((scene.clone(), pass, c.backend));
+                        }
                     }
                 }
                 Err(why) => answer.refused.push((scene, "speed".into(), why)),

@@ -121,19 +121,21 @@ fn bless_rewrites_only_the_named_golden() {
     let text = std::fs::read_to_string(root.path().join("scenes/arrow.toml")).unwrap();
     std::fs::write(&elsewhere, text.replace("\"assets/", "\"../scenes/assets/")).unwrap();
     let before = snapshot(&golden);
-    let output = common::harness_command()
-        .args(["bless", "--no-speed", "--every-pass", "--scene"])
-        .arg(&elsewhere)
-        .env("HARNESS_ROOT", root.path())
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_eq!(output.status.code(), Some(1), "{stderr}");
-    assert!(
-        stderr.contains("shares its name with the canonical scene")
-            && stderr.contains("golden/arrow/"),
-        "{stderr}"
-    );
+    for mode in ["--every-pass", "--prune"] {
+        let output = common::harness_command()
+            .args(["bless", "--no-speed", mode, "--scene"])
+            .arg(&elsewhere)
+            .env("HARNESS_ROOT", root.path())
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{mode}: {stderr}");
+        assert!(
+            stderr.contains("shares its name with the canonical scene")
+                && stderr.contains("golden/arrow/"),
+            "{mode}: {stderr}"
+        );
+    }
     assert_eq!(snapshot(&golden), before);
 
     // Without --scene or --all, bless refuses.

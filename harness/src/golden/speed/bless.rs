@@ -101,27 +101,28 @@ impl std::fmt::Display for SpeedBlessed {
 
 /// Why a bless on this host (fingerprint `host`, CPU signature `cpu`) keeps the timing goldens
 /// `existing` of a scene (its command-line `argument`) on one backend as they are, or None when
-/// it may rewrite them: where there are none yet, where this host blessed them, or where every
-/// pass is asked for (the backend's goldens then move to this host whole). A backend's goldens
-/// are one host's ratios: another CPU puts a pass x0.4 to x1.75 away, so a few passes blessed
-/// here among another host's would be judged against the wrong host's figures.
+/// it may rewrite them: where there are none yet, where this host blessed them, or where they
+/// are asked to move here (`move_here`: the backend's goldens then move to this host whole). A
+/// backend's goldens are one host's ratios: another CPU puts a pass x0.4 to x1.75 away, so a
+/// few passes blessed here among another host's would be judged against the wrong host's
+/// figures.
 pub fn kept_as_another_hosts(
     existing: Option<&BackendTimings>,
     host: &str,
     cpu: &str,
-    every_pass: bool,
+    move_here: bool,
     argument: &str,
 ) -> Option<String> {
     let existing = existing?;
-    if every_pass || existing.blessed_on(host, cpu) {
+    if move_here || existing.blessed_on(host, cpu) {
         return None;
     }
     Some(format!(
-        "blessed on another host ({}); a backend's timing goldens are one host's ratios, so \
-         none is rewritten from here. To move them all to this host: {} --speed-only \
-         --every-pass",
+        "blessed on another host ({}, {}); a backend's timing goldens are one host's ratios, \
+         so none is rewritten from here. To move every backend's to this host: {}",
+        existing.host,
         existing.blessed,
-        crate::golden::command_line::bless_command(argument)
+        crate::golden::command_line::speed_bless_command(argument, false)
     ))
 }
 
@@ -130,6 +131,10 @@ pub fn kept_as_another_hosts(
 pub struct TimingBless<'a> {
     /// Every pass, also those within their limit.
     pub every_pass: bool,
+    /// Where another host blessed a backend's timing goldens, move them to this host whole
+    /// (every pass probed and written); otherwise they are kept. `bless --speed-only
+    /// --every-pass` sets it: an image bless's `--every-pass` (after a driver change) does not.
+    pub move_here: bool,
     /// Decide and print; write nothing.
     pub dry_run: bool,
     /// Why the passes written changed (`--reason`), recorded beside each.
@@ -164,7 +169,7 @@ pub fn bless_scenes(
         for (scene, argument) in scenes {
             let goldens = TimingGoldens::load(root, scene)?;
             let existing = goldens.backends.get(kind);
-            match kept_as_another_hosts(existing, &host, &cpu, options.every_pass, argument) {
+            match kept_as_another_hosts(existing, &host, &cpu, options.move_here, argument) {
                 Some(why) => lines.push(SpeedBlessed {
                     scene: scene.clone(),
                     backend: *kind,
@@ -172,13 +177,17 @@ pub fn bless_scenes(
                     previous: why,
                     fate: Fate::Kept,
                 }),
-                None => writable.push((scene.clone(), argument.clone())),
+                None => {
+                    // Moving another host's goldens here: every pass, the old section replaced.
+                    let moving = existing.is_some_and(|e| !e.blessed_on(&host, &cpu));
+                    writable.push((scene.clone(), argument.clone(), moving));
+                }
             }
         }
         if writable.is_empty() {
             continue;
         }
-        let arguments: Vec<String> = writable.iter().map(|(_, a)| a.clone()).collect();
+        let arguments: Vec<String> = writable.iter().map(|(_, a, _)| a.clone()).collect();
         let mut probes: BTreeMap<String, Vec<SceneSpeed>> = BTreeMap::new();
         for round in 1..=BLESS_PROBES {
             progress(&format!(
@@ -199,7 +208,8 @@ pub fn bless_scenes(
                 probes.entry(result.scene.clone()).or_default().push(result);
             }
         }
-        for (scene, _) in &writable {
+        for (scene, _, moving) in &writable {
+            let every_pass = options.every_pass || *moving;
             let Some(probe) = probes.get(scene).and_then(|p| median_probe(p)) else {
                 return Err(SpeedError::Probe(format!(
                     "{kind}: scene {scene} was not probed"
@@ -213,7 +223,7 @@ pub fn bless_scenes(
                     check.outcome,
                     SpeedOutcome::Slower | SpeedOutcome::Faster | SpeedOutcome::MissingGolden
                 );
-                let written = options.every_pass || moved;
+                let written = every_pass || moved;
                 if written {
                     rewrite.push(check.pass);
                 }
@@ -226,7 +236,7 @@ pub fn bless_scenes(
                 });
             }
             if !rewrite.is_empty() && !options.dry_run {
-                if options.every_pass {
+                if every_pass {
                     // Every pass is this probe's: none of another host's (or of a pass gone
                     // from the plan) stays beside them.
                     goldens.backends.remove(kind);

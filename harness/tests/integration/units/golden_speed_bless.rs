@@ -31,8 +31,8 @@ fn the_median_probe_takes_each_pass_from_its_median_run() {
 }
 
 /// A bless writes a backend's timing goldens where there are none, where this host blessed
-/// them, or when every pass is asked for; otherwise it keeps them (one backend's goldens are one
-/// host's ratios) and says how to move them all here.
+/// them, or when they are asked to move here (`--speed-only --every-pass`); otherwise it keeps
+/// them (one backend's goldens are one host's ratios) and says how to move them all here.
 #[test]
 fn a_bless_keeps_another_hosts_timing_goldens_unless_every_pass_moves() {
     use harness::golden::speed::BackendTimings;
@@ -58,7 +58,7 @@ fn a_bless_keeps_another_hosts_timing_goldens_unless_every_pass_moves() {
     );
     let why = kept_as_another_hosts(Some(&section), here.0, here.1, false, "arrow").unwrap();
     assert!(
-        why.contains("blessed on another host (2026-11-25T10:00:00Z)")
+        why.contains("blessed on another host (the EPYC, 2026-11-25T10:00:00Z)")
             && why.ends_with("bless --scene arrow --speed-only --every-pass"),
         "{why}"
     );
