@@ -396,10 +396,10 @@ pub(crate) fn from_last_check(
     } else {
         Vec::new()
     };
-    let timings = if options.speed {
+    let (timings, hosts) = if options.speed {
         accept::speed_candidates(out, scenes, passes)?
     } else {
-        Vec::new()
+        Default::default()
     };
     if candidates.is_empty() && timings.is_empty() {
         let on = backend.map_or("its reference backend".to_owned(), |b| b.to_string());
@@ -485,7 +485,7 @@ pub(crate) fn from_last_check(
     }
     // The timing goldens, as the check measured them (a probe again would be a new measurement).
     let reason = options.reason.as_deref();
-    let timed = accept::accept_all_timings(&store, &timings, dry_run, reason, |path| {
+    let timed = accept::accept_all_timings(&store, &timings, &hosts, dry_run, reason, |path| {
         eprintln!(
             "waiting for another `harness bless` to finish (it holds {})",
             path.display()

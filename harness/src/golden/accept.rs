@@ -239,14 +239,23 @@ fn read_output(path: &Path) -> Result<engine::Image, crate::images::ImageFileErr
 
 /// The last check's speed checks to accept: a pass slower or faster than its timing golden
 /// beyond the limit, or timed without one, of `scenes` and `passes` (plan passes, by name; all
-/// when empty).
+/// when empty); with the host each backend ran on ([`crate::golden::speed::host_fingerprint`]
+/// of the check's driver, on this machine's CPU), which [`accept_timings`] needs.
 pub fn speed_candidates(
     out: &Path,
     scenes: &[String],
     passes: &[String],
-) -> Result<Vec<crate::golden::speed::SpeedCheck>, AcceptError> {
+) -> Result<(Vec<crate::golden::speed::SpeedCheck>, CheckHosts), AcceptError> {
     use crate::golden::speed::SpeedOutcome;
     let (run, _) = last_check(out)?;
+    let hosts = run
+        .backends
+        .iter()
+        .filter_map(|b| {
+            let driver = b.fingerprint.as_deref()?;
+            Some((b.backend, crate::golden::speed::host_fingerprint(driver)))
+        })
+        .collect();
     check_request(&run, None, scenes, passes)?;
     let checks: Vec<_> = run
         .speed
@@ -270,8 +279,11 @@ pub fn speed_candidates(
             return Err(AcceptError::SharesACanonicalName(why));
         }
     }
-    Ok(checks)
+    Ok((checks, hosts))
 }
+
+/// The host each backend of the last check ran on, by its fingerprint.
+pub type CheckHosts = std::collections::BTreeMap<BackendKind, String>;
 
 /// What accepting a scene's speed checks did ([`accept_timings`]).
 #[derive(Debug, Default)]
@@ -287,17 +299,21 @@ pub struct TimingAcceptance {
 /// `dry_run`. A check is kept out, with why, where it ran on a host that did not bless the
 /// backend's timing goldens (it measured another host's ratio, and one backend's goldens are one
 /// host's, see [`crate::golden::speed::kept_as_another_hosts`]) and where the backend has no
-/// timing goldens yet (a first golden is a bless's three probes, not one check).
+/// timing goldens yet (a first golden is a bless's three probes, not one check). Whether the
+/// check's host (`hosts`, [`speed_candidates`]) blessed them is asked of the file as it is now,
+/// so a section re-blessed elsewhere since the check is not written into.
 pub fn accept_timings(
     store: &GoldenStore,
     lock: &SceneLock,
     checks: &[crate::golden::speed::SpeedCheck],
+    hosts: &CheckHosts,
     dry_run: bool,
     reason: Option<&str>,
 ) -> Result<TimingAcceptance, String> {
-    use crate::golden::speed::{Stamp, Tier, TimingGoldens};
+    use crate::golden::speed::{cpu_signature, Stamp, TimingGoldens};
     use crate::measure::speed::{PassSpeed, SceneSpeed};
     let scene = lock.scene();
+    let cpu = cpu_signature();
     let mut goldens = TimingGoldens::load(store.root(), scene).map_err(|e| e.to_string())?;
     let blessed = humantime::format_rfc3339_seconds(SystemTime::now()).to_string();
     let command =
@@ -313,7 +329,10 @@ pub fn accept_timings(
             ));
             continue;
         };
-        if c.tier != Tier::SameHost {
+        let blessed_here = hosts
+            .get(&c.backend)
+            .is_some_and(|host| section.blessed_on(host, &cpu));
+        if !blessed_here {
             done.kept.push(format!(
                 "{name}: not accepted: the check ran on a host that did not bless {}'s timing \
                  goldens (they are {}'s), and a backend's timing goldens are one host's ratios. \
@@ -324,7 +343,7 @@ pub fn accept_timings(
             ));
             continue;
         }
-        // This host blessed the section (the check's tier says so): its host stays.
+        // The check's host blessed the section: its host stays.
         let (host, cpu) = (section.host.clone(), section.cpu.clone());
         // The check's figures as a probe of one sample: its fastest time over its floor's.
         let probe = SceneSpeed {
@@ -461,6 +480,7 @@ fn recorded_verification(
 pub fn accept_all_timings(
     store: &GoldenStore,
     checks: &[crate::golden::speed::SpeedCheck],
+    hosts: &CheckHosts,
     dry_run: bool,
     reason: Option<&str>,
     on_wait: impl Fn(&Path),
@@ -474,7 +494,7 @@ pub fn accept_all_timings(
             let result = store
                 .lock_scene(scene, &on_wait)
                 .map_err(|e| e.to_string())
-                .and_then(|lock| accept_timings(store, &lock, checks, dry_run, reason));
+                .and_then(|lock| accept_timings(store, &lock, checks, hosts, dry_run, reason));
             (scene.to_owned(), result)
         })
         .collect()

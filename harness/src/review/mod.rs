@@ -325,11 +325,14 @@ impl Review {
         store: &GoldenStore,
         answer: &mut AcceptAnswer,
     ) {
-        let checks = match accept::speed_candidates(&self.out, scenes, passes) {
-            Ok(checks) => checks
-                .into_iter()
-                .filter(|c| backend.is_none_or(|b| c.backend == b))
-                .collect::<Vec<_>>(),
+        let (checks, hosts) = match accept::speed_candidates(&self.out, scenes, passes) {
+            Ok((checks, hosts)) => (
+                checks
+                    .into_iter()
+                    .filter(|c| backend.is_none_or(|b| c.backend == b))
+                    .collect::<Vec<_>>(),
+                hosts,
+            ),
             Err(e) => {
                 answer
                     .refused
@@ -337,7 +340,9 @@ impl Review {
                 return;
             }
         };
-        for (scene, result) in accept::accept_all_timings(store, &checks, false, reason, |_| {}) {
+        for (scene, result) in
+            accept::accept_all_timings(store, &checks, &hosts, false, reason, |_| {})
+        {
             match result {
                 Ok(done) => {
                     // Each check is written or kept out with its line (which names it).

@@ -113,6 +113,14 @@ fn inspect_lists_a_real_world_models_textures_and_warnings() {
         .unwrap()
         .iter()
         .any(|w| w.as_str().unwrap().contains("crate.mtl:1: not UTF-8")));
+    // A scene's lights read as their file wrote them (0.93, not f32's 0.9300000071525574).
+    let arrow = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/arrow.toml");
+    let (code, stdout, stderr) = harness(&["inspect", arrow.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stdout.contains(r#"light {"color":[1.0,0.93,0.82],"falloff":1.0,"intensity":2.5,"#),
+        "{stdout}"
+    );
 }
 
 /// Output that cannot be written ends the run without a panic: quietly with status 141 when
