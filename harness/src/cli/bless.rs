@@ -396,11 +396,14 @@ pub(crate) fn from_last_check(
     } else {
         Vec::new()
     };
-    let (timings, hosts) = if options.speed {
+    let (mut timings, hosts) = if options.speed {
         accept::speed_candidates(out, scenes, passes)?
     } else {
         Default::default()
     };
+    if let Some(backend) = backend {
+        timings.retain(|c| c.backend == backend);
+    }
     if candidates.is_empty() && timings.is_empty() {
         let on = backend.map_or("its reference backend".to_owned(), |b| b.to_string());
         println!(
@@ -491,9 +494,10 @@ pub(crate) fn from_last_check(
             path.display()
         );
     });
-    // A timing kept out is a refusal where timings were all that was asked for (--speed-only),
-    // and a note beside the images otherwise (ratios from a host that did not bless are common).
-    let timings_asked = !options.images;
+    // A timing kept out is a refusal where timings were all that was asked for or found
+    // (--speed-only, or no image to accept), and a note beside the images otherwise (ratios
+    // from a host that did not bless are common).
+    let timings_asked = !options.images || candidates.is_empty();
     for (_, done) in timed {
         match done {
             Ok(done) => {

@@ -267,15 +267,25 @@ pub fn speed_candidates(
                 SpeedOutcome::Slower | SpeedOutcome::Faster | SpeedOutcome::MissingGolden
             )
         })
-        .filter(|c| scenes.is_empty() || scenes.contains(&c.scene))
+        .filter(|c| {
+            // A scene named as the check named it: by name, or by its file's path.
+            scenes.is_empty()
+                || scenes.contains(&c.scene)
+                || run
+                    .results
+                    .iter()
+                    .any(|r| r.scene == c.scene && scenes.contains(&r.scene_argument))
+        })
         .filter(|c| passes.is_empty() || passes.contains(&c.pass.to_string()))
         .collect();
     // A scene file named like a canonical scene writes none of that scene's timing goldens.
     for c in &checks {
-        let argument = run.results.iter().find(|r| r.scene == c.scene);
-        if let Some(why) =
-            argument.and_then(|r| crate::golden::bless::refusal_for(&r.scene, &r.scene_argument))
-        {
+        let why = run
+            .results
+            .iter()
+            .filter(|r| r.scene == c.scene)
+            .find_map(|r| crate::golden::bless::refusal_for(&r.scene, &r.scene_argument));
+        if let Some(why) = why {
             return Err(AcceptError::SharesACanonicalName(why));
         }
     }
@@ -299,9 +309,10 @@ pub struct TimingAcceptance {
 /// `dry_run`. A check is kept out, with why, where it ran on a host that did not bless the
 /// backend's timing goldens (it measured another host's ratio, and one backend's goldens are one
 /// host's, see [`crate::golden::speed::kept_as_another_hosts`]) and where the backend has no
-/// timing goldens yet (a first golden is a bless's three probes, not one check). Whether the
-/// check's host (`hosts`, [`speed_candidates`]) blessed them is asked of the file as it is now,
-/// so a section re-blessed elsewhere since the check is not written into.
+/// timing goldens yet (a first golden is a bless's three probes, not one check). The check must
+/// have judged it on the blessing host (its tier, decided where it ran), and that host
+/// (`hosts`, [`speed_candidates`]) must still have blessed the section as the file is now, so a
+/// section re-blessed elsewhere since the check is not written into.
 pub fn accept_timings(
     store: &GoldenStore,
     lock: &SceneLock,
@@ -329,9 +340,12 @@ pub fn accept_timings(
             ));
             continue;
         };
-        let blessed_here = hosts
-            .get(&c.backend)
-            .is_some_and(|host| section.blessed_on(host, &cpu));
+        // Judged on the blessing host by the check (the CPU it ran on), and still that host's
+        // section now (not re-blessed elsewhere since).
+        let blessed_here = c.tier == crate::golden::speed::Tier::SameHost
+            && hosts
+                .get(&c.backend)
+                .is_some_and(|host| section.blessed_on(host, &cpu));
         if !blessed_here {
             done.kept.push(format!(
                 "{name}: not accepted: the check ran on a host that did not bless {}'s timing \

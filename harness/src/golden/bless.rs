@@ -26,11 +26,13 @@ pub fn refusal(case: &Case) -> Option<String> {
 /// against the canonical goldens is fine; blessing it is not.
 pub fn refusal_for(name: &str, argument: &str) -> Option<String> {
     let canonical = crate::scenes_dir().join(format!("{name}.toml"));
-    let path = std::path::Path::new(argument);
-    if !path.is_file() || !canonical.is_file() {
-        // A canonical name, or no canonical scene of that name.
+    // A bare name is a canonical scene (a file in scenes/ is named by its stem); no canonical
+    // scene of that name, nothing to overwrite. Any other path that does not resolve to the
+    // canonical file (moved, deleted, read from another folder) is refused: fail closed.
+    if argument == name || !canonical.is_file() {
         return None;
     }
+    let path = std::path::Path::new(argument);
     let same = canonical
         .canonicalize()
         .ok()

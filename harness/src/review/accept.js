@@ -12,14 +12,16 @@
     ' .accept-bar input.accept-reason{width:36em;margin:0 .4em .4em 0}';
   document.head.appendChild(style);
 
-  // A speed row's pass is a plan pass; the server names an accepted timing `speed <pass>`.
+  // A speed row's pass is a plan pass; the server names an accepted timing `speed <pass>`. An
+  // image golden serves every backend's row of its pass; a timing golden is one backend's.
   const key = (row) => (row.dataset.speed ? 'speed ' : '') + row.dataset.pass;
 
   function mark(accepted) {
-    for (const [scene, pass] of accepted) {
+    for (const [scene, pass, backend] of accepted) {
       const rows = document.querySelectorAll('tr[data-scene][data-pass]');
       for (const row of rows) {
         if (row.dataset.scene !== scene || key(row) !== pass) continue;
+        if (row.dataset.speed && row.dataset.backend !== backend) continue;
         row.classList.add('accepted');
         const result = row.querySelector('td.result');
         if (result) result.textContent = 'ACCEPTED';
@@ -51,7 +53,7 @@
     })
       .then((response) => response.json())
       .then((answer) => {
-        mark(answer.accepted.map(([scene, pass]) => [scene, pass]));
+        mark(answer.accepted);
         if (answer.refused.length) {
           button.disabled = false;
           button.textContent = 'refused';

@@ -78,7 +78,8 @@ pub struct Review {
     port: u16,
     token: String,
     out: PathBuf,
-    accepted: BTreeSet<(String, String)>,
+    /// `(scene, pass, backend)` accepted so far (the page marks them again after a reload).
+    accepted: BTreeSet<(String, String, BackendKind)>,
 }
 
 impl Review {
@@ -287,10 +288,11 @@ impl Review {
                 Ok(done) => {
                     for blessed in done.accepted {
                         let pass = blessed.pass.to_string();
-                        self.accepted.insert((case.name().to_owned(), pass.clone()));
                         // The candidates' backend: the one asked for, or the check's reference.
                         let backend = mine.first().map(|c| c.check.backend);
                         let backend = backend.unwrap_or(suite::REFERENCE_BACKEND);
+                        let key = (case.name().to_owned(), pass.clone(), backend);
+                        self.accepted.insert(key);
                         answer
                             .accepted
                             .push((case.name().to_owned(), pass, backend));
@@ -304,12 +306,20 @@ impl Review {
                 Err(why) => refuse(&mut answer, why),
             }
         }
-        // A scene's or the run's Accept takes its timing goldens too, as the check measured
-        // (those it cannot take are not refusals of the images: left out of the answer).
+        // A scene's or the run's Accept takes its timing goldens too, as the check measured.
+        // A speed row it cannot take (another host's timing goldens) is no refusal of the
+        // images beside it, unless nothing was accepted; a failure to accept is one always.
         if ask.pass.is_none() {
             let mut timings = AcceptAnswer::default();
             self.accept_timings(&scenes, &[], None, reason, store, &mut timings);
             answer.accepted.extend(timings.accepted);
+            let nothing = answer.accepted.is_empty();
+            answer.refused.extend(
+                timings
+                    .refused
+                    .into_iter()
+                    .filter(|(_, pass, _)| nothing || pass == "speed"),
+            );
         }
         answer
     }
@@ -352,7 +362,8 @@ impl Review {
                         if let Some(why) = done.kept.iter().find(|k| k.starts_with(&name)) {
                             answer.refused.push((scene.clone(), pass, why.clone()));
                         } else {
-                            self.accepted.insert((scene.clone(), pass.clone()));
+                            self.accepted
+                                .insert((scene.clone(), pass.clone(), c.backend));
                             answer.accepted.push((scene.clone(), pass, c.backend));
                         }
                     }

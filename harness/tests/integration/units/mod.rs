@@ -8,6 +8,7 @@
 
 mod faults;
 mod golden_accept;
+mod golden_bless;
 mod golden_check;
 mod golden_diagnosis;
 mod golden_metrics;
