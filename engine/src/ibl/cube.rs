@@ -213,7 +213,7 @@ pub fn equirect_uv(d: Vec3) -> (f32, f32) {
 /// Bilinear lookup of an equirectangular image (wrapping in u, clamping in v).
 pub fn sample_equirect(image: &EnvironmentImage, d: Vec3) -> [f32; 3] {
     let mut out = [0.0; 3];
-    for (texel, weight) in equirect_footprint(image, d) {
+    for (texel, weight) in equirect_footprint(image, equirect_uv(d)) {
         for c in 0..3 {
             out[c] += texel[c] * weight;
         }
@@ -221,17 +221,12 @@ pub fn sample_equirect(image: &EnvironmentImage, d: Vec3) -> [f32; 3] {
     out
 }
 
-/// The four texels a bilinear lookup of an equirectangular image in direction `d` reads
-/// (wrapping in u, clamping in v), each with its weight: what [`sample_equirect`] sums, for a
-/// caller that needs the texels too (how far a GPU's fixed-point filter weights may move the
-/// result depends on their spread).
-pub fn equirect_footprint(image: &EnvironmentImage, d: Vec3) -> [([f32; 4], f32); 4] {
-    equirect_footprint_at(image, equirect_uv(d))
-}
-
-/// [`equirect_footprint`] at texture coordinates `(u, v)` (the skybox computes its own: see
-/// skybox.wgsl).
-pub fn equirect_footprint_at(image: &EnvironmentImage, (u, v): (f32, f32)) -> [([f32; 4], f32); 4] {
+/// The four texels a bilinear lookup of an equirectangular image at texture coordinates
+/// `(u, v)` reads (wrapping in u, clamping in v), each with its weight: what
+/// [`sample_equirect`] sums, for a caller that needs the texels too (how far a GPU's
+/// fixed-point filter weights may move the result depends on their spread; the sky test takes
+/// `(u, v)` as skybox.wgsl computes them).
+pub fn equirect_footprint(image: &EnvironmentImage, (u, v): (f32, f32)) -> [([f32; 4], f32); 4] {
     let (w, h) = (image.width as i64, image.height as i64);
     let fx = u * w as f32 - 0.5;
     let fy = v * h as f32 - 0.5;

@@ -66,14 +66,11 @@ pub(crate) struct BlessArgs {
     reason: Option<String>,
 }
 
-/// A `--reason` as recorded: trimmed, and not empty (an empty reason would read as one given).
+/// A `--reason` as recorded ([`harness::golden::bless::given_reason`]); an empty one refused.
 fn reason_text(text: &str) -> Result<String, String> {
-    let text = text.trim();
-    if text.is_empty() {
-        Err("say why the goldens changed (the text is empty)".to_owned())
-    } else {
-        Ok(text.to_owned())
-    }
+    harness::golden::bless::given_reason(text)
+        .map(str::to_owned)
+        .ok_or_else(|| "say why the goldens changed (the text is empty)".to_owned())
 }
 
 /// `harness bless`, by mode: prune, accept from the last check, or render and bless.
@@ -502,7 +499,7 @@ pub(crate) fn from_last_check(
         match done {
             Ok(done) => {
                 done.written.iter().for_each(|line| println!("{line}"));
-                for why in &done.kept {
+                for why in done.kept.iter().map(|k| &k.why) {
                     if timings_asked {
                         refused += 1;
                         println!("REFUSED {why}");

@@ -60,7 +60,7 @@ fn check_request(
         if names.is_empty() {
             "nothing".to_owned()
         } else {
-            names.join(", ")
+            crate::names(&names)
         }
     }
     let not_checked = |what: String, checked: String| AcceptError::NotChecked { what, checked };
@@ -300,8 +300,19 @@ pub type CheckHosts = std::collections::BTreeMap<BackendKind, String>;
 pub struct TimingAcceptance {
     /// A line per timing golden written (or, in a dry run, that would be).
     pub written: Vec<String>,
-    /// A line per speed check not accepted, and why.
-    pub kept: Vec<String>,
+    /// The speed checks not accepted.
+    pub kept: Vec<KeptTiming>,
+}
+
+/// A speed check not accepted as its timing golden, and why.
+#[derive(Debug)]
+pub struct KeptTiming {
+    /// The plan pass.
+    pub pass: engine::plan::PassId,
+    /// The backend.
+    pub backend: BackendKind,
+    /// One line: the check and why it was not accepted.
+    pub why: String,
 }
 
 /// Records `checks` (those of the locked scene) as its timing goldens: each pass's ratio as the
@@ -327,17 +338,23 @@ pub fn accept_timings(
     let cpu = cpu_signature();
     let mut goldens = TimingGoldens::load(store.root(), scene).map_err(|e| e.to_string())?;
     let blessed = humantime::format_rfc3339_seconds(SystemTime::now()).to_string();
-    let command =
-        |every_pass: bool| crate::golden::command_line::speed_bless_command(scene, !every_pass);
+    let bless = |on_blessing_host| {
+        crate::golden::command_line::speed_bless_command(scene, on_blessing_host)
+    };
     let mut done = TimingAcceptance::default();
     for c in checks.iter().filter(|c| c.scene == scene) {
         let name = format!("{scene}/{} on {} (speed)", c.pass, c.backend);
+        let kept = |why: String| KeptTiming {
+            pass: c.pass,
+            backend: c.backend,
+            why: format!("{name}: not accepted: {why}"),
+        };
         let Some(section) = goldens.backends.get(&c.backend) else {
-            done.kept.push(format!(
-                "{name}: not accepted: no timing goldens there yet, and one check's probe is \
-                 not one; bless them with `{}`",
-                command(false)
-            ));
+            done.kept.push(kept(format!(
+                "no timing goldens there yet, and one check's probe is not one; bless them \
+                 with `{}`",
+                bless(true)
+            )));
             continue;
         };
         // Judged on the blessing host by the check (the CPU it ran on), and still that host's
@@ -347,18 +364,18 @@ pub fn accept_timings(
                 .get(&c.backend)
                 .is_some_and(|host| section.blessed_on(host, &cpu));
         if !blessed_here {
-            done.kept.push(format!(
-                "{name}: not accepted: the check ran on a host that did not bless {}'s timing \
-                 goldens (they are {}'s), and a backend's timing goldens are one host's ratios. \
-                 To move them all to this host: `{}`",
+            done.kept.push(kept(format!(
+                "the check ran on a host that did not bless {}'s timing goldens (they are \
+                 {}'s), and a backend's timing goldens are one host's ratios. To move them all \
+                 to this host: `{}`",
                 c.backend,
                 section.host,
-                command(true)
-            ));
+                bless(false)
+            )));
             continue;
         }
-        // The check's host blessed the section: its host stays.
-        let (host, cpu) = (section.host.clone(), section.cpu.clone());
+        // The check's host blessed the section: its stamp stays.
+        let (section_host, section_cpu) = (section.host.clone(), section.cpu.clone());
         // The check's figures as a probe of one sample: its fastest time over its floor's.
         let probe = SceneSpeed {
             scene: scene.to_owned(),
@@ -371,8 +388,8 @@ pub fn accept_timings(
             }],
         };
         let stamp = Stamp {
-            host: &host,
-            cpu: &cpu,
+            host: &section_host,
+            cpu: &section_cpu,
             blessed: &blessed,
             reason,
         };

@@ -13,6 +13,12 @@ use engine::Image;
 use super::suite::{bless_change, Case};
 use super::{GoldenError, GoldenStore, SceneLock};
 
+/// A reason for a bless as recorded (`--reason`, the review page's field): trimmed, and None
+/// when nothing is left (an empty reason would read as one given).
+pub fn given_reason(text: &str) -> Option<&str> {
+    Some(text.trim()).filter(|r| !r.is_empty())
+}
+
 /// Why `case`'s goldens may not be written, when it is a file outside scenes/ that
 /// shares a canonical scene's name ([`refusal_for`]).
 pub fn refusal(case: &Case) -> Option<String> {

@@ -210,12 +210,10 @@ impl Review {
     /// Accepts what `ask` names from the last check: verified, then blessed, scene by scene.
     fn accept(&mut self, ask: &AcceptRequest, store: &GoldenStore) -> AcceptAnswer {
         let mut answer = AcceptAnswer::default();
-        // An empty field is no reason.
         let reason = ask
             .reason
             .as_deref()
-            .map(str::trim)
-            .filter(|r| !r.is_empty());
+            .and_then(crate::golden::bless::given_reason);
         let options = accept::AcceptOptions {
             reason,
             ..Default::default()
@@ -355,12 +353,15 @@ impl Review {
         {
             match result {
                 Ok(done) => {
-                    // Each check is written or kept out with its line (which names it).
+                    // Each check is written, or kept out with why.
                     for c in checks.iter().filter(|c| c.scene == scene) {
-                        let name = format!("{scene}/{} on {} (speed)", c.pass, c.backend);
                         let pass = format!("speed {}", c.pass);
-                        if let Some(why) = done.kept.iter().find(|k| k.starts_with(&name)) {
-                            answer.refused.push((scene.clone(), pass, why.clone()));
+                        let kept = done
+                            .kept
+                            .iter()
+                            .find(|k| k.pass == c.pass && k.backend == c.backend);
+                        if let Some(kept) = kept {
+                            answer.refused.push((scene.clone(), pass, kept.why.clone()));
                         } else {
                             self.accepted
                                 .insert((scene.clone(), pass.clone(), c.backend));

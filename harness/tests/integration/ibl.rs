@@ -426,7 +426,7 @@ fn anisotropic_knobs_change_only_the_anisotropic_pixels() {
 }
 
 /// The sky is the environment looked up in each pixel's direction, and on every backend it is
-/// the CPU's bilinear lookup of it (`cube::equirect_footprint_at`, at the angles skybox.wgsl
+/// the CPU's bilinear lookup of it (`cube::equirect_footprint`, at the angles skybox.wgsl
 /// computes, mirrored below; over the texels as uploaded: clamped to 0..65000 and rounded to
 /// fp16) to within what the filter and the light buffer may round: the weights in fixed point
 /// (8 bits each way, as GPUs filter; llvmpipe weights in f32) and fp16. A compiler's own atan2
@@ -471,7 +471,7 @@ fn the_sky_is_the_cpu_lookup_of_the_environment() {
                 let d = (far.truncate() / far.w).normalize();
                 let rotated = glam::DVec3::new(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
                 let uv = skybox_uv(rotated.as_vec3());
-                let footprint = engine::ibl::cube::equirect_footprint_at(&uploaded, uv);
+                let footprint = engine::ibl::cube::equirect_footprint(&uploaded, uv);
                 std::array::from_fn(|k| {
                     let (low, high) = footprint
                         .iter()

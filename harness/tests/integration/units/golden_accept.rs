@@ -70,9 +70,14 @@ fn a_timing_golden_is_accepted_only_on_the_host_that_blessed_it() {
 
     let gl = [slower(BackendKind::Gl)];
     let done = accept_timings(&store, &lock, &gl, &on("host-c"), false, None).unwrap();
-    let [why] = &done.kept[..] else {
+    let [kept] = &done.kept[..] else {
         panic!("{done:?}")
     };
+    let why = &kept.why;
+    assert_eq!(
+        (kept.pass, kept.backend),
+        (PassId::Geometry, BackendKind::Gl)
+    );
     assert!(
         done.written.is_empty()
             && why.starts_with("arrow/geometry on gl (speed): not accepted")
@@ -86,7 +91,7 @@ fn a_timing_golden_is_accepted_only_on_the_host_that_blessed_it() {
     let both = [slower(BackendKind::WgpuVulkan), slower(BackendKind::Gl)];
     let done = accept_timings(&store, &lock, &both, &on("the EPYC"), true, None).unwrap();
     assert!(
-        done.kept[0].contains("no timing goldens there yet"),
+        done.kept[0].why.contains("no timing goldens there yet"),
         "{done:?}"
     );
     assert_eq!(
