@@ -62,7 +62,10 @@ pub fn junit(run: &CheckRun) -> Result<String, quick_junit::SerializeError> {
                 format!(
                     "{}\nif the slowdown is intended, bless the timing goldens with:\n  {}",
                     c.describe(),
-                    speed_bless_command(&c.scene, c.tier == crate::golden::speed::Tier::SameHost)
+                    speed_bless_command(
+                        run.scene_argument(&c.scene),
+                        c.tier == crate::golden::speed::Tier::SameHost
+                    )
                 )
             });
             suite.add_test_case(case(

@@ -393,7 +393,7 @@ pub(crate) fn from_last_check(
     } else {
         Vec::new()
     };
-    let (mut timings, hosts) = if options.speed {
+    let (mut timings, checked) = if options.speed {
         accept::speed_candidates(out, scenes, passes)?
     } else {
         Default::default()
@@ -485,7 +485,7 @@ pub(crate) fn from_last_check(
     }
     // The timing goldens, as the check measured them (a probe again would be a new measurement).
     let reason = options.reason.as_deref();
-    let timed = accept::accept_all_timings(&store, &timings, &hosts, dry_run, reason, |path| {
+    let timed = accept::accept_all_timings(&store, &timings, &checked, dry_run, reason, |path| {
         eprintln!(
             "waiting for another `harness bless` to finish (it holds {})",
             path.display()

@@ -239,13 +239,12 @@ fn read_output(path: &Path) -> Result<engine::Image, crate::images::ImageFileErr
 
 /// The last check's speed checks to accept: a pass slower or faster than its timing golden
 /// beyond the limit, or timed without one, of `scenes` and `passes` (plan passes, by name; all
-/// when empty); with the host each backend ran on ([`crate::golden::speed::host_fingerprint`]
-/// of the check's driver, on this machine's CPU), which [`accept_timings`] needs.
+/// when empty); with what [`accept_timings`] needs to know of the check ([`CheckContext`]).
 pub fn speed_candidates(
     out: &Path,
     scenes: &[String],
     passes: &[String],
-) -> Result<(Vec<crate::golden::speed::SpeedCheck>, CheckHosts), AcceptError> {
+) -> Result<(Vec<crate::golden::speed::SpeedCheck>, CheckContext), AcceptError> {
     use crate::golden::speed::SpeedOutcome;
     let (run, _) = last_check(out)?;
     let hosts = run
@@ -289,11 +288,33 @@ pub fn speed_candidates(
             return Err(AcceptError::SharesACanonicalName(why));
         }
     }
-    Ok((checks, hosts))
+    let arguments = checks
+        .iter()
+        .filter_map(|c| {
+            let r = run.results.iter().find(|r| r.scene == c.scene)?;
+            Some((c.scene.clone(), r.scene_argument.clone()))
+        })
+        .collect();
+    Ok((checks, CheckContext { hosts, arguments }))
 }
 
-/// The host each backend of the last check ran on, by its fingerprint.
-pub type CheckHosts = std::collections::BTreeMap<BackendKind, String>;
+/// What accepting the last check's speed checks needs to know of that check.
+#[derive(Clone, Debug, Default)]
+pub struct CheckContext {
+    /// The host each backend ran on, by its fingerprint
+    /// ([`crate::golden::speed::host_fingerprint`] of the check's driver, on this machine's CPU).
+    pub hosts: std::collections::BTreeMap<BackendKind, String>,
+    /// Each scene as the check was given it (a name in scenes/ or a scene file's path), by
+    /// name: what a printed command names to find it again.
+    pub arguments: std::collections::BTreeMap<String, String>,
+}
+
+impl CheckContext {
+    /// `scene` as the check was given it (the name itself when not recorded).
+    pub fn scene_argument<'a>(&'a self, scene: &'a str) -> &'a str {
+        self.arguments.get(scene).map_or(scene, String::as_str)
+    }
+}
 
 /// What accepting a scene's speed checks did ([`accept_timings`]).
 #[derive(Debug, Default)]
@@ -322,13 +343,13 @@ pub struct KeptTiming {
 /// host's, see [`crate::golden::speed::kept_as_another_hosts`]) and where the backend has no
 /// timing goldens yet (a first golden is a bless's three probes, not one check). The check must
 /// have judged it on the blessing host (its tier, decided where it ran), and that host
-/// (`hosts`, [`speed_candidates`]) must still have blessed the section as the file is now, so a
+/// (`check`, [`speed_candidates`]) must still have blessed the section as the file is now, so a
 /// section re-blessed elsewhere since the check is not written into.
 pub fn accept_timings(
     store: &GoldenStore,
     lock: &SceneLock,
     checks: &[crate::golden::speed::SpeedCheck],
-    hosts: &CheckHosts,
+    check: &CheckContext,
     dry_run: bool,
     reason: Option<&str>,
 ) -> Result<TimingAcceptance, String> {
@@ -339,7 +360,10 @@ pub fn accept_timings(
     let mut goldens = TimingGoldens::load(store.root(), scene).map_err(|e| e.to_string())?;
     let blessed = humantime::format_rfc3339_seconds(SystemTime::now()).to_string();
     let bless = |on_blessing_host| {
-        crate::golden::command_line::speed_bless_command(scene, on_blessing_host)
+        crate::golden::command_line::speed_bless_command(
+            check.scene_argument(scene),
+            on_blessing_host,
+        )
     };
     let mut done = TimingAcceptance::default();
     for c in checks.iter().filter(|c| c.scene == scene) {
@@ -360,7 +384,8 @@ pub fn accept_timings(
         // Judged on the blessing host by the check (the CPU it ran on), and still that host's
         // section now (not re-blessed elsewhere since).
         let blessed_here = c.tier == crate::golden::speed::Tier::SameHost
-            && hosts
+            && check
+                .hosts
                 .get(&c.backend)
                 .is_some_and(|host| section.blessed_on(host, &cpu));
         if !blessed_here {
@@ -511,7 +536,7 @@ fn recorded_verification(
 pub fn accept_all_timings(
     store: &GoldenStore,
     checks: &[crate::golden::speed::SpeedCheck],
-    hosts: &CheckHosts,
+    check: &CheckContext,
     dry_run: bool,
     reason: Option<&str>,
     on_wait: impl Fn(&Path),
@@ -525,7 +550,7 @@ pub fn accept_all_timings(
             let result = store
                 .lock_scene(scene, &on_wait)
                 .map_err(|e| e.to_string())
-                .and_then(|lock| accept_timings(store, &lock, checks, hosts, dry_run, reason));
+                .and_then(|lock| accept_timings(store, &lock, checks, check, dry_run, reason));
             (scene.to_owned(), result)
         })
         .collect()

@@ -108,6 +108,16 @@ impl CheckRun {
             && self.speed.passed()
     }
 
+    /// The scene named `scene` as this check was given it (a name in scenes/ or a scene
+    /// file's path): what a printed command must name to find it again. The name itself when
+    /// the check rendered nothing of it.
+    pub fn scene_argument<'a>(&'a self, scene: &'a str) -> &'a str {
+        self.results
+            .iter()
+            .find(|r| r.scene == scene)
+            .map_or(scene, |r| r.scene_argument.as_str())
+    }
+
     /// One `harness bless` command per scene with a failing or missing pass, in the order of
     /// the results (each rewrites only its scene's changed passes).
     pub fn bless_commands(&self) -> Vec<String> {
@@ -119,14 +129,10 @@ impl CheckRun {
             }
         }
         for c in self.speed.checks.iter().filter(|c| c.failed()) {
-            let argument = self
-                .results
-                .iter()
-                .find(|r| r.scene == c.scene)
-                .map_or_else(|| c.scene.clone(), |r| r.scene_argument.clone());
+            let argument = self.scene_argument(&c.scene);
             let same_host = c.tier == crate::golden::speed::Tier::SameHost;
-            let command = crate::golden::command_line::speed_bless_command(&argument, same_host);
-            if !commands.contains(&command) && !commands.contains(&bless_command(&argument)) {
+            let command = crate::golden::command_line::speed_bless_command(argument, same_host);
+            if !commands.contains(&command) && !commands.contains(&bless_command(argument)) {
                 commands.push(command);
             }
         }

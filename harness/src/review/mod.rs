@@ -333,13 +333,13 @@ impl Review {
         store: &GoldenStore,
         answer: &mut AcceptAnswer,
     ) {
-        let (checks, hosts) = match accept::speed_candidates(&self.out, scenes, passes) {
-            Ok((checks, hosts)) => (
+        let (checks, checked) = match accept::speed_candidates(&self.out, scenes, passes) {
+            Ok((checks, checked)) => (
                 checks
                     .into_iter()
                     .filter(|c| backend.is_none_or(|b| c.backend == b))
                     .collect::<Vec<_>>(),
-                hosts,
+                checked,
             ),
             Err(e) => {
                 answer
@@ -349,7 +349,7 @@ impl Review {
             }
         };
         for (scene, result) in
-            accept::accept_all_timings(store, &checks, &hosts, false, reason, |_| {})
+            accept::accept_all_timings(store, &checks, &checked, false, reason, |_| {})
         {
             match result {
                 Ok(done) => {

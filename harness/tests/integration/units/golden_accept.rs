@@ -2,7 +2,7 @@
 
 use engine::backend::BackendKind;
 use engine::plan::PassId;
-use harness::golden::accept::{accept_timings, CheckHosts};
+use harness::golden::accept::{accept_timings, CheckContext};
 use harness::golden::speed::TimingGoldens;
 use harness::golden::speed::{cpu_signature, SpeedCheck, SpeedOutcome, Stamp, Tier};
 use harness::golden::GoldenStore;
@@ -25,12 +25,15 @@ fn slower(backend: BackendKind) -> SpeedCheck {
     }
 }
 
-/// The last check's hosts: every backend on `host`.
-fn on(host: &str) -> CheckHosts {
-    BackendKind::ALL
-        .into_iter()
-        .map(|kind| (kind, host.to_owned()))
-        .collect()
+/// The last check: every backend on `host`, arrow named by its file's path.
+fn on(host: &str) -> CheckContext {
+    CheckContext {
+        hosts: BackendKind::ALL
+            .into_iter()
+            .map(|kind| (kind, host.to_owned()))
+            .collect(),
+        arguments: [("arrow".to_owned(), "scenes/arrow.toml".to_owned())].into(),
+    }
 }
 
 /// Accepting a speed check from the last check writes the ratio it measured (with the reason)
@@ -38,7 +41,8 @@ fn on(host: &str) -> CheckHosts {
 /// (a section re-blessed elsewhere since the check is not written into), and keeps it out,
 /// writing nothing, where another host did (it would put this host's ratio among that host's)
 /// or where the backend has no timing goldens yet (a first golden comes from a bless's probes,
-/// not one check); per check, so one kept out does not stop another.
+/// not one check); per check, so one kept out does not stop another. The command it prints
+/// names the scene as the check was given it.
 #[test]
 fn a_timing_golden_is_accepted_only_on_the_host_that_blessed_it() {
     let dir = tempfile::tempdir().unwrap();
@@ -82,7 +86,7 @@ fn a_timing_golden_is_accepted_only_on_the_host_that_blessed_it() {
         done.written.is_empty()
             && why.starts_with("arrow/geometry on gl (speed): not accepted")
             && why.contains("did not bless gl's timing goldens (they are the EPYC's)")
-            && why.contains("--speed-only --every-pass"),
+            && why.contains("bless --scene scenes/arrow.toml --speed-only --every-pass"),
         "{why}"
     );
     assert_eq!(std::fs::read_to_string(&file).unwrap(), before);
