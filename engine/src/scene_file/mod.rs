@@ -89,6 +89,10 @@ pub struct LoadedScene {
     pub tolerances: toml::Table,
     /// Texture files decoded while loading (each at most once).
     pub textures_decoded: usize,
+    /// Every file the load read, each once, in the order first read: the scene file, the
+    /// environment, the meshes, their material libraries and the textures. A digest of their
+    /// bytes says whether the scene is still what it was.
+    pub files: Vec<PathBuf>,
     /// What the loaders noted about untidy but usable assets (text that is not UTF-8, a
     /// missing material library, unknown material names, generated normals, ...), each
     /// asset's once, each naming its file and line.

@@ -33,6 +33,9 @@ pub(super) struct Resolver {
     models: HashMap<PathBuf, Arc<MeshParts>>,
     /// Each loaded asset's warnings, once per asset.
     warnings: Vec<String>,
+    /// The scene file, environment, meshes and material libraries read so far (the textures
+    /// are the cache's).
+    files: Vec<PathBuf>,
 }
 
 /// The meshes of one OBJ file, each with its MTL material.
@@ -53,6 +56,7 @@ impl Resolver {
             textures: Vec::new(),
             models: HashMap::new(),
             warnings: Vec::new(),
+            files: vec![path.to_owned()],
         }
     }
 
@@ -139,6 +143,8 @@ impl Resolver {
             None => {
                 let model = assets::load_obj(&key, &mut self.cache).map_err(|e| self.asset(e))?;
                 self.warnings.extend(model.warnings);
+                self.files.push(key.clone());
+                self.files.extend(model.material_libraries);
                 let materials = model.materials;
                 model
                     .meshes
@@ -192,12 +198,17 @@ impl Resolver {
             quality,
         };
         scene.validate().map_err(|e| self.invalid(e.to_string()))?;
+        let mut files = self.files;
+        files.extend(self.cache.iter().map(|(_, texture)| texture.path.clone()));
+        let mut seen = std::collections::HashSet::new();
+        files.retain(|file| seen.insert(file.clone()));
         Ok(LoadedScene {
             scene,
             path: self.path.clone(),
             description: file.description,
             tolerances: file.tolerances,
             textures_decoded: self.cache.decode_count(),
+            files,
             warnings: self.warnings,
         })
     }
@@ -224,6 +235,7 @@ impl Resolver {
         self.reserve_environment(&env_path)
             .map_err(|e| self.asset(e))?;
         let loaded = assets::load_environment(&env_path).map_err(|e| self.asset(e))?;
+        self.files.push(env_path.clone());
         if loaded.width != 2 * loaded.height {
             self.warnings.push(format!(
                 "{}: environment {} is {}x{}, not twice as wide as tall: an equirectangular \

@@ -382,6 +382,27 @@ fn canonical_scenes_load_with_valid_tangent_frames() {
         chess.textures_decoded, 4,
         "albedo, roughness, normal, clearcoat"
     );
+    // Every file the load read, once each, the material libraries and textures included.
+    let names: Vec<String> = chess
+        .files
+        .iter()
+        .map(|f| f.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "chess.toml",
+            "sunset.exr",
+            "board.obj",
+            "board.mtl",
+            "checker.obj",
+            "checker.mtl",
+            "board_albedo.png",
+            "board_roughness.png",
+            "board_normal.png",
+            "board_clearcoat.png",
+        ]
+    );
 }
 
 /// A negative light intensity, absolute asset paths and material values outside their ranges

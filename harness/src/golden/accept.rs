@@ -105,6 +105,8 @@ pub struct Candidate {
     pub checked_at: SystemTime,
     /// The check's verification of this output, if it verified it.
     pub verification: Option<crate::golden::verify::Verification>,
+    /// The files the check loaded the scene from (None from a check that did not record them).
+    pub inputs: Option<crate::golden::scene_inputs::SceneInputs>,
 }
 
 /// The last check under `out` and when it was written.
@@ -142,7 +144,7 @@ pub fn candidates(
         .find(|b| b.backend == backend)
         .and_then(|b| b.fingerprint.clone())
         .unwrap_or_default();
-    let verifications = run.verifications;
+    let (verifications, inputs) = (run.verifications, run.inputs);
     Ok(run
         .results
         .into_iter()
@@ -158,6 +160,7 @@ pub fn candidates(
                     v.scene == check.scene && v.backend == backend && v.passes.contains(&check.pass)
                 })
                 .cloned(),
+            inputs: inputs.iter().find(|i| i.scene == check.scene).cloned(),
             check,
             driver: driver.clone(),
             checked_at,
@@ -456,6 +459,8 @@ pub struct SceneAcceptance {
 /// by the check's own verification when it covers them and the scene's inputs are unchanged,
 /// which renders nothing; otherwise now, running `exe`, the harness binary, with `progress` told
 /// each source), then blessed. The one flow of `bless --from-last-check` and `harness review`.
+/// Refused whole, with the files, where a file the scene was loaded from changed since the
+/// check ([`SceneInputs`](crate::golden::scene_inputs::SceneInputs)).
 pub fn accept_scene(
     exe: &Path,
     store: &GoldenStore,
@@ -466,6 +471,14 @@ pub fn accept_scene(
     progress: impl FnMut(&str),
 ) -> Result<SceneAcceptance, String> {
     if let Some(why) = crate::golden::bless::refusal(case) {
+        return Err(why);
+    }
+    // Outputs of the scene as it was are not goldens of the scene as it is, verified or not.
+    let now = crate::golden::scene_inputs::SceneInputs::of(case);
+    if let Some(why) = candidates
+        .iter()
+        .find_map(|c| c.inputs.as_ref()?.refusal(&now, &c.check.scene_argument))
+    {
         return Err(why);
     }
     let mut done = SceneAcceptance::default();

@@ -97,6 +97,10 @@ pub struct CheckRun {
     /// relies on instead of rendering again).
     #[serde(default)]
     pub verifications: Vec<crate::golden::verify::Verification>,
+    /// The files each scene was loaded from, digested: accepting this check's outputs refuses
+    /// a scene that has changed since.
+    #[serde(default)]
+    pub inputs: Vec<crate::golden::scene_inputs::SceneInputs>,
 }
 
 impl CheckRun {
@@ -383,6 +387,10 @@ pub fn run_with(
             diagnoses,
             orphans: Vec::new(),
             verifications: Vec::new(),
+            inputs: cases
+                .iter()
+                .map(crate::golden::scene_inputs::SceneInputs::of)
+                .collect(),
             driver_notes,
             backends,
             results,

@@ -15,6 +15,17 @@ pub fn bless_command(scene: &str) -> String {
     )
 }
 
+/// The `harness check` command line of one scene (`scene` as the user gave it), as
+/// [`bless_command`] makes its own.
+pub fn check_command(scene: &str) -> String {
+    format!(
+        "{}{} check --scene {}",
+        workspace(),
+        harness(),
+        shell_quote(scene)
+    )
+}
+
 /// The command that blesses a deliberate change of `scene`'s timings: `--speed-only` on the
 /// host that blessed its timing goldens; elsewhere, where a bless keeps another host's timing
 /// goldens, with `--every-pass`, which moves a backend's to this host whole.

@@ -93,6 +93,7 @@ pub fn merge(shards: &[PathBuf]) -> Result<(CheckRun, Outputs), MergeError> {
         merged.speed.errors.extend(run.speed.errors);
         merged.diagnoses.extend(run.diagnoses);
         merged.verifications.extend(run.verifications);
+        merged.inputs.extend(run.inputs);
         for orphan in run.orphans {
             if !merged.orphans.contains(&orphan) {
                 merged.orphans.push(orphan);

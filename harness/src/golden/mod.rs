@@ -14,6 +14,7 @@ pub mod noise;
 pub mod orphans;
 pub mod pass_kind;
 pub mod portability;
+pub mod scene_inputs;
 pub mod selftest;
 pub mod speed;
 pub mod store;

@@ -137,22 +137,18 @@ impl Verification {
 }
 
 /// A digest of what a scene's verification depends on that can change between a check and an
-/// accept: the scene file, every file its values name (assets beside it), the noise model the
-/// limits come from, and the harness executable that renders it. (Files an asset names in
-/// turn, such as an OBJ's material library, are not followed: check again after changing one.)
+/// accept: every file the scene was loaded from (the scene file, its environment, meshes,
+/// material libraries and textures), the noise model the limits come from, and the harness
+/// executable that renders it.
 pub fn inputs_digest(store: &GoldenStore, case: &Case) -> String {
     use std::hash::{Hash, Hasher};
     let mut hasher = std::collections::hash_map::DefaultHasher::new();
     std::fs::read(store.root().join("noise.toml"))
         .unwrap_or_default()
         .hash(&mut hasher);
-    let path = &case.loaded.path;
-    std::fs::read_to_string(path)
-        .unwrap_or_default()
-        .hash(&mut hasher);
-    for (name, file) in named_files(path) {
-        name.hash(&mut hasher);
-        std::fs::read(&file).unwrap_or_default().hash(&mut hasher);
+    for file in &case.loaded.files {
+        file.hash(&mut hasher);
+        std::fs::read(file).unwrap_or_default().hash(&mut hasher);
     }
     if let Ok(meta) = std::env::current_exe().and_then(std::fs::metadata) {
         meta.len().hash(&mut hasher);

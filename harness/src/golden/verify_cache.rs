@@ -43,7 +43,8 @@ pub fn folder() -> Option<PathBuf> {
 }
 
 /// The key of verifying `candidates` of `case`, whose inputs digest is `inputs`
-/// ([`super::verify::inputs_digest`]: the scene file, the files it names, the executable),
+/// ([`super::verify::inputs_digest`]: every file the scene was loaded from, the noise model,
+/// the executable),
 /// against the temporary golden folder `golden` (which holds them and the limits); None when an
 /// input cannot be hashed with certainty.
 pub fn key(inputs: &str, case: &Case, golden: &Path, candidates: &[TargetId]) -> Option<String> {

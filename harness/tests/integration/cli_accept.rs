@@ -10,9 +10,9 @@ use crate::common;
 /// metrics against the old golden, unverified) and nothing else; the next check passes it and
 /// still fails the final image, until it is accepted too. (Accepting on the check's own
 /// verification, rendering nothing, is in the review page's test.) A kept output whose scene
-/// changed after the check is verified again, although the check verified it, and refused when
-/// it no longer reproduces (the scene changed back), naming the source and backend; a golden
-/// rewritten after the check is refused too.
+/// file changed after the check is refused, verified or not, naming the file; one whose noise
+/// model changed is verified again, although the check verified it; a golden rewritten after
+/// the check is refused too.
 #[test]
 fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
     if !common::gl_available() {
@@ -79,7 +79,7 @@ fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
         (output.status.code(), stdout + &stderr)
     };
     let light_final = vec!["light".to_owned(), "final".to_owned()];
-    assert_eq!(check(false), (Some(1), light_final.clone()));
+    assert_eq!(check(false), (Some(1), light_final));
     let golden = root.path().join("golden");
     let before = snapshot(&golden);
     refuses_what_the_check_did_not_check(root.path(), &out);
@@ -129,20 +129,49 @@ fn bless_from_the_last_check_accepts_its_outputs_without_rendering() {
     assert_eq!(code, Some(0), "{stdout}");
     assert_eq!(check(false), (Some(0), vec![]));
 
-    // Checked (and verified) at 3.5, accepted after the scene went back to 3.0: the check's
-    // verification is of other inputs, so the accept verifies again; the kept light buffer does
-    // not reproduce, and nothing is written.
+    after_the_check(&golden, check, accept, with_intensity);
+}
+
+/// What changed after a check (of arrow at 3.5, its outputs verified) decides the accept: the
+/// scene file, refused; the noise model, verified again; a golden, refused.
+fn after_the_check(
+    golden: &std::path::Path,
+    check: impl Fn(bool) -> (Option<i32>, Vec<String>),
+    accept: impl Fn(&str, bool, bool) -> (Option<i32>, String),
+    with_intensity: impl Fn(&str),
+) {
+    let light_final = vec!["light".to_owned(), "final".to_owned()];
+    // Checked (and verified) at 3.5, accepted after the scene went back to 3.0: the kept
+    // outputs are of the scene as it was, so the accept is refused, verified or not, naming the
+    // file that changed and the check to run, and nothing is written.
     with_intensity("3.5");
     assert_eq!(check(true), (Some(1), light_final));
     with_intensity("3.0");
-    let before = snapshot(&golden);
+    let before = snapshot(golden);
+    for verify in [true, false] {
+        let (code, stdout) = accept("light", true, verify);
+        assert_eq!(code, Some(1), "{stdout}");
+        assert!(
+            stdout.contains("arrow changed since the check (")
+                && stdout.contains("scenes/arrow.toml)")
+                && stdout.contains(" check --scene arrow`), then accept"),
+            "{stdout}"
+        );
+        assert_eq!(snapshot(golden), before);
+    }
+    // The scene as checked again, but the noise model edited since: the check's verification
+    // is of other inputs, so the accept verifies again (the outputs reproduce) and writes.
+    with_intensity("3.5");
+    let noise = golden.join("noise.toml");
+    let model = std::fs::read_to_string(&noise).unwrap();
+    std::fs::write(&noise, format!("{model}\n# edited after the check\n")).unwrap();
     let (code, stdout) = accept("light", true, true);
-    assert_eq!(code, Some(1), "{stdout}");
+    assert_eq!(code, Some(0), "{stdout}");
     assert!(
-        stdout.contains("REFUSED arrow/light does not reproduce under drivers on gl"),
+        stdout.contains("verifying arrow's new goldens under cpu-avx") && stdout.contains("wrote "),
         "{stdout}"
     );
-    assert_eq!(snapshot(&golden), before);
+    assert_ne!(snapshot(golden), before);
 
     // The final golden rewritten after that check: accepting the check's final is refused.
     let future = std::time::SystemTime::now() + std::time::Duration::from_secs(60);

@@ -36,6 +36,8 @@ pub struct Model {
     pub meshes: Vec<MeshData>,
     /// Materials from all `mtllib` files, in file order.
     pub materials: Vec<MaterialData>,
+    /// The material libraries read (the textures their maps name are in the texture cache).
+    pub material_libraries: Vec<PathBuf>,
     /// Non-fatal problems and notes (skipped elements, unknown keys,
     /// generated normals/UVs, repaired tangents, ...).
     pub warnings: Vec<String>,
@@ -238,6 +240,7 @@ pub fn load_obj(path: &Path, textures: &mut TextureCache) -> Result<Model, Asset
         path: path.to_path_buf(),
         meshes,
         materials,
+        material_libraries: state.libs.iter().map(|lib| lib.path.clone()).collect(),
         warnings,
     })
 }

@@ -18,6 +18,7 @@ mod golden_noise;
 mod golden_portability_model;
 mod golden_portability_rounding;
 mod golden_portability_sources;
+mod golden_scene_inputs;
 mod golden_speed_bless;
 mod golden_speed_goldens;
 mod golden_speed_history;
