@@ -40,7 +40,8 @@ pub(crate) struct BlessArgs {
     #[arg(long)]
     no_speed: bool,
     /// Instead of blessing, remove what nothing produces or records any more: folders of
-    /// scenes gone from scenes/, goldens of passes gone, goldens blessed.toml does not
+    /// scenes gone from scenes/ (a scene blessed from a file elsewhere keeps its folder while
+    /// that file exists), goldens of passes gone, goldens blessed.toml does not
     /// record, records without a golden, stray files (every scene's, or the --scene ones';
     /// with --dry-run, only list them).
     #[arg(long, conflicts_with_all = ["speed_only", "every_pass", "passes"])]
@@ -337,6 +338,15 @@ fn bless_images(
         if kept > 0 {
             println!(
                 "{}: {kept} pass(es) within tolerance kept as they are (--every-pass rewrites them)",
+                case.name()
+            );
+        }
+        if !harness::golden::bless::is_canonical(case) {
+            println!(
+                "note: {} is not in scenes/: `check` checks it only when named with --scene, and \
+                 `bless --prune` keeps golden/{}/ while the file is there (move it into scenes/ \
+                 to make it part of the suite)",
+                case.loaded.path.display(),
                 case.name()
             );
         }

@@ -56,6 +56,16 @@ pub fn refusal_for(name: &str, argument: &str) -> Option<String> {
     })
 }
 
+/// Whether `case` is the scene of scenes/ named like it (not a scene file elsewhere).
+pub fn is_canonical(case: &Case) -> bool {
+    let canonical = crate::scenes_dir().join(format!("{}.toml", case.name()));
+    canonical
+        .canonicalize()
+        .ok()
+        .zip(case.loaded.path.canonicalize().ok())
+        .is_some_and(|(a, b)| a == b)
+}
+
 /// Which of a case's golden passes to rewrite beyond those that changed.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct BlessRequest<'a> {
@@ -141,6 +151,7 @@ pub fn bless_pass(
                 previous: &change.previous,
                 unverified: request.unverified,
                 reason: request.reason,
+                scene_file: (!is_canonical(case)).then_some(case.loaded.path.as_path()),
             },
         )?)
     };

@@ -45,7 +45,10 @@ impl fmt::Display for Orphan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let scene = self.scene.as_deref().unwrap_or("-");
         let why = match &self.kind {
-            OrphanKind::SceneGone => format!("no scene in scenes/ is named {scene}"),
+            OrphanKind::SceneGone => format!(
+                "no scene in scenes/ is named {scene}, and its blessed.toml names no scene file \
+                 that exists elsewhere"
+            ),
             OrphanKind::PassGone => format!("no golden pass of {scene} is written to this file"),
             OrphanKind::Unrecorded => {
                 format!("{scene}/blessed.toml does not record it (copied in, not blessed)")
@@ -75,7 +78,17 @@ pub fn find(
     if let Some(canonical) = canonical {
         for (name, path, is_dir) in entries(store.root())? {
             let known = TOP_LEVEL.contains(&name.as_str()) || canonical.contains(&name);
-            if !known {
+            // A scene file outside scenes/ keeps its folder while the file blessed.toml
+            // records for it is there.
+            let elsewhere = || {
+                is_dir
+                    && store
+                        .scene_file(&name)
+                        .ok()
+                        .flatten()
+                        .is_some_and(|file| file.is_file())
+            };
+            if !known && !elsewhere() {
                 let kind = if is_dir {
                     OrphanKind::SceneGone
                 } else {

@@ -95,6 +95,9 @@ pub struct Provenance<'a> {
     pub unverified: bool,
     /// Why the picture changed, as the person blessing said it (`harness bless --reason`).
     pub reason: Option<&'a str>,
+    /// The scene file, when the scene is not one of scenes/: recorded in blessed.toml so that
+    /// `bless --prune` keeps the folder while that file exists.
+    pub scene_file: Option<&'a Path>,
 }
 
 /// The name of a scene folder's lock file.
@@ -166,6 +169,9 @@ pub struct BlessRecord {
 
 #[derive(Debug, Default, serde::Serialize, serde::Deserialize)]
 struct BlessFile {
+    /// The scene file of a scene outside scenes/ (relative to the workspace when inside it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    scene_file: Option<PathBuf>,
     #[serde(default)]
     passes: BTreeMap<String, BlessRecord>,
 }
@@ -277,19 +283,33 @@ impl GoldenStore {
     /// What blessed.toml says about each pass of a scene, by the pass's name as the file has it
     /// (a file may name passes no plan has any more).
     pub fn records(&self, scene: &str) -> Result<BTreeMap<String, BlessRecord>, GoldenError> {
+        Ok(self.bless_file(scene)?.passes)
+    }
+
+    /// The scene file blessed.toml records for a scene outside scenes/ (see
+    /// [`Provenance::scene_file`]), as a path from here; None for a scene of scenes/.
+    pub fn scene_file(&self, scene: &str) -> Result<Option<PathBuf>, GoldenError> {
+        let workspace = self.root.parent().unwrap_or(Path::new(""));
+        Ok(self
+            .bless_file(scene)?
+            .scene_file
+            .map(|file| workspace.join(file)))
+    }
+
+    /// A scene's blessed.toml as read (empty when there is none).
+    fn bless_file(&self, scene: &str) -> Result<BlessFile, GoldenError> {
         let path = self.record_path(scene);
         if !path.exists() {
-            return Ok(BTreeMap::new());
+            return Ok(BlessFile::default());
         }
         let text = std::fs::read_to_string(&path).map_err(|e| GoldenError::Record {
             path: path.clone(),
             message: e.to_string(),
         })?;
-        let file: BlessFile = toml::from_str(&text).map_err(|e| GoldenError::Record {
+        toml::from_str(&text).map_err(|e| GoldenError::Record {
             path: path.clone(),
             message: e.to_string(),
-        })?;
-        Ok(file.passes)
+        })
     }
 
     /// Takes `scene`'s bless lock, waiting while another bless holds it (`on_wait` is called
@@ -341,6 +361,7 @@ impl GoldenStore {
             previous,
             unverified,
             reason,
+            scene_file,
         } = provenance;
         let scene = lock.scene();
         if let Some(values) = image.as_f32() {
@@ -374,7 +395,7 @@ impl GoldenStore {
                 reason: reason.map(str::to_owned),
             },
         );
-        self.write_records(lock, records)?;
+        self.write_records(lock, records, scene_file)?;
         Ok(path)
     }
 
@@ -383,23 +404,40 @@ impl GoldenStore {
     pub fn forget(&self, lock: &SceneLock, pass: &str) -> Result<(), GoldenError> {
         let mut records = self.records(lock.scene())?;
         if records.remove(pass).is_some() {
-            self.write_records(lock, records)?;
+            self.write_records(lock, records, None)?;
         }
         Ok(())
     }
 
-    /// Writes the locked scene's blessed.toml, atomically.
+    /// Writes the locked scene's blessed.toml, atomically, with `scene_file` as its scene file
+    /// (relative to the workspace when inside it), or the one it records when None.
     fn write_records(
         &self,
         lock: &SceneLock,
         records: BTreeMap<String, BlessRecord>,
+        scene_file: Option<&Path>,
     ) -> Result<(), GoldenError> {
         let path = self.record_path(lock.scene());
-        let text = toml::to_string_pretty(&BlessFile { passes: records }).map_err(|e| {
-            GoldenError::Record {
-                path: path.clone(),
-                message: e.to_string(),
+        let scene_file = match scene_file {
+            Some(file) => {
+                let workspace = self.root.parent().unwrap_or(Path::new(""));
+                let absolute = std::path::absolute(file).unwrap_or_else(|_| file.to_owned());
+                let workspace = std::path::absolute(workspace).unwrap_or_default();
+                Some(
+                    absolute
+                        .strip_prefix(&workspace)
+                        .map_or(absolute.clone(), Path::to_path_buf),
+                )
             }
+            None => self.bless_file(lock.scene())?.scene_file,
+        };
+        let file = BlessFile {
+            scene_file,
+            passes: records,
+        };
+        let text = toml::to_string_pretty(&file).map_err(|e| GoldenError::Record {
+            path: path.clone(),
+            message: e.to_string(),
         })?;
         let header = "# Written by `harness bless`: when each golden was blessed, from which \
                       backend and driver,\n# and how it differed from the golden it replaced.\n\n";

@@ -31,6 +31,7 @@ fn a_rewritten_golden_is_decoded_again() {
             previous: "new",
             unverified: false,
             reason: None,
+            scene_file: None,
         };
         store
             .bless(&lock, TargetId::Light, &image(value), provenance)
@@ -72,6 +73,7 @@ fn bless_writes_the_golden_and_the_record_and_refuses_nan() {
                 previous: "new",
                 unverified: false,
                 reason: Some("the sky's \"atan2\" changed"),
+                scene_file: None,
             },
         )
         .unwrap();
@@ -105,6 +107,7 @@ fn bless_writes_the_golden_and_the_record_and_refuses_nan() {
                 previous: "new",
                 unverified: false,
                 reason: None,
+                scene_file: None,
             },
         )
         .unwrap_err();
@@ -129,4 +132,56 @@ fn bless_writes_the_golden_and_the_record_and_refuses_nan() {
         "{err}"
     );
     let _ = std::fs::remove_dir_all(store.root());
+}
+
+/// A scene blessed from a file outside scenes/ records that file in blessed.toml (relative to
+/// the workspace), a later bless or a forgotten record keeps it, and its folder is no orphan
+/// while the file exists; once the file is gone, the folder is a scene gone.
+#[test]
+fn a_scene_file_elsewhere_keeps_its_golden_folder() {
+    use harness::golden::orphans::{find, OrphanKind};
+    let workspace = tempfile::tempdir().unwrap();
+    let store = GoldenStore::new(workspace.path().join("golden"));
+    let scene_file = workspace.path().join("mine/pyramid.toml");
+    std::fs::create_dir_all(scene_file.parent().unwrap()).unwrap();
+    std::fs::write(&scene_file, "").unwrap();
+    let image = Image {
+        width: 1,
+        height: 1,
+        format: TextureFormat::Rgba8Unorm,
+        data: ImageData::U8(vec![1, 2, 3, 255]),
+    };
+    let lock = store.lock_scene("pyramid", |_| {}).unwrap();
+    let bless = |pass, scene_file| {
+        let provenance = Provenance {
+            backend: BackendKind::Gl,
+            driver: "llvmpipe",
+            previous: "new",
+            unverified: false,
+            reason: None,
+            scene_file,
+        };
+        store.bless(&lock, pass, &image, provenance).unwrap();
+    };
+    bless(TargetId::Final, Some(scene_file.as_path()));
+    bless(TargetId::Mask(0), None);
+    store.forget(&lock, "mask").unwrap();
+    let text = std::fs::read_to_string(store.root().join("pyramid/blessed.toml")).unwrap();
+    assert!(
+        text.contains("scene_file = \"mine/pyramid.toml\""),
+        "{text}"
+    );
+    assert_eq!(
+        store.scene_file("pyramid").unwrap(),
+        Some(scene_file.clone())
+    );
+    drop(lock);
+    let orphans = || find(&store, &[], Some(&[])).unwrap();
+    assert!(orphans().is_empty(), "{:?}", orphans());
+    std::fs::remove_file(&scene_file).unwrap();
+    let gone = orphans();
+    assert!(
+        gone.len() == 1 && gone[0].kind == OrphanKind::SceneGone,
+        "{gone:?}"
+    );
 }
