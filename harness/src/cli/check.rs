@@ -355,14 +355,64 @@ fn print_diagnoses(run: &CheckRun) {
     if run.diagnoses.is_empty() {
         return;
     }
+    use harness::golden::diagnosis::Role;
     println!("\nwhy: where each change starts, and what to do");
     let mut seen: Vec<(&str, engine::plan::TargetId)> = Vec::new();
+    let mut scenes: Vec<&str> = Vec::new();
     for d in &run.diagnoses {
         if seen.contains(&(d.scene.as_str(), d.pass)) {
             continue;
         }
+        if !scenes.contains(&d.scene.as_str()) {
+            scenes.push(&d.scene);
+            print_load_warnings_of(run, &d.scene);
+        }
+        // A scene without goldens: one line for all its outputs, not a bless command each.
+        let mut uncompared: Vec<engine::plan::TargetId> = Vec::new();
+        for o in &run.diagnoses {
+            let new = !seen.contains(&(d.scene.as_str(), o.pass)) && !uncompared.contains(&o.pass);
+            if o.scene == d.scene && o.role == Role::NoComparison && new {
+                uncompared.push(o.pass);
+            }
+        }
+        if d.role == Role::NoComparison && uncompared.len() > 1 {
+            let folder = run
+                .results
+                .iter()
+                .find(|r| r.scene == d.scene && r.pass == d.pass && r.backend == d.backend)
+                .and_then(|r| r.artifacts.actual.as_deref()?.parent());
+            println!(
+                "  {}: nothing to compare with for {} outputs ({}); look at them{}; bless them \
+                 if they are right: `{}`",
+                d.scene,
+                uncompared.len(),
+                harness::names(&uncompared),
+                folder.map_or(String::new(), |f| format!(" in {}", f.display())),
+                harness::golden::command_line::bless_command(run.scene_argument(&d.scene))
+            );
+            seen.extend(uncompared.iter().map(|&p| (d.scene.as_str(), p)));
+            continue;
+        }
         seen.push((d.scene.as_str(), d.pass));
         println!("  {}/{}: {}; {}", d.scene, d.pass, d.headline(), d.advice);
+    }
+}
+
+/// A note under a failing scene that loaded with warnings: a material library, material or
+/// map the scene lost changes its picture, which a bless would make the golden.
+fn print_load_warnings_of(run: &CheckRun, scene: &str) {
+    let Some(inputs) = run.inputs.iter().find(|i| i.scene == scene) else {
+        return;
+    };
+    if let Some(first) = inputs.warnings.first() {
+        let more = match inputs.warnings.len() {
+            1 => String::new(),
+            n => format!("; {} more printed above", n - 1),
+        };
+        println!(
+            "  {scene}: loaded with warnings ({first}{more}): an asset the scene lost or read \
+             differently changes its picture; fix them before blessing"
+        );
     }
 }
 

@@ -2,7 +2,9 @@
 //! environment, meshes, material libraries and textures), each with a digest of its bytes, kept
 //! in last-check.json. Accepting the check's outputs compares them with the files as they are
 //! now: outputs rendered from a scene that has changed since are not that scene's pictures any
-//! more, verified or not, so they are refused with the files that changed.
+//! more, verified or not, so they are refused with the files that changed. The load's warnings
+//! are kept beside them: a material library or map the scene lost changes its picture, which a
+//! failing check's advice must say before it says bless.
 
 use std::path::PathBuf;
 
@@ -15,6 +17,10 @@ pub struct SceneInputs {
     pub scene: String,
     /// Each file the load read, with a digest of its bytes (None: unreadable when digested).
     pub files: Vec<(PathBuf, Option<String>)>,
+    /// What the load noted about untidy assets (a material library that cannot be read, a
+    /// material no library defines, generated normals, ...).
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 impl SceneInputs {
@@ -28,6 +34,7 @@ impl SceneInputs {
                 .iter()
                 .map(|file| (file.clone(), super::verify::file_digest(file)))
                 .collect(),
+            warnings: case.loaded.warnings.clone(),
         }
     }
 

@@ -131,3 +131,50 @@ fn the_untidy_crate_renders_with_its_textures_on_every_backend() {
         );
     }
 }
+
+/// `check` of the crate, which has no goldens: its verdict says once, not per output, that
+/// there is nothing to compare with, where the outputs are and the one bless command; and
+/// before that, that it loaded with warnings, which a bless would make part of its golden.
+#[test]
+fn checking_the_crate_says_its_warnings_before_it_says_bless() {
+    if !common::gl_available() {
+        return;
+    }
+    let out = tempfile::tempdir().unwrap();
+    let scene = harness::workspace_root().join("scenes/models/crate.toml");
+    let output = common::harness_command()
+        .args(["check", "--no-speed", "--no-verify", "--backend", "gl"])
+        .args(["--scene", scene.to_str().unwrap()])
+        .args(["--out", out.path().to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(1), "{stdout}");
+    let why: Vec<&str> = stdout
+        .split("\nwhy: where each change starts, and what to do\n")
+        .nth(1)
+        .unwrap_or_default()
+        .lines()
+        .take_while(|l| l.starts_with("  "))
+        .collect();
+    let [warnings, uncompared] = why[..] else {
+        panic!("two lines expected under why:\n{stdout}");
+    };
+    assert!(
+        warnings.starts_with("  crate: loaded with warnings (")
+            && warnings.contains("crate.obj:2: not UTF-8 at byte 21")
+            && warnings.contains(&format!(
+                "; {} more printed above)",
+                crate_scene().warnings.len() - 1
+            ))
+            && warnings.ends_with("fix them before blessing"),
+        "{warnings}"
+    );
+    let folder = out.path().join("failures/crate/gl");
+    assert!(
+        uncompared.starts_with("  crate: nothing to compare with for ")
+            && uncompared.contains(&format!("look at them in {};", folder.display()))
+            && uncompared.ends_with(&format!(" bless --scene {}`", scene.display())),
+        "{uncompared}"
+    );
+}

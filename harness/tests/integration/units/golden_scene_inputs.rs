@@ -10,6 +10,7 @@ fn inputs(files: &[(&str, Option<&str>)]) -> SceneInputs {
             .iter()
             .map(|(f, d)| (f.into(), d.map(str::to_owned)))
             .collect(),
+        warnings: Vec::new(),
     }
 }
 
