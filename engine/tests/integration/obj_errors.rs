@@ -275,6 +275,34 @@ fn missing_obj() {
     assert!(e.contains("cannot read file"), "{e}");
 }
 
+/// A face whose vertices mix forms (one names a texture coordinate or normal, another not)
+/// is refused with its line: loaded, it would leave the mesh without one per vertex, and all
+/// of them generated, with no line to find it by.
+#[test]
+fn a_face_that_mixes_vertex_forms_names_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("mixed.obj");
+    let head = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvn 0 0 1\n";
+    for (face, says) in [
+        (
+            "f 1/1 2/2 3/",
+            ":7: face mixes vertex forms: `1/1` names a texture coordinate and `3/` does not",
+        ),
+        (
+            "f 1//1 2 3//1",
+            ":7: face mixes vertex forms: `1//1` names a normal and `2` does not",
+        ),
+    ] {
+        std::fs::write(&path, format!("{head}{face}\n")).unwrap();
+        let e = engine::assets::load_obj(&path, &mut engine::assets::TextureCache::new())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(&format!("mixed.obj{says}")), "{e}");
+    }
+    std::fs::write(&path, format!("{head}f 1/1/1 2/2/1 3/1/1\n")).unwrap();
+    assert!(engine::assets::load_obj(&path, &mut engine::assets::TextureCache::new()).is_ok());
+}
+
 #[test]
 fn random_garbage_never_panics() {
     // Deterministic xorshift fuzz over OBJ-ish tokens.

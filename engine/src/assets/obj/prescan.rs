@@ -177,14 +177,34 @@ impl Prescan {
         Ok(())
     }
 
-    /// `f v1 v2 v3 ...`: every vertex checked against the elements seen so far.
+    /// `f v1 v2 v3 ...`: every vertex checked against the elements seen so far, and all of one
+    /// form (each names a texture coordinate, or none does; the same for normals): a face that
+    /// mixes them would leave the mesh's texture coordinates or normals without one per vertex,
+    /// and all of them generated.
     fn face<'a>(&mut self, toks: impl Iterator<Item = &'a str>, rest: &str) -> Result<(), String> {
         let mut count = 0usize;
+        let mut first: Option<(&str, [bool; 2])> = None;
         for t in toks {
-            check_face_vertex(
+            let form = check_face_vertex(
                 t,
                 [self.scan.positions, self.scan.texcoords, self.scan.normals],
             )?;
+            match first {
+                None => first = Some((t, form)),
+                Some((f, first_form)) if first_form != form => {
+                    let (what, has) = if first_form[0] == form[0] {
+                        ("a normal", first_form[1])
+                    } else {
+                        ("a texture coordinate", first_form[0])
+                    };
+                    let (with, without) = if has { (f, t) } else { (t, f) };
+                    return Err(format!(
+                        "face mixes vertex forms: `{with}` names {what} and `{without}` does not \
+                         (every vertex of a face has the same form: v, v/vt, v//vn or v/vt/vn)"
+                    ));
+                }
+                Some(_) => {}
+            }
             count += 1;
         }
         if count < 3 {
@@ -302,8 +322,10 @@ const INDEX_KINDS: [(&str, &str); 3] = [
 ];
 
 /// Checks one `v`, `v/vt`, `v//vn` or `v/vt/vn` face vertex against the
-/// element counts seen so far. Never allocates based on an index value.
-fn check_face_vertex(tok: &str, counts: [usize; 3]) -> Result<(), String> {
+/// element counts seen so far, and says whether it names a texture coordinate and a normal.
+/// Never allocates based on an index value.
+fn check_face_vertex(tok: &str, counts: [usize; 3]) -> Result<[bool; 2], String> {
+    let mut form = [false; 2];
     for (k, part) in tok.split('/').enumerate() {
         let (Some((kind, plural)), Some(&count)) = (INDEX_KINDS.get(k), counts.get(k)) else {
             return Err(format!("face vertex `{tok}` has more than 3 components"));
@@ -313,6 +335,9 @@ fn check_face_vertex(tok: &str, counts: [usize; 3]) -> Result<(), String> {
                 return Err(format!("face vertex `{tok}` has no position index"));
             }
             continue;
+        }
+        if let Some(named) = k.checked_sub(1).and_then(|i| form.get_mut(i)) {
+            *named = true;
         }
         let count_u = count as u64;
         match part.parse::<i64>() {
@@ -335,7 +360,7 @@ fn check_face_vertex(tok: &str, counts: [usize; 3]) -> Result<(), String> {
             }
         }
     }
-    Ok(())
+    Ok(form)
 }
 
 #[cfg(test)]
@@ -345,9 +370,10 @@ mod tests {
     #[test]
     fn face_vertex_checks() {
         let c = [3, 2, 1];
-        assert_eq!(check_face_vertex("1", c), Ok(()));
-        assert_eq!(check_face_vertex("-3/-2/-1", c), Ok(()));
-        assert_eq!(check_face_vertex("3//1", c), Ok(()));
+        assert_eq!(check_face_vertex("1", c), Ok([false, false]));
+        assert_eq!(check_face_vertex("-3/-2/-1", c), Ok([true, true]));
+        assert_eq!(check_face_vertex("3//1", c), Ok([false, true]));
+        assert_eq!(check_face_vertex("3/1/", c), Ok([true, false]));
         assert!(check_face_vertex("4", c).is_err_and(|e| e.contains("4 out of range")));
         assert!(check_face_vertex("1/3", c).is_err_and(|e| e.contains("texture coordinate")));
         assert!(check_face_vertex("1/1/2", c).is_err_and(|e| e.contains("normal index 2")));
