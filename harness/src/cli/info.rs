@@ -85,5 +85,23 @@ pub(crate) fn plan(scene: &str) -> anyhow::Result<ExitCode> {
     // The plan of the scene as drawn: an extracted sun's light and shadow map are in it.
     let prepared = engine::renderer::PreparedFrame::new(&loaded.scene)?;
     print!("{}", prepared.plan());
+    // The shadow terms are debug outputs, planned only when asked for (`render --pass`, and
+    // the golden suite, which always asks): named here, since they have goldens too.
+    let mut with_terms = loaded.scene.clone();
+    with_terms.quality.debug_shadow_terms = true;
+    let planned = prepared.plan().target_ids();
+    let terms: Vec<engine::plan::TargetId> = engine::renderer::PreparedFrame::new(&with_terms)?
+        .plan()
+        .target_ids()
+        .into_iter()
+        .filter(|t| !planned.contains(t))
+        .collect();
+    if !terms.is_empty() {
+        println!(
+            "debug outputs (planned when asked for: `render --pass NAME` or `--pass all`; \
+             golden outputs too): {}",
+            harness::names(&terms)
+        );
+    }
     Ok(ExitCode::SUCCESS)
 }

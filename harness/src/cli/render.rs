@@ -19,10 +19,13 @@ pub(crate) fn run(
 ) -> anyhow::Result<ExitCode> {
     let mut loaded = harness::load_scene(scene)?;
     print_load_warnings(&loaded);
-    // A shadow term is a debug output, planned when asked for (the golden suite always asks).
+    // A shadow term is a debug output, planned when asked for (the golden suite always asks):
+    // by name, or by `all`, which writes every output a golden holds.
     let shadow_term = |name: &String| {
-        name.parse::<TargetId>()
-            .is_ok_and(|t| matches!(t, TargetId::ShadowTerm { .. }))
+        name == "all"
+            || name
+                .parse::<TargetId>()
+                .is_ok_and(|t| matches!(t, TargetId::ShadowTerm { .. }))
     };
     if passes.iter().any(shadow_term) {
         loaded.scene.quality.debug_shadow_terms = true;
@@ -54,6 +57,7 @@ pub(crate) fn run(
                 )
             })?
     };
+    check_out_path(out.as_deref(), &targets, plan)?;
     let mut backend = harness::faults::create_backend(kind)?;
     eprintln!(
         "rendering {} ({}x{}) on {kind} ...",
@@ -88,4 +92,46 @@ pub(crate) fn run(
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses, before anything is rendered, an `--out` that names a file (it has an extension)
+/// where several outputs are asked for (they go into a folder), or one it cannot write: EXR
+/// holds a float output, PNG any (a float one clamped to 0..1).
+fn check_out_path(
+    out: Option<&std::path::Path>,
+    targets: &[TargetId],
+    plan: &engine::plan::RenderPlan,
+) -> anyhow::Result<()> {
+    use engine::backend::TextureFormat;
+    let Some(extension) = out.and_then(|o| o.extension()) else {
+        return Ok(());
+    };
+    let out = out.unwrap_or(std::path::Path::new("")).display();
+    let [target] = targets else {
+        anyhow::bail!(
+            "--out {out} names a file, but {} outputs are asked for: give a folder",
+            targets.len()
+        );
+    };
+    let eight_bit = plan.target(*target).is_some_and(|t| {
+        matches!(
+            t.format,
+            TextureFormat::Rgba8Unorm | TextureFormat::Rgba8UnormSrgb
+        )
+    });
+    // PNG holds any output; EXR a float one.
+    let writable = extension.eq_ignore_ascii_case("png")
+        || (extension.eq_ignore_ascii_case("exr") && !eight_bit);
+    if !writable {
+        anyhow::bail!(
+            "--out {out}: {target} is {}, written as {} (or give a folder)",
+            if eight_bit { "8-bit" } else { "floating point" },
+            if eight_bit {
+                ".png"
+            } else {
+                ".exr, or .png clamped to 0..1"
+            }
+        );
+    }
+    Ok(())
 }

@@ -103,7 +103,7 @@ fn check_pass_checks_only_that_pass_and_rejects_an_unknown_one() {
 }
 
 /// `render` takes a scene file path as well as a name, and writes every pass with `--pass all`
-/// (PNG for 8-bit outputs, EXR for float ones).
+/// (PNG for 8-bit outputs, EXR for float ones; the shadow terms, which have goldens, too).
 #[test]
 fn render_writes_every_pass_of_a_scene_file() {
     if !common::gl_available() {
@@ -133,8 +133,33 @@ fn render_writes_every_pass_of_a_scene_file() {
         "gbuffer_tangent.exr",
         "gbuffer_albedo.exr",
         "gbuffer_material.exr",
+        "shadow_term_0.exr",
     ] {
         assert!(dir.path().join(file).is_file(), "{file} missing:\n{stdout}");
+    }
+    // A file's name where a folder is needed, or the other format's extension: refused before
+    // anything is rendered, and nothing is written.
+    for (pass, out, says) in [
+        (
+            "all",
+            "out.png",
+            "names a file, but 12 outputs are asked for: give a folder",
+        ),
+        ("final", "final.exr", "final is 8-bit, written as .png"),
+        (
+            "light",
+            "light.jpg",
+            "light is floating point, written as .exr, or .png",
+        ),
+    ] {
+        let out = dir.path().join(out);
+        let args = ["render", "--scene", "arrow", "--pass", pass, "--out"];
+        let (code, _, stderr) = harness(&[&args[..], &[out.to_str().unwrap()]].concat());
+        assert_eq!(code, 1, "{stderr}");
+        assert!(
+            stderr.contains(says) && !stderr.contains("rendering ") && !out.exists(),
+            "{stderr}"
+        );
     }
     let (code, _, stderr) = harness(&["render", "--scene", "arrow", "--pass", "shadow"]);
     assert_eq!(code, 1);
@@ -190,6 +215,15 @@ fn plan_and_render_know_the_extracted_sun() {
     assert_eq!(code, 0, "{stderr}");
     assert!(
         stdout.contains("shadow_0") && stdout.contains("directional"),
+        "{stdout}"
+    );
+    // Its shadow term, a debug output with a golden, is named though not planned.
+    assert!(
+        stdout
+            .lines()
+            .last()
+            .is_some_and(|l| l.starts_with("debug outputs (")
+                && l.ends_with("golden outputs too): shadow_term_0")),
         "{stdout}"
     );
     let out = dir.path().join("shadow_0.exr");
