@@ -269,8 +269,18 @@ fn check_environment(scene: &Scene) -> Result<(), String> {
     if let Some(problem) = scene.quality.ibl.problem() {
         return Err(problem);
     }
-    if !(env.intensity.is_finite() && env.intensity >= 0.0 && env.rotation_degrees.is_finite()) {
-        return Err("environment intensity and rotation must be finite".into());
+    if !(env.intensity.is_finite() && env.intensity >= 0.0) {
+        return Err(format!(
+            "environment intensity {} must be finite and at least 0 (an environment cannot take \
+             light away)",
+            env.intensity
+        ));
+    }
+    if !env.rotation_degrees.is_finite() {
+        return Err(format!(
+            "environment rotation_degrees {} must be finite",
+            env.rotation_degrees
+        ));
     }
     let image = &env.image;
     if image.width == 0

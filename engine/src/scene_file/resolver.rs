@@ -213,10 +213,22 @@ impl Resolver {
         })
     }
 
-    /// `[camera]`, whose values must be finite.
+    /// `[camera]`, whose values must be finite (the first that is not is named).
     fn camera(&self, c: &CameraSpec) -> Result<Camera, SceneFileError> {
-        if !finite(&[c.fov_y, c.near, c.far]) || !finite(&c.position) || !finite(&c.target) {
-            return Err(self.invalid("[camera]: values must be finite".into()));
+        let values: [(&str, &[f64]); 6] = [
+            ("position", &c.position),
+            ("target", &c.target),
+            ("up", &c.up),
+            ("fov_y", &[c.fov_y]),
+            ("near", &[c.near]),
+            ("far", &[c.far]),
+        ];
+        if let Some((key, value)) = values.iter().find(|(_, v)| !finite(v)) {
+            let value = match value {
+                [one] => one.to_string(),
+                many => format!("{many:?}"),
+            };
+            return Err(self.invalid(format!("[camera] {key} = {value}: values must be finite")));
         }
         Ok(Camera {
             position: DVec3::from(c.position),

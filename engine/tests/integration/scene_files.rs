@@ -109,8 +109,9 @@ fn load_error(dir: &Path, name: &str, text: &str) -> SceneFileError {
 
 /// A name that cannot be one folder (it names `golden/<name>/` and the failure images' folder),
 /// a list of other than three numbers where three are read (TOML's lists would otherwise keep
-/// the first three), and a far / near ratio a 32-bit depth buffer cannot hold are refused,
-/// naming the file.
+/// the first three), a far / near ratio a 32-bit depth buffer cannot hold, a camera value that
+/// is not finite and an environment that takes light away are refused, naming the file (and
+/// the value).
 #[test]
 fn names_that_leave_their_folder_lists_of_four_and_depth_beyond_f32_are_refused() {
     let temp = tempfile::tempdir().unwrap();
@@ -152,6 +153,22 @@ fn names_that_leave_their_folder_lists_of_four_and_depth_beyond_f32_are_refused(
     )
     .to_string();
     assert!(e.contains("depth.toml") && e.contains("over 2^24"), "{e}");
+    // A value out of range is named with what was read.
+    let nan = "[camera]\nposition = [1.4, nan, 1.8]\ntarget = [0, 0, 0]\n";
+    let e = load_error(dir, "nan.toml", nan).to_string();
+    assert!(
+        e.contains("nan.toml")
+            && e.ends_with("[camera] position = [1.4, NaN, 1.8]: values must be finite"),
+        "{e}"
+    );
+    std::fs::copy(fixture("sky.hdr"), dir.join("sky.hdr")).unwrap();
+    let dark = format!("{CAMERA}[environment]\npath = \"sky.hdr\"\nintensity = -1.0\n");
+    let e = load_error(dir, "dark.toml", &dark).to_string();
+    assert!(
+        e.contains("dark.toml")
+            && e.contains("environment intensity -1 must be finite and at least 0"),
+        "{e}"
+    );
 }
 
 /// A scene file may light its scene with a Radiance `.hdr` environment as well as an EXR: its
