@@ -18,6 +18,9 @@ pub enum InspectError {
     /// A scene file failed to load.
     #[error(transparent)]
     Scene(#[from] scene_file::SceneFileError),
+    /// A scene's `[tolerances]` do not fit its golden passes (as `check` would refuse them).
+    #[error(transparent)]
+    Tolerances(#[from] Box<crate::golden::suite::SuiteError>),
     /// The extension is not one `inspect` knows.
     #[error("{0}: don't know how to inspect this (expected .obj, .mtl, .toml, an environment (.exr, .hdr) or a texture (.png, .jpg, .tga, .bmp))")]
     UnknownKind(String),
@@ -111,6 +114,11 @@ fn inspect_environment(path: &Path) -> Result<Value, InspectError> {
 /// A scene file: its objects, lights, environment, textures and render plan.
 fn inspect_scene(path: &Path) -> Result<Value, InspectError> {
     let loaded = scene_file::load(path)?;
+    // Its tolerances read against its golden passes, as `check` reads them (the scene is
+    // loaded again for that, only when it has any).
+    if !loaded.tolerances.is_empty() {
+        crate::golden::suite::Case::load(&path.to_string_lossy()).map_err(Box::new)?;
+    }
     let scene = &loaded.scene;
     let objects: Vec<Value> = scene.objects.iter().map(object_json).collect();
     let lights: Vec<Value> = scene.lights.iter().map(light_json).collect();

@@ -43,6 +43,30 @@ fn inspect_fails_cleanly_on_every_malformed_fixture() {
         );
         assert!(!stderr.contains("panicked"), "{file}: panicked:\n{stderr}");
     }
+    // A scene whose tolerances `check` would refuse: a pass it has no golden of, a limit that
+    // can never be exceeded.
+    let dir = tempfile::tempdir().unwrap();
+    let corner = std::fs::read_to_string(harness::scenes_dir().join("corner.toml")).unwrap();
+    let corner = corner.replace(
+        "\"assets/",
+        &format!("\"{}/", harness::scenes_dir().join("assets").display()),
+    );
+    for (table, expected) in [
+        (
+            "[tolerances.finale]\nmetric = \"rmse\"\nmax = 0.1\n",
+            "the scene has no golden pass `finale`",
+        ),
+        (
+            "[tolerances.final]\nmetric = \"flip_mean\"\nmax = 5\n",
+            "`max` 5 can never be exceeded",
+        ),
+    ] {
+        let path = dir.path().join("tolerant.toml");
+        std::fs::write(&path, format!("{corner}\n{table}")).unwrap();
+        let (code, _, stderr) = harness(&["inspect", path.to_str().unwrap()]);
+        assert_eq!(code, 1, "{stderr}");
+        assert!(stderr.contains(expected), "{stderr}");
+    }
 }
 
 #[test]

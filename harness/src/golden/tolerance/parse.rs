@@ -143,6 +143,18 @@ impl Rule {
                 "`max` {limit} is negative: no render could pass (0 asks for no difference)"
             )));
         }
+        // A fraction of pixels and a FLIP error lie in 0..1: a `max` of 1 or more lets every
+        // render pass, a check that cannot fire.
+        let fraction = matches!(
+            metric,
+            Metric::FractionOver { .. } | Metric::FlipMean | Metric::FlipPercentile { .. }
+        );
+        if fraction && limit >= 1.0 {
+            return Err(err(format!(
+                "`max` {limit} can never be exceeded: {name} lies in 0..1, so every render \
+                 would pass (a limit below 1 checks something)"
+            )));
+        }
         if let Metric::FractionOver { threshold, .. } = metric {
             if threshold < 0.0 {
                 return Err(err(format!(

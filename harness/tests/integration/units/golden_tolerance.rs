@@ -88,4 +88,18 @@ shift = 1"#,
         "{e}"
     );
     assert!(rule("metric = \"max_abs\"\nmax = 0").is_ok());
+    // A limit no render could exceed: a fraction or a FLIP error at 1 or more.
+    for metric in [
+        "metric = \"flip_mean\"\nmax = 5",
+        "metric = \"flip_percentile\"\npercentile = 0.99\nmax = 1",
+        "metric = \"fraction_over\"\nthreshold = 0.01\nmax = 1.5",
+    ] {
+        let e = rule(metric).unwrap_err().to_string();
+        assert!(
+            e.contains("can never be exceeded") && e.contains("lies in 0..1"),
+            "{e}"
+        );
+    }
+    assert!(rule("metric = \"flip_mean\"\nmax = 0.99").is_ok());
+    assert!(rule("metric = \"rmse\"\nmax = 5").is_ok());
 }
