@@ -173,6 +173,17 @@ fn object_json(o: &Object) -> Value {
     .into_iter()
     .filter_map(|(name, map)| map.map(|_| name))
     .collect();
+    // A map replaces its value (the Quarantamaula engine's rule; the MTL specification
+    // multiplies `Kd` by `map_Kd`): these values are not what is drawn.
+    let replaced: Vec<&str> = [
+        ("base_color", m.base_color_map),
+        ("roughness", m.roughness_map),
+        ("metallic", m.metallic_map),
+        ("clearcoat", m.clearcoat_map),
+    ]
+    .into_iter()
+    .filter_map(|(name, map)| map.map(|_| name))
+    .collect();
     json!({
         "name": o.name,
         "mesh": o.mesh.name,
@@ -186,6 +197,7 @@ fn object_json(o: &Object) -> Value {
         "clearcoat": m.clearcoat,
         "anisotropy": m.anisotropy,
         "maps": maps,
+        "replaced_by_maps": replaced,
     })
 }
 
@@ -303,10 +315,18 @@ pub fn to_text(value: &Value) -> String {
                 line(&mut out, format!("  {d}"));
             }
             for o in value["objects"].as_array().into_iter().flatten() {
+                let from_map = o["replaced_by_maps"]
+                    .as_array()
+                    .is_some_and(|r| r.iter().any(|v| v == "base_color"));
+                let base_color = if from_map {
+                    "its map".to_owned()
+                } else {
+                    short(&o["base_color"])
+                };
                 line(
                     &mut out,
                     format!(
-                        "  object {:<28} {:>6} triangles  {:<11} maps {}",
+                        "  object {:<28} {:>6} triangles  {:<11} base color {base_color}  maps {}",
                         o["name"].as_str().unwrap_or(""),
                         o["triangles"],
                         o["lighting"].as_str().unwrap_or(""),
@@ -333,6 +353,7 @@ pub fn to_text(value: &Value) -> String {
             }
             out.push_str(value["plan"].as_str().unwrap_or(""));
         }
+        Some("mtl") => mtl_text(&mut out, value),
         Some("texture") => {
             let t = &value["texture"];
             line(
@@ -370,4 +391,76 @@ pub fn to_text(value: &Value) -> String {
         }
     }
     out
+}
+
+/// The texture and warning lines of an MTL's [`to_text`].
+fn text_textures_and_warnings(out: &mut String, value: &Value) {
+    for t in value["textures"].as_array().into_iter().flatten() {
+        out.push_str(&format!(
+            "  texture {} {}x{} {} mips {}\n",
+            t["path"].as_str().unwrap_or(""),
+            t["width"],
+            t["height"],
+            t["mips"],
+            t["color_space"].as_str().unwrap_or("")
+        ));
+    }
+    for w in value["warnings"].as_array().into_iter().flatten() {
+        out.push_str(&format!("  warning: {}\n", w.as_str().unwrap_or("")));
+    }
+}
+
+/// A JSON number, or list of numbers, read from f32 values, as their shortest decimals
+/// (`[0.8, 0.7, 0.6]`, not `[0.800000011920929, ...]`); `-` for null.
+fn short(value: &Value) -> String {
+    let number = |v: &Value| {
+        v.as_f64()
+            .map_or_else(|| v.to_string(), |x| (x as f32).to_string())
+    };
+    match value {
+        Value::Null => "-".to_owned(),
+        Value::Array(items) => {
+            let items: Vec<String> = items.iter().map(number).collect();
+            format!("[{}]", items.join(", "))
+        }
+        other => number(other),
+    }
+}
+
+/// [`to_text`] of an MTL: its materials (an unused `Kd` marked so), textures and warnings.
+fn mtl_text(out: &mut String, value: &Value) {
+    let line = |out: &mut String, s: String| {
+        out.push_str(&s);
+        out.push('\n');
+    };
+    line(out, format!("MTL {}", value["path"].as_str().unwrap_or("")));
+    for m in value["materials"].as_array().into_iter().flatten() {
+        let maps: Vec<&str> = m["maps"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(|map| map["slot"].as_str())
+            .collect();
+        let kd = match &m["diffuse"] {
+            Value::Null => "-".to_owned(),
+            kd if maps.contains(&"base_color") => {
+                format!("{} (unused: map_Kd replaces it)", short(kd))
+            }
+            kd => short(kd),
+        };
+        line(
+            out,
+            format!(
+                "  material {}  Kd {kd}  Ns {}  maps {}",
+                m["name"].as_str().unwrap_or(""),
+                short(&m["shininess"]),
+                if maps.is_empty() {
+                    "none".to_owned()
+                } else {
+                    maps.join(", ")
+                }
+            ),
+        );
+    }
+    text_textures_and_warnings(out, value);
 }

@@ -75,7 +75,11 @@ fn inspect_loads_fixtures_that_only_warn() {
         ("unknown_keys.obj", "unknown MTL key"),
         ("points_lines.obj", "skipped"),
         ("ngons.obj", "triangulated"),
-        ("textured.mtl", ""),
+        // As text, not JSON; a `Kd` beside a `map_Kd` is said to be unused.
+        (
+            "textured.mtl",
+            "  material brick  Kd [0.8, 0.7, 0.6] (unused: map_Kd replaces it)  Ns 32  maps base_color,",
+        ),
         ("non_utf8.obj", "non_utf8.obj:4: not UTF-8"),
         ("missing_mtl.obj", "does_not_exist.mtl` cannot be read"),
         ("latin1_mtl.obj", "latin1.mtl:1: not UTF-8"),
@@ -104,6 +108,19 @@ fn inspect_loads_fixtures_that_only_warn() {
     assert_eq!(code, 0);
     let value: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     assert_eq!(value["textures_decoded"], 3);
+    // Which values of an object its maps replace (its base_color is not what is drawn).
+    let replaced: Vec<&serde_json::Value> = value["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| &o["replaced_by_maps"])
+        .collect();
+    assert!(
+        replaced
+            .iter()
+            .any(|r| r.as_array().unwrap().contains(&"base_color".into())),
+        "{replaced:?}"
+    );
 }
 
 /// `harness inspect` on a JPEG-textured OBJ lists its textures with their sizes, bit depths and
