@@ -6,7 +6,7 @@
 //! are kept beside them: a material library or map the scene lost changes its picture, which a
 //! failing check's advice must say before it says bless.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use super::suite::Case;
 
@@ -15,7 +15,8 @@ use super::suite::Case;
 pub struct SceneInputs {
     /// The scene.
     pub scene: String,
-    /// Each file the load read, with a digest of its bytes (None: unreadable when digested).
+    /// Each file the load read ([`input_name`]), with a digest of its bytes (None: unreadable
+    /// when digested).
     pub files: Vec<(PathBuf, Option<String>)>,
     /// What the load noted about untidy assets (a material library that cannot be read, a
     /// material no library defines, generated normals, ...).
@@ -32,7 +33,7 @@ impl SceneInputs {
                 .loaded
                 .files
                 .iter()
-                .map(|file| (file.clone(), super::verify::file_digest(file)))
+                .map(|file| (input_name(file), super::verify::file_digest(file)))
                 .collect(),
             warnings: case.loaded.warnings.clone(),
         }
@@ -75,4 +76,17 @@ impl SceneInputs {
             )
         })
     }
+}
+
+/// A file a scene was loaded from as the check records it: relative to the workspace when it
+/// lies inside (so that a check made in another checkout, a CI job's, compares with this
+/// checkout's files, and two workspaces share a verification), else absolute.
+pub fn input_name(file: &Path) -> PathBuf {
+    let root = crate::workspace_root();
+    let root = root.canonicalize().unwrap_or(root);
+    let file = file
+        .canonicalize()
+        .unwrap_or_else(|_| std::path::absolute(file).unwrap_or_else(|_| file.to_owned()));
+    file.strip_prefix(&root)
+        .map_or_else(|_| file.clone(), Path::to_path_buf)
 }

@@ -147,7 +147,7 @@ pub fn inputs_digest(store: &GoldenStore, case: &Case) -> String {
         .unwrap_or_default()
         .hash(&mut hasher);
     for file in &case.loaded.files {
-        file.hash(&mut hasher);
+        super::scene_inputs::input_name(file).hash(&mut hasher);
         std::fs::read(file).unwrap_or_default().hash(&mut hasher);
     }
     if let Ok(meta) = std::env::current_exe().and_then(std::fs::metadata) {
