@@ -47,6 +47,16 @@ impl MeshData {
     ) -> MeshData {
         let pos = finite_positions(name, positions, notes);
         let tris = valid_triangles(name, indices, positions.len(), notes);
+        if closed_signed_volume(&pos, &tris).is_some_and(|volume| volume < 0.0) {
+            note_warn(
+                notes,
+                format!(
+                    "mesh `{name}`: a closed surface whose triangles are wound clockwise seen \
+                     from outside (it encloses a negative volume), so its outside faces away: \
+                     counter-clockwise triangles are front faces (reverse each face's vertices)"
+                ),
+            );
+        }
         let nrm = vertex_normals(name, normals, &pos, &tris, notes);
         let uv = vertex_uvs(name, uvs, &pos, notes);
 
@@ -144,6 +154,46 @@ fn valid_triangles(
         );
     }
     tris
+}
+
+/// The volume a closed, consistently wound surface encloses, signed (negative: its triangles
+/// turn clockwise seen from outside); None for an open surface, one whose edges are not each
+/// shared by exactly two triangles in opposite directions, or a flat one. Vertices are welded
+/// by position, since a loader splits them by texture coordinate and normal.
+fn closed_signed_volume(pos: &[Vec3], tris: &[[u32; 3]]) -> Option<f64> {
+    use std::collections::HashMap;
+    let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
+    let welded: Vec<u32> = pos
+        .iter()
+        .map(|p| {
+            let next = ids.len() as u32;
+            *ids.entry(p.to_array().map(f32::to_bits)).or_insert(next)
+        })
+        .collect();
+    // Per undirected edge: how many triangles use it, and the sum of their directions.
+    let mut edges: HashMap<(u32, u32), (u32, i32)> = HashMap::new();
+    let mut volume = 0.0f64;
+    let mut size = 0.0f64;
+    for tri in tris {
+        let [a, b, c] = tri.map(|i| welded.get(i as usize).copied());
+        let [p, q, r] = tri.map(|i| pos.get(i as usize).map(|p| p.as_dvec3()));
+        let (Some(a), Some(b), Some(c), Some(p), Some(q), Some(r)) = (a, b, c, p, q, r) else {
+            return None;
+        };
+        if a == b || b == c || c == a {
+            continue;
+        }
+        for (from, to) in [(a, b), (b, c), (c, a)] {
+            let entry = edges.entry((from.min(to), from.max(to))).or_default();
+            entry.0 += 1;
+            entry.1 += if from < to { 1 } else { -1 };
+        }
+        volume += p.dot(q.cross(r)) / 6.0;
+        size = size.max(p.abs().max_element());
+    }
+    let closed = !edges.is_empty() && edges.values().all(|&(count, sum)| count == 2 && sum == 0);
+    // Flat within rounding: no inside to speak of.
+    (closed && volume.abs() > 1e-9 * size.powi(3).max(f64::MIN_POSITIVE)).then_some(volume)
 }
 
 /// Unit normals: the given ones where usable (zero or non-finite ones replaced by generated

@@ -220,3 +220,34 @@ fn a_vertex_shared_by_thousands_of_triangles_gets_accumulated_tangents() {
         );
     }
 }
+
+/// A closed surface wound clockwise seen from outside is a warning naming the mesh and the
+/// rule; wound counter-clockwise, or open, it is not. Vertices split by texture coordinate
+/// (as a loader splits them) are the same corner.
+#[test]
+fn an_inside_out_closed_surface_is_warned_about() {
+    // A tetrahedron, counter-clockwise seen from outside, its apex twice (two UVs).
+    let positions = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let outward: [u32; 12] = [0, 2, 1, 0, 1, 3, 1, 2, 4, 2, 0, 4];
+    let inward: Vec<u32> = outward.chunks(3).flat_map(|t| [t[0], t[2], t[1]]).collect();
+    let warned = |indices: &[u32]| {
+        let mut notes = Vec::new();
+        engine::assets::MeshData::from_triangles(
+            "tet", &positions, None, None, indices, &mut notes,
+        );
+        notes.iter().any(|n| {
+            n.starts_with("mesh `tet`: a closed surface whose triangles are wound clockwise")
+                && n.contains("counter-clockwise triangles are front faces")
+        })
+    };
+    assert!(!warned(&outward));
+    assert!(warned(&inward));
+    // Open (one face fewer), either way: no inside to speak of.
+    assert!(!warned(&inward[3..]));
+}
