@@ -343,9 +343,9 @@ fn bless_images(
         }
         if !harness::golden::bless::is_canonical(case) {
             println!(
-                "note: {} is not in scenes/: `check` checks it only when named with --scene, and \
-                 `bless --prune` keeps golden/{}/ while the file is there (move it into scenes/ \
-                 to make it part of the suite)",
+                "note: {} is not a canonical scene (a file directly in scenes/): `check` checks \
+                 it only when named with --scene, and `bless --prune` keeps golden/{}/ while the \
+                 file is there (put it directly in scenes/ to make it part of the suite)",
                 case.loaded.path.display(),
                 case.name()
             );
@@ -466,10 +466,19 @@ pub(crate) fn from_last_check(
                 dry_run,
                 unverified,
                 reason: options.reason.as_deref(),
+                check_out: Some(out),
             },
             |source| eprintln!("verifying {}'s new goldens under {source} ...", case.name()),
-        )
-        .map_err(anyhow::Error::msg)?;
+        );
+        // A scene refused whole (changed since the check, say) leaves the others to accept.
+        let done = match done {
+            Ok(done) => done,
+            Err(why) => {
+                println!("REFUSED {why}");
+                refused += mine.len();
+                continue;
+            }
+        };
         if done.verified_by_check {
             let outcome = if done.disagreements.is_empty() {
                 "verified by the last check"

@@ -229,6 +229,8 @@ pub struct AcceptOptions<'a> {
     pub unverified: bool,
     /// Why the pictures changed, recorded in blessed.toml (`--reason`).
     pub reason: Option<&'a str>,
+    /// The last check's folder: where a refused scene's check, run again, must write.
+    pub check_out: Option<&'a Path>,
 }
 
 /// A kept output, as `check` wrote it (PNG for 8-bit passes, EXR for float ones).
@@ -298,7 +300,17 @@ pub fn speed_candidates(
             Some((c.scene.clone(), r.scene_argument.clone()))
         })
         .collect();
-    Ok((checks, CheckContext { hosts, arguments }))
+    let inputs = run.inputs;
+    let out = out.to_owned();
+    Ok((
+        checks,
+        CheckContext {
+            hosts,
+            arguments,
+            inputs,
+            out,
+        },
+    ))
 }
 
 /// What accepting the last check's speed checks needs to know of that check.
@@ -310,6 +322,10 @@ pub struct CheckContext {
     /// Each scene as the check was given it (a name in scenes/ or a scene file's path), by
     /// name: what a printed command names to find it again.
     pub arguments: std::collections::BTreeMap<String, String>,
+    /// The files each scene was loaded from: a scene changed since has its timings refused.
+    pub inputs: Vec<crate::golden::scene_inputs::SceneInputs>,
+    /// The check's folder.
+    pub out: std::path::PathBuf,
 }
 
 impl CheckContext {
@@ -359,6 +375,13 @@ pub fn accept_timings(
     use crate::golden::speed::{cpu_signature, Stamp, TimingGoldens};
     use crate::measure::speed::{PassSpeed, SceneSpeed};
     let scene = lock.scene();
+    // Timings of the scene as it was are not the scene's as it is, as for its images.
+    if let Some(then) = check.inputs.iter().find(|i| i.scene == scene) {
+        let changed = then.changed_on_disk();
+        if let Some(why) = then.refusal(&changed, check.scene_argument(scene), Some(&check.out)) {
+            return Err(why);
+        }
+    }
     let cpu = cpu_signature();
     let mut goldens = TimingGoldens::load(store.root(), scene).map_err(|e| e.to_string())?;
     let blessed = humantime::format_rfc3339_seconds(SystemTime::now()).to_string();
@@ -474,11 +497,11 @@ pub fn accept_scene(
         return Err(why);
     }
     // Outputs of the scene as it was are not goldens of the scene as it is, verified or not.
-    let now = crate::golden::scene_inputs::SceneInputs::of(case);
-    if let Some(why) = candidates
-        .iter()
-        .find_map(|c| c.inputs.as_ref()?.refusal(&now, &c.check.scene_argument))
-    {
+    if let Some(why) = candidates.iter().find_map(|c| {
+        let then = c.inputs.as_ref()?;
+        let changed = then.changed(&case.inputs);
+        then.refusal(&changed, &c.check.scene_argument, options.check_out)
+    }) {
         return Err(why);
     }
     let mut done = SceneAcceptance::default();

@@ -387,10 +387,7 @@ pub fn run_with(
             diagnoses,
             orphans: Vec::new(),
             verifications: Vec::new(),
-            inputs: cases
-                .iter()
-                .map(crate::golden::scene_inputs::SceneInputs::of)
-                .collect(),
+            inputs: cases.iter().map(|case| case.inputs.clone()).collect(),
             driver_notes,
             backends,
             results,

@@ -15,11 +15,14 @@ pub fn bless_command(scene: &str) -> String {
     )
 }
 
-/// The `harness check` command line of one scene (`scene` as the user gave it), as
-/// [`bless_command`] makes its own.
-pub fn check_command(scene: &str) -> String {
+/// The `harness check` command line of one scene (`scene` as the user gave it) writing to
+/// `out` when given (where an accept reads it again), as [`bless_command`] makes its own.
+pub fn check_command(scene: &str, out: Option<&std::path::Path>) -> String {
+    let out = out.map_or(String::new(), |dir| {
+        format!(" --out {}", shell_quote(&dir.to_string_lossy()))
+    });
     format!(
-        "{}{} check --scene {}",
+        "{}{} check --scene {}{out}",
         workspace(),
         harness(),
         shell_quote(scene)

@@ -95,8 +95,8 @@ pub struct Provenance<'a> {
     pub unverified: bool,
     /// Why the picture changed, as the person blessing said it (`harness bless --reason`).
     pub reason: Option<&'a str>,
-    /// The scene file, when the scene is not one of scenes/: recorded in blessed.toml so that
-    /// `bless --prune` keeps the folder while that file exists.
+    /// The scene file, when the scene is not one of scenes/ (None: it is): recorded in
+    /// blessed.toml so that `bless --prune` keeps the folder while that file exists.
     pub scene_file: Option<&'a Path>,
 }
 
@@ -395,7 +395,7 @@ impl GoldenStore {
                 reason: reason.map(str::to_owned),
             },
         );
-        self.write_records(lock, records, scene_file)?;
+        self.write_records(lock, records, Some(scene_file))?;
         Ok(path)
     }
 
@@ -410,25 +410,18 @@ impl GoldenStore {
     }
 
     /// Writes the locked scene's blessed.toml, atomically, with `scene_file` as its scene file
-    /// (relative to the workspace when inside it), or the one it records when None.
+    /// (`Some(None)`: a scene of scenes/, none; relative to the workspace when inside it), or
+    /// the one it records when None.
     fn write_records(
         &self,
         lock: &SceneLock,
         records: BTreeMap<String, BlessRecord>,
-        scene_file: Option<&Path>,
+        scene_file: Option<Option<&Path>>,
     ) -> Result<(), GoldenError> {
         let path = self.record_path(lock.scene());
+        let workspace = self.root.parent().unwrap_or(Path::new(""));
         let scene_file = match scene_file {
-            Some(file) => {
-                let workspace = self.root.parent().unwrap_or(Path::new(""));
-                let absolute = std::path::absolute(file).unwrap_or_else(|_| file.to_owned());
-                let workspace = std::path::absolute(workspace).unwrap_or_default();
-                Some(
-                    absolute
-                        .strip_prefix(&workspace)
-                        .map_or(absolute.clone(), Path::to_path_buf),
-                )
-            }
+            Some(file) => file.map(|f| super::scene_inputs::input_name(f, workspace)),
             None => self.bless_file(lock.scene())?.scene_file,
         };
         let file = BlessFile {

@@ -110,6 +110,8 @@ pub struct Case {
     pub rules: BTreeMap<TargetId, Rule>,
     /// Where each pass's limits came from.
     pub limit_sources: BTreeMap<TargetId, LimitSource>,
+    /// The files it was loaded from, digested right after the load, and the load's warnings.
+    pub inputs: crate::golden::scene_inputs::SceneInputs,
     /// Size and format per pass output.
     targets: BTreeMap<TargetId, TargetSpec>,
 }
@@ -125,6 +127,7 @@ impl Case {
     /// [`Case::load`] with the limits of `model`.
     pub fn load_with(name_or_path: &str, model: &NoiseModel) -> Result<Case, SuiteError> {
         let mut loaded = crate::load_scene(name_or_path)?;
+        let inputs = crate::golden::scene_inputs::SceneInputs::of(&loaded);
         // A shadowed light's shadow term is where a shadow change first shows: golden renders
         // read it back (a full-screen pass per shadowed light).
         loaded.scene.quality.debug_shadow_terms = true;
@@ -210,6 +213,7 @@ impl Case {
             passes,
             rules,
             limit_sources,
+            inputs,
             targets,
         })
     }

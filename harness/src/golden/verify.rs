@@ -146,10 +146,8 @@ pub fn inputs_digest(store: &GoldenStore, case: &Case) -> String {
     std::fs::read(store.root().join("noise.toml"))
         .unwrap_or_default()
         .hash(&mut hasher);
-    for file in &case.loaded.files {
-        super::scene_inputs::input_name(file).hash(&mut hasher);
-        std::fs::read(file).unwrap_or_default().hash(&mut hasher);
-    }
+    // As the check recorded them when it loaded the scene.
+    case.inputs.files.hash(&mut hasher);
     if let Ok(meta) = std::env::current_exe().and_then(std::fs::metadata) {
         meta.len().hash(&mut hasher);
         meta.modified().ok().hash(&mut hasher);
@@ -157,14 +155,7 @@ pub fn inputs_digest(store: &GoldenStore, case: &Case) -> String {
     format!("{:016x}", hasher.finish())
 }
 
-/// A digest of a file's bytes (None when it cannot be read).
-pub fn file_digest(path: &Path) -> Option<String> {
-    use std::hash::{Hash, Hasher};
-    let bytes = std::fs::read(path).ok()?;
-    let mut hasher = std::collections::hash_map::DefaultHasher::new();
-    bytes.hash(&mut hasher);
-    Some(format!("{:016x}", hasher.finish()))
-}
+pub use super::scene_inputs::file_digest;
 
 /// The files the values of the scene file at `path` name (its assets), each as named and as
 /// found beside the scene file.

@@ -216,6 +216,7 @@ impl Review {
             .and_then(crate::golden::bless::given_reason);
         let options = accept::AcceptOptions {
             reason,
+            check_out: Some(&self.out),
             ..Default::default()
         };
         if ask.speed {

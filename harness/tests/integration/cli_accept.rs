@@ -154,7 +154,8 @@ fn after_the_check(
         assert!(
             stdout.contains("arrow changed since the check (")
                 && stdout.contains("scenes/arrow.toml)")
-                && stdout.contains(" check --scene arrow`), then accept"),
+                && stdout.contains(" check --scene arrow --out ")
+                && stdout.contains("`), then accept"),
             "{stdout}"
         );
         assert_eq!(snapshot(golden), before);

@@ -33,6 +33,8 @@ fn on(host: &str) -> CheckContext {
             .map(|kind| (kind, host.to_owned()))
             .collect(),
         arguments: [("arrow".to_owned(), "scenes/arrow.toml".to_owned())].into(),
+        inputs: Vec::new(),
+        out: "out".into(),
     }
 }
 

@@ -135,8 +135,9 @@ fn bless_writes_the_golden_and_the_record_and_refuses_nan() {
 }
 
 /// A scene blessed from a file outside scenes/ records that file in blessed.toml (relative to
-/// the workspace), a later bless or a forgotten record keeps it, and its folder is no orphan
-/// while the file exists; once the file is gone, the folder is a scene gone.
+/// the workspace), a forgotten record keeps it, and its folder is no orphan while the file
+/// exists; once the file is gone, the folder is a scene gone. Blessed as a scene of scenes/
+/// (no file to record), the record goes.
 #[test]
 fn a_scene_file_elsewhere_keeps_its_golden_folder() {
     use harness::golden::orphans::{find, OrphanKind};
@@ -152,7 +153,7 @@ fn a_scene_file_elsewhere_keeps_its_golden_folder() {
         data: ImageData::U8(vec![1, 2, 3, 255]),
     };
     let lock = store.lock_scene("pyramid", |_| {}).unwrap();
-    let bless = |pass, scene_file| {
+    let bless = |lock: &SceneLock, pass, scene_file| {
         let provenance = Provenance {
             backend: BackendKind::Gl,
             driver: "llvmpipe",
@@ -161,19 +162,20 @@ fn a_scene_file_elsewhere_keeps_its_golden_folder() {
             reason: None,
             scene_file,
         };
-        store.bless(&lock, pass, &image, provenance).unwrap();
+        store.bless(lock, pass, &image, provenance).unwrap();
     };
-    bless(TargetId::Final, Some(scene_file.as_path()));
-    bless(TargetId::Mask(0), None);
+    bless(&lock, TargetId::Final, Some(scene_file.as_path()));
+    bless(&lock, TargetId::Mask(0), Some(scene_file.as_path()));
     store.forget(&lock, "mask").unwrap();
     let text = std::fs::read_to_string(store.root().join("pyramid/blessed.toml")).unwrap();
     assert!(
         text.contains("scene_file = \"mine/pyramid.toml\""),
         "{text}"
     );
+    let recorded = store.scene_file("pyramid").unwrap().unwrap();
     assert_eq!(
-        store.scene_file("pyramid").unwrap(),
-        Some(scene_file.clone())
+        recorded.canonicalize().unwrap(),
+        scene_file.canonicalize().unwrap()
     );
     drop(lock);
     let orphans = || find(&store, &[], Some(&[])).unwrap();
@@ -184,4 +186,7 @@ fn a_scene_file_elsewhere_keeps_its_golden_folder() {
         gone.len() == 1 && gone[0].kind == OrphanKind::SceneGone,
         "{gone:?}"
     );
+    let lock = store.lock_scene("pyramid", |_| {}).unwrap();
+    bless(&lock, TargetId::Final, None);
+    assert_eq!(store.scene_file("pyramid").unwrap(), None);
 }
