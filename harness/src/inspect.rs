@@ -115,9 +115,10 @@ fn inspect_environment(path: &Path) -> Result<Value, InspectError> {
 fn inspect_scene(path: &Path) -> Result<Value, InspectError> {
     let loaded = scene_file::load(path)?;
     // Its tolerances read against its golden passes, as `check` reads them (the scene is
-    // loaded again for that, only when it has any).
+    // loaded again for that, only when it has any; the rules, not the noise model's limits).
     if !loaded.tolerances.is_empty() {
-        crate::golden::suite::Case::load(&path.to_string_lossy()).map_err(Box::new)?;
+        let model = crate::golden::noise::NoiseModel::default();
+        crate::golden::suite::Case::load_with(&path.to_string_lossy(), &model).map_err(Box::new)?;
     }
     let scene = &loaded.scene;
     let objects: Vec<Value> = scene.objects.iter().map(object_json).collect();

@@ -53,7 +53,8 @@ impl MeshData {
                 format!(
                     "mesh `{name}`: a closed surface whose triangles are wound clockwise seen \
                      from outside (it encloses a negative volume), so its outside faces away: \
-                     counter-clockwise triangles are front faces (reverse each face's vertices)"
+                     counter-clockwise triangles are front faces (reverse each face's vertices; \
+                     a room or dome seen from inside is right as it is)"
                 ),
             );
         }
@@ -156,24 +157,39 @@ fn valid_triangles(
     tris
 }
 
+/// Meshes above this many triangles are not asked whether they are inside out (the edge map
+/// would cost more than the rest of the load).
+const MAX_TRIANGLES_FOR_WINDING: usize = 1 << 20;
+
+/// A vertex position as a map key, -0.0 folded into 0.0 (a welded corner is one key).
+fn position_key(p: Vec3) -> [u32; 3] {
+    (p + Vec3::ZERO).to_array().map(f32::to_bits)
+}
+
 /// The volume a closed, consistently wound surface encloses, signed (negative: its triangles
 /// turn clockwise seen from outside); None for an open surface, one whose edges are not each
-/// shared by exactly two triangles in opposite directions, or a flat one. Vertices are welded
-/// by position, since a loader splits them by texture coordinate and normal.
+/// shared by exactly two triangles in opposite directions, a flat one, or one over
+/// [`MAX_TRIANGLES_FOR_WINDING`]. Vertices are welded by position, since a loader splits them
+/// by texture coordinate and normal.
 fn closed_signed_volume(pos: &[Vec3], tris: &[[u32; 3]]) -> Option<f64> {
     use std::collections::HashMap;
+    if tris.len() > MAX_TRIANGLES_FOR_WINDING {
+        return None;
+    }
     let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
     let welded: Vec<u32> = pos
         .iter()
-        .map(|p| {
+        .map(|&p| {
             let next = ids.len() as u32;
-            *ids.entry(p.to_array().map(f32::to_bits)).or_insert(next)
+            *ids.entry(position_key(p)).or_insert(next)
         })
         .collect();
+    // Volumes about the first corner (the origin may lie far away), against the extent.
+    let origin = pos.first().copied().unwrap_or_default().as_dvec3();
+    let (mut lo, mut hi) = (glam::DVec3::splat(f64::MAX), glam::DVec3::splat(f64::MIN));
     // Per undirected edge: how many triangles use it, and the sum of their directions.
     let mut edges: HashMap<(u32, u32), (u32, i32)> = HashMap::new();
     let mut volume = 0.0f64;
-    let mut size = 0.0f64;
     for tri in tris {
         let [a, b, c] = tri.map(|i| welded.get(i as usize).copied());
         let [p, q, r] = tri.map(|i| pos.get(i as usize).map(|p| p.as_dvec3()));
@@ -188,12 +204,16 @@ fn closed_signed_volume(pos: &[Vec3], tris: &[[u32; 3]]) -> Option<f64> {
             entry.0 += 1;
             entry.1 += if from < to { 1 } else { -1 };
         }
+        let (p, q, r) = (p - origin, q - origin, r - origin);
         volume += p.dot(q.cross(r)) / 6.0;
-        size = size.max(p.abs().max_element());
+        for corner in [p, q, r] {
+            (lo, hi) = (lo.min(corner), hi.max(corner));
+        }
     }
     let closed = !edges.is_empty() && edges.values().all(|&(count, sum)| count == 2 && sum == 0);
     // Flat within rounding: no inside to speak of.
-    (closed && volume.abs() > 1e-9 * size.powi(3).max(f64::MIN_POSITIVE)).then_some(volume)
+    let extent = (hi - lo).max_element();
+    (closed && volume.abs() > 1e-9 * extent.powi(3)).then_some(volume)
 }
 
 /// Unit normals: the given ones where usable (zero or non-finite ones replaced by generated
@@ -296,7 +316,7 @@ fn note_warn(notes: &mut Vec<String>, msg: String) {
 /// Position-welded, area-weighted vertex normals; vertices with no usable
 /// triangle get +Y.
 fn smooth_normals(pos: &[Vec3], tris: &[[u32; 3]]) -> Vec<Vec3> {
-    let key = |p: Vec3| (p + Vec3::ZERO).to_array().map(f32::to_bits); // +0 folds -0.0
+    let key = position_key;
     let mut accum: HashMap<[u32; 3], Vec3> = HashMap::new();
     for t in tris {
         let [a, b, c] = t.map(|i| pos.get(i as usize).copied().unwrap_or(Vec3::ZERO));

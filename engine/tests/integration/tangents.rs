@@ -236,18 +236,23 @@ fn an_inside_out_closed_surface_is_warned_about() {
     ];
     let outward: [u32; 12] = [0, 2, 1, 0, 1, 3, 1, 2, 4, 2, 0, 4];
     let inward: Vec<u32> = outward.chunks(3).flat_map(|t| [t[0], t[2], t[1]]).collect();
-    let warned = |indices: &[u32]| {
+    let warned_at = |positions: &[[f32; 3]], indices: &[u32]| {
         let mut notes = Vec::new();
-        engine::assets::MeshData::from_triangles(
-            "tet", &positions, None, None, indices, &mut notes,
-        );
+        engine::assets::MeshData::from_triangles("tet", positions, None, None, indices, &mut notes);
         notes.iter().any(|n| {
             n.starts_with("mesh `tet`: a closed surface whose triangles are wound clockwise")
                 && n.contains("counter-clockwise triangles are front faces")
         })
     };
+    let warned = |indices: &[u32]| warned_at(&positions, indices);
     assert!(!warned(&outward));
     assert!(warned(&inward));
     // Open (one face fewer), either way: no inside to speak of.
     assert!(!warned(&inward[3..]));
+    // Far from the origin, and with -0.0 for a corner's 0: the same.
+    let far = positions.map(|[x, y, z]| [x + 1e5, y, z]);
+    assert!(warned_at(&far, &inward) && !warned_at(&far, &outward));
+    let mut signed = positions;
+    signed[4] = [-0.0, 0.0, 1.0];
+    assert!(warned_at(&signed, &inward));
 }

@@ -398,20 +398,32 @@ fn print_diagnoses(run: &CheckRun) {
     }
 }
 
-/// A note under a failing scene that loaded with warnings: a material library, material or
-/// map the scene lost changes its picture, which a bless would make the golden.
+/// The most load warnings quoted under a failing scene.
+const WARNINGS_QUOTED: usize = 5;
+
+/// Under a failing scene that loaded with warnings, the warnings (the first
+/// [`WARNINGS_QUOTED`]): a material library, material or map the scene lost changes its
+/// picture, which a bless would make the golden, so they are read before blessing.
 fn print_load_warnings_of(run: &CheckRun, scene: &str) {
     let Some(inputs) = run.inputs.iter().find(|i| i.scene == scene) else {
         return;
     };
-    if let Some(first) = inputs.warnings.first() {
-        let more = match inputs.warnings.len() {
-            1 => String::new(),
-            n => format!("; {} more printed above", n - 1),
-        };
+    let warnings = &inputs.warnings;
+    if warnings.is_empty() {
+        return;
+    }
+    println!(
+        "  {scene}: loaded with {} warning(s); one about a lost material library, material or \
+         map, or data read differently, is a change to fix before blessing:",
+        warnings.len()
+    );
+    for warning in warnings.iter().take(WARNINGS_QUOTED) {
+        println!("    {warning}");
+    }
+    if warnings.len() > WARNINGS_QUOTED {
         println!(
-            "  {scene}: loaded with warnings ({first}{more}): an asset the scene lost or read \
-             differently changes its picture; fix them before blessing"
+            "    and {} more (`harness inspect` lists them)",
+            warnings.len() - WARNINGS_QUOTED
         );
     }
 }

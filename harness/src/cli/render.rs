@@ -79,7 +79,7 @@ pub(crate) fn run(
         };
         let file = format!("{target}.{extension}");
         let path = match &out {
-            Some(path) if targets.len() == 1 && path.extension().is_some() => path.clone(),
+            Some(path) if targets.len() == 1 && names_a_file(path) => path.clone(),
             Some(dir) => dir.join(file),
             None => default_dir.join(file),
         };
@@ -94,16 +94,29 @@ pub(crate) fn run(
     Ok(ExitCode::SUCCESS)
 }
 
-/// Refuses, before anything is rendered, an `--out` that names a file (it has an extension)
-/// where several outputs are asked for (they go into a folder), or one it cannot write: EXR
-/// holds a float output, PNG any (a float one clamped to 0..1).
+/// Whether `--out` names an image file rather than a folder: it is no folder already, and its
+/// extension is an image format's (a folder may have a dot in its name, `run.1`).
+fn names_a_file(out: &std::path::Path) -> bool {
+    const IMAGES: [&str; 10] = [
+        "png", "exr", "jpg", "jpeg", "tga", "bmp", "hdr", "tif", "tiff", "webp",
+    ];
+    !out.is_dir()
+        && out
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| IMAGES.iter().any(|i| e.eq_ignore_ascii_case(i)))
+}
+
+/// Refuses, before anything is rendered, an `--out` that names an image file
+/// ([`names_a_file`]) where several outputs are asked for (they go into a folder), or one it
+/// cannot write: EXR holds a float output, PNG any (a float one clamped to 0..1).
 fn check_out_path(
     out: Option<&std::path::Path>,
     targets: &[TargetId],
     plan: &engine::plan::RenderPlan,
 ) -> anyhow::Result<()> {
     use engine::backend::TextureFormat;
-    let Some(extension) = out.and_then(|o| o.extension()) else {
+    let Some(extension) = out.filter(|o| names_a_file(o)).and_then(|o| o.extension()) else {
         return Ok(());
     };
     let out = out.unwrap_or(std::path::Path::new("")).display();

@@ -161,6 +161,15 @@ fn render_writes_every_pass_of_a_scene_file() {
             "{stderr}"
         );
     }
+    // A folder with a dot in its name is a folder.
+    let folder = dir.path().join("run.1");
+    std::fs::create_dir(&folder).unwrap();
+    let args = [
+        "render", "--scene", "arrow", "--pass", "mask", "--pass", "depth", "--out",
+    ];
+    let (code, _, stderr) = harness(&[&args[..], &[folder.to_str().unwrap()]].concat());
+    assert_eq!(code, 0, "{stderr}");
+    assert!(folder.join("mask.png").is_file() && folder.join("depth.exr").is_file());
     let (code, _, stderr) = harness(&["render", "--scene", "arrow", "--pass", "shadow"]);
     assert_eq!(code, 1);
     assert!(stderr.contains("no pass output `shadow`"), "{stderr}");
