@@ -174,17 +174,10 @@ fn object_json(o: &Object) -> Value {
     .into_iter()
     .filter_map(|(name, map)| map.map(|_| name))
     .collect();
-    // A map replaces its value (the Quarantamaula engine's rule; the MTL specification
-    // multiplies `Kd` by `map_Kd`): these values are not what is drawn.
-    let replaced: Vec<&str> = [
-        ("base_color", m.base_color_map),
-        ("roughness", m.roughness_map),
-        ("metallic", m.metallic_map),
-        ("clearcoat", m.clearcoat_map),
-    ]
-    .into_iter()
-    .filter_map(|(name, map)| map.map(|_| name))
-    .collect();
+    // A map replaces its value (the Quarantamaula engine's rule, gbuffer.wgsl; the MTL
+    // specification multiplies `Kd` by `map_Kd`): these values are not what is drawn. The
+    // normal map has no value to replace.
+    let replaced: Vec<&str> = maps.iter().copied().filter(|&m| m != "normal").collect();
     json!({
         "name": o.name,
         "mesh": o.mesh.name,
