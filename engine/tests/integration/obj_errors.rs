@@ -301,6 +301,27 @@ fn a_face_that_mixes_vertex_forms_names_its_line() {
     }
     std::fs::write(&path, format!("{head}f 1/1/1 2/2/1 3/1/1\n")).unwrap();
     assert!(engine::assets::load_obj(&path, &mut engine::assets::TextureCache::new()).is_ok());
+    // Faces of two forms in one mesh load, with a warning naming both lines; in two meshes
+    // (a group between them), without.
+    let load = |faces: &str| {
+        std::fs::write(&path, format!("{head}{faces}")).unwrap();
+        engine::assets::load_obj(&path, &mut engine::assets::TextureCache::new())
+            .unwrap()
+            .warnings
+    };
+    let warnings = load("f 1/1 2/2 3/1\nf 1 2 3\n");
+    assert!(
+        warnings.iter().any(|w| w.ends_with(
+            "mixed.obj:7: this face names texture coordinates and the face at line 8 of the \
+             same mesh does not: the mesh's texture coordinates are generated for all of it"
+        )),
+        "{warnings:?}"
+    );
+    let warnings = load("f 1/1 2/2 3/1\ng two\nf 1 2 3\n");
+    assert!(
+        !warnings.iter().any(|w| w.contains("this face names")),
+        "{warnings:?}"
+    );
 }
 
 #[test]

@@ -377,7 +377,7 @@ pub fn accept_timings(
     let scene = lock.scene();
     // Timings of the scene as it was are not the scene's as it is, as for its images.
     if let Some(then) = check.inputs.iter().find(|i| i.scene == scene) {
-        let changed = then.changed_on_disk();
+        let changed = then.changed_on_disk(&crate::workspace_root());
         if let Some(why) = then.refusal(&changed, check.scene_argument(scene), Some(&check.out)) {
             return Err(why);
         }

@@ -62,10 +62,10 @@ impl SceneInputs {
         changed
     }
 
-    /// The recorded files whose bytes differ on disk now (without loading the scene again: a
-    /// file the scene would read now and did not then is not seen; [`Self::changed`] sees it).
-    pub fn changed_on_disk(&self) -> Vec<PathBuf> {
-        let workspace = crate::workspace_root();
+    /// The recorded files whose bytes differ on disk now, in `workspace` (without loading the
+    /// scene again: a file the scene would read now and did not then is not seen;
+    /// [`Self::changed`] sees it).
+    pub fn changed_on_disk(&self, workspace: &Path) -> Vec<PathBuf> {
         self.files
             .iter()
             .filter(|(file, digest)| {

@@ -82,6 +82,10 @@ struct Prescan {
     first_unsupported: Option<(String, usize)>,
     /// Statements skipped because they name nothing (`usemtl` or `mtllib` alone).
     unnamed: Vec<(String, usize)>,
+    /// The form (texture coordinates, normals) of the first face of the mesh being read (since
+    /// the last `o`, `g` or `usemtl`, where tobj starts a mesh), its line, and whether a face of
+    /// another form in it has been warned about.
+    mesh_form: Option<([bool; 2], usize, bool)>,
 }
 
 impl Prescan {
@@ -99,7 +103,10 @@ impl Prescan {
             "v" => self.vertex(toks).map_err(err)?,
             "vt" => self.texcoord(toks).map_err(err)?,
             "vn" => self.normal(toks).map_err(err)?,
-            "f" => self.face(toks, rest).map_err(err)?,
+            "f" => {
+                let form = self.face(toks, rest).map_err(err)?;
+                self.note_face_form(path, lineno, form);
+            }
             "l" | "p" => {
                 if key == "l" {
                     self.scan.lines += 1;
@@ -108,8 +115,16 @@ impl Prescan {
                 }
                 self.first_skipped.get_or_insert(lineno);
             }
-            "o" | "g" => push_line(&mut self.scan.normalized, &format!("{key} {rest}")),
-            "usemtl" | "mtllib" => self.material_statement(key, rest, lineno),
+            "o" | "g" => {
+                self.mesh_form = None;
+                push_line(&mut self.scan.normalized, &format!("{key} {rest}"));
+            }
+            "usemtl" | "mtllib" => {
+                if key == "usemtl" {
+                    self.mesh_form = None;
+                }
+                self.material_statement(key, rest, lineno);
+            }
             k if SILENTLY_IGNORED.contains(&k) => {}
             k => {
                 self.unsupported += 1;
@@ -181,7 +196,11 @@ impl Prescan {
     /// form (each names a texture coordinate, or none does; the same for normals): a face that
     /// mixes them would leave the mesh's texture coordinates or normals without one per vertex,
     /// and all of them generated.
-    fn face<'a>(&mut self, toks: impl Iterator<Item = &'a str>, rest: &str) -> Result<(), String> {
+    fn face<'a>(
+        &mut self,
+        toks: impl Iterator<Item = &'a str>,
+        rest: &str,
+    ) -> Result<[bool; 2], String> {
         let mut count = 0usize;
         let mut first: Option<(&str, [bool; 2])> = None;
         for t in toks {
@@ -215,7 +234,39 @@ impl Prescan {
         }
         self.scan.faces += 1;
         push_line(&mut self.scan.normalized, &format!("f {rest}"));
-        Ok(())
+        Ok(first.map_or([false; 2], |(_, form)| form))
+    }
+
+    /// A face whose form differs from the first face of its mesh: tobj then has texture
+    /// coordinates or normals for some of the mesh's vertices only, and all of them are
+    /// generated (`from_triangles`); warned once per mesh, naming both lines.
+    fn note_face_form(&mut self, path: &Path, lineno: usize, form: [bool; 2]) {
+        let Some((first, line, warned)) = &mut self.mesh_form else {
+            self.mesh_form = Some((form, lineno, false));
+            return;
+        };
+        if *first == form || *warned {
+            return;
+        }
+        *warned = true;
+        let (what, has) = if first[0] == form[0] {
+            ("normals", form[1])
+        } else {
+            ("texture coordinates", form[0])
+        };
+        let (with, without) = if has {
+            (lineno, *line)
+        } else {
+            (*line, lineno)
+        };
+        warn(
+            &mut self.scan.warnings,
+            format!(
+                "{}:{with}: this face names {what} and the face at line {without} of the same \
+                 mesh does not: the mesh's {what} are generated for all of it",
+                path.display()
+            ),
+        );
     }
 
     /// `usemtl name` or `mtllib file...`; `key` alone is skipped with a warning.
@@ -248,6 +299,7 @@ impl Prescan {
             unsupported,
             first_unsupported,
             unnamed,
+            mesh_form: _,
         } = self;
         let p = path.display();
         let mut notes = Vec::new();

@@ -68,4 +68,18 @@ fn digests_travel_and_changes_on_disk_are_seen() {
     );
     let elsewhere = tempfile::tempdir().unwrap();
     assert!(input_name(&file, elsewhere.path()).is_absolute());
+    // What a timing accept asks: the recorded files' bytes now, without loading the scene.
+    let recorded = SceneInputs {
+        scene: "a".to_owned(),
+        files: vec![("a.toml".into(), file_digest(&file))],
+        warnings: Vec::new(),
+    };
+    assert!(recorded.changed_on_disk(dir.path()).is_empty());
+    std::fs::write(&file, "abd").unwrap();
+    assert_eq!(
+        recorded.changed_on_disk(dir.path()),
+        [std::path::PathBuf::from("a.toml")]
+    );
+    std::fs::remove_file(&file).unwrap();
+    assert_eq!(recorded.changed_on_disk(dir.path()).len(), 1);
 }
