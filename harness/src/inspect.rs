@@ -278,23 +278,7 @@ pub fn to_text(value: &Value) -> String {
                     ),
                 );
             }
-            for t in m["textures"].as_array().into_iter().flatten() {
-                line(
-                    &mut out,
-                    format!(
-                        "  texture {} {}x{} {}-bit {} mips {}",
-                        t["path"].as_str().unwrap_or(""),
-                        t["width"],
-                        t["height"],
-                        t["bits"],
-                        t["mips"],
-                        t["color_space"].as_str().unwrap_or("")
-                    ),
-                );
-            }
-            for w in m["warnings"].as_array().into_iter().flatten() {
-                line(&mut out, format!("  warning: {}", w.as_str().unwrap_or("")));
-            }
+            text_textures_and_warnings(&mut out, m);
         }
         Some("scene") => {
             line(
@@ -387,11 +371,15 @@ pub fn to_text(value: &Value) -> String {
     out
 }
 
-/// The texture and warning lines of an MTL's [`to_text`].
+/// The texture lines (with their bit depth where known) and the warning lines of an OBJ's or
+/// an MTL's [`to_text`], from the part of its JSON that lists them.
 fn text_textures_and_warnings(out: &mut String, value: &Value) {
     for t in value["textures"].as_array().into_iter().flatten() {
+        let bits = t["bits"]
+            .as_u64()
+            .map_or(String::new(), |b| format!("{b}-bit "));
         out.push_str(&format!(
-            "  texture {} {}x{} {} mips {}\n",
+            "  texture {} {}x{} {bits}{} mips {}\n",
             t["path"].as_str().unwrap_or(""),
             t["width"],
             t["height"],

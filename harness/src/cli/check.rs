@@ -369,13 +369,16 @@ fn print_diagnoses(run: &CheckRun) {
         }
         // A scene without goldens: one line for all its outputs, not a bless command each.
         let mut uncompared: Vec<engine::plan::TargetId> = Vec::new();
-        for o in &run.diagnoses {
-            let new = !seen.contains(&(d.scene.as_str(), o.pass)) && !uncompared.contains(&o.pass);
-            if o.scene == d.scene && o.role == Role::NoComparison && new {
-                uncompared.push(o.pass);
+        if d.role == Role::NoComparison {
+            for o in run.diagnoses.iter().filter(|o| o.scene == d.scene) {
+                let new =
+                    !seen.contains(&(d.scene.as_str(), o.pass)) && !uncompared.contains(&o.pass);
+                if o.role == Role::NoComparison && new {
+                    uncompared.push(o.pass);
+                }
             }
         }
-        if d.role == Role::NoComparison && uncompared.len() > 1 {
+        if uncompared.len() > 1 {
             let folder = run
                 .results
                 .iter()

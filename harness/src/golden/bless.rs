@@ -39,12 +39,7 @@ pub fn refusal_for(name: &str, argument: &str) -> Option<String> {
         return None;
     }
     let path = std::path::Path::new(argument);
-    let same = canonical
-        .canonicalize()
-        .ok()
-        .zip(path.canonicalize().ok())
-        .is_some_and(|(a, b)| a == b);
-    (!same).then(|| {
+    (!is_canonical_file(name, path)).then(|| {
         format!(
             "{} shares its name with the canonical scene {}: its goldens would be written \
              over golden/{name}/, which are that scene's. Edit {} instead, or give this file a \
@@ -58,11 +53,17 @@ pub fn refusal_for(name: &str, argument: &str) -> Option<String> {
 
 /// Whether `case` is the scene of scenes/ named like it (not a scene file elsewhere).
 pub fn is_canonical(case: &Case) -> bool {
-    let canonical = crate::scenes_dir().join(format!("{}.toml", case.name()));
+    is_canonical_file(case.name(), &case.loaded.path)
+}
+
+/// Whether `path` is the file of the canonical scene `name`, `scenes/<name>.toml` (links and
+/// `..` resolved; false when either is missing).
+fn is_canonical_file(name: &str, path: &std::path::Path) -> bool {
+    let canonical = crate::scenes_dir().join(format!("{name}.toml"));
     canonical
         .canonicalize()
         .ok()
-        .zip(case.loaded.path.canonicalize().ok())
+        .zip(path.canonicalize().ok())
         .is_some_and(|(a, b)| a == b)
 }
 
