@@ -22,7 +22,8 @@ struct ObjectUniforms {
     // roughness, metallic, specular, clearcoat.
     params: vec4<f32>,
     // clearcoat roughness, specular exponent, fault flag (1: swap albedo red and blue; only the
-    // harness's mutation self-test sets it), -.
+    // harness's mutation self-test sets it), handedness (-1 where the model matrix mirrors,
+    // else 1: a mirrored tangent frame's bitangent is the other cross product).
     params2: vec4<f32>,
     // 1.0 where a map replaces the scalar: base color, normal, roughness, metallic.
     maps: vec4<f32>,
@@ -69,7 +70,10 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.relative_position = world.xyz;
     out.normal = (object.normal_matrix * vec4<f32>(v.normal, 0.0)).xyz;
     out.uv = v.uv;
-    out.tangent = vec4<f32>((object.model * vec4<f32>(v.tangent.xyz, 0.0)).xyz, v.tangent.w);
+    out.tangent = vec4<f32>(
+        (object.model * vec4<f32>(v.tangent.xyz, 0.0)).xyz,
+        v.tangent.w * object.params2.w,
+    );
     return out;
 }
 

@@ -104,7 +104,8 @@ pub(super) fn object_uniforms(
     } else {
         0.0
     };
-    data.extend_from_slice(&[m.clearcoat_roughness, m.specular_exponent, swap, 0.0]);
+    let handedness = if transform.mirrors() { -1.0 } else { 1.0 };
+    data.extend_from_slice(&[m.clearcoat_roughness, m.specular_exponent, swap, handedness]);
     data.extend_from_slice(&[
         flag(m.base_color_map),
         flag(m.normal_map),

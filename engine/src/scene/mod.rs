@@ -118,6 +118,14 @@ impl Transform {
     pub fn relative_to(&self, origin: DVec3) -> DMat4 {
         DMat4::from_scale_rotation_translation(self.scale, self.rotation, self.translation - origin)
     }
+
+    /// Whether the transform mirrors the mesh (an odd number of negative scale factors): its
+    /// triangles are then wound the other way round on screen, and its tangent frames change
+    /// handedness. The renderer culls such an object's front-facing triangles instead of its
+    /// back-facing ones, and flips the handedness it stores.
+    pub fn mirrors(&self) -> bool {
+        self.scale.x * self.scale.y * self.scale.z < 0.0
+    }
 }
 
 /// One drawable: a mesh with a transform, a material and a lighting model.

@@ -520,3 +520,79 @@ fn culled_renders_give_the_whole_frame_s_targets() {
         }
     }
 }
+
+/// An object mirrored by a negative scale is drawn from outside, its bumps the right way up: its
+/// triangles are wound the other way round on screen, so the renderer culls its front faces
+/// instead of its back faces, and its tangent frames change handedness. Corner's sphere mirrored
+/// across its own centre is the same sphere (only its quads' diagonals swap): the final image
+/// matches the unmirrored one within the final image's tolerance; culled as before, the sphere
+/// showed its inside. A mirrored floor's normal map bends the normal as the mirror image of the
+/// unmirrored floor's.
+#[test]
+fn a_mirrored_object_is_drawn_from_outside_with_its_bumps_mirrored() {
+    use engine::scene::{Material, TextureImage};
+    use std::sync::Arc;
+
+    let corner = engine::scene_file::load(&harness::scenes_dir().join("corner.toml"))
+        .unwrap()
+        .scene;
+    let mut mirrored = corner.clone();
+    let sphere = mirrored
+        .objects
+        .iter_mut()
+        .find(|o| o.name == "sphere")
+        .expect("corner's sphere");
+    sphere.transform.scale.x = -sphere.transform.scale.x;
+    assert!(sphere.transform.mirrors());
+    // Tangent-space normals (0.6, 0, 0.8) and (0, 0.6, 0.8), encoded n * 0.5 + 0.5, on a floor
+    // seen from above, its tangent along +x (mirrored: -x) and its bitangent along -z.
+    let cases = [
+        ([204u8, 128, 230, 255], [-0.6f32, 0.8, 0.0]),
+        ([128u8, 204, 230, 255], [0.0f32, 0.8, -0.6]),
+    ];
+    for kind in common::available_backends() {
+        let mut backend = engine::backend::create(kind).unwrap();
+        let a = render(backend.as_mut(), &corner);
+        let b = render(backend.as_mut(), &mirrored);
+        let diff = harness::golden::metrics::compare::u8_difference(
+            a.output(TargetId::Final).unwrap(),
+            b.output(TargetId::Final).unwrap(),
+            1,
+        )
+        .unwrap();
+        eprintln!("{kind}: mirrored sphere {diff:?}");
+        assert!(
+            diff.fraction_within >= 0.999,
+            "{kind}: only {:.3}% of pixels within 1/255 with the sphere mirrored",
+            diff.fraction_within * 100.0
+        );
+        for (encoded, expected) in cases {
+            let mut scene = test_scenes::many_point_lights(64, 1);
+            scene.camera.position = DVec3::new(0.0, 5.0, 0.01);
+            scene.textures = vec![Arc::new(TextureImage {
+                label: format!("{encoded:?}"),
+                srgb: false,
+                width: 2,
+                height: 2,
+                format: engine::assets::TexelFormat::Rgba8,
+                mips: vec![encoded.repeat(4), encoded.to_vec()],
+            })];
+            scene.objects[0].material = Material {
+                normal_map: Some(0),
+                ..Material::default()
+            };
+            scene.objects[0].transform.scale.x = -1.0;
+            let frame = render(backend.as_mut(), &scene);
+            let normal = frame
+                .output(TargetId::GBuffer(GBufferTarget::Normal))
+                .unwrap()
+                .pixel(32, 32);
+            for i in 0..3 {
+                assert!(
+                    (normal[i] - expected[i]).abs() < 0.01,
+                    "{kind}: mirrored floor's normal {normal:?}, expected {expected:?}"
+                );
+            }
+        }
+    }
+}

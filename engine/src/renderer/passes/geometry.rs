@@ -11,6 +11,7 @@ use super::FrameContext;
 use crate::backend::*;
 use crate::mesh::Vertex;
 use crate::plan::{MaskChannel, PassId, TargetId};
+use crate::scene::Object;
 use crate::shaders;
 
 /// The vertex layout of [`Vertex`]: position, normal, uv, tangent.
@@ -47,6 +48,49 @@ fn gbuffer_shader(ctx: &mut FrameContext<'_>) -> Result<Handle<Shader>, RenderEr
     shader(ctx.scope, ctx.backend, shaders::GBUFFER)
 }
 
+/// A pass's pipeline, and where an object of the scene mirrors ([`Transform::mirrors`]), its
+/// twin that culls front faces instead: a mirrored object's triangles are wound the other way
+/// round on screen, so culling its back faces would show its inside.
+///
+/// [`Transform::mirrors`]: crate::scene::Transform::mirrors
+struct CullingPipelines {
+    unmirrored: Handle<Pipeline>,
+    mirrored: Option<Handle<Pipeline>>,
+}
+
+impl CullingPipelines {
+    /// The pipeline that draws `object`.
+    fn of(&self, object: &Object) -> Handle<Pipeline> {
+        match self.mirrored {
+            Some(mirrored) if object.transform.mirrors() => mirrored,
+            _ => self.unmirrored,
+        }
+    }
+}
+
+/// The pipelines of `desc` (which culls back faces) for the scene's objects: the mirrored twin
+/// only where an object needs it.
+fn culling_pipelines(
+    ctx: &mut FrameContext<'_>,
+    desc: PipelineDesc,
+) -> Result<CullingPipelines, RenderError> {
+    let unmirrored = ctx.scope.pipeline(ctx.backend, &desc)?;
+    let mirrored = if ctx.scene.objects.iter().any(|o| o.transform.mirrors()) {
+        let desc = PipelineDesc {
+            label: format!("{} (mirrored objects)", desc.label),
+            cull: CullMode::Front,
+            ..desc
+        };
+        Some(ctx.scope.pipeline(ctx.backend, &desc)?)
+    } else {
+        None
+    };
+    Ok(CullingPipelines {
+        unmirrored,
+        mirrored,
+    })
+}
+
 /// Every object into the G-buffer targets and depth; leaves each object's uniform buffer in
 /// `ctx` for the mask pass.
 pub(in crate::renderer) fn record_geometry(ctx: &mut FrameContext<'_>) -> Result<(), RenderError> {
@@ -57,9 +101,9 @@ pub(in crate::renderer) fn record_geometry(ctx: &mut FrameContext<'_>) -> Result
         binding: 7,
         kind: BindingKind::Sampler(SamplerBindingKind::Filtering),
     });
-    let pipeline = ctx.scope.pipeline(
-        ctx.backend,
-        &PipelineDesc {
+    let pipelines = culling_pipelines(
+        ctx,
+        PipelineDesc {
             label: "geometry".to_owned(),
             shader: gbuffer_shader,
             vertex_entry: "vs_main".to_owned(),
@@ -118,7 +162,7 @@ pub(in crate::renderer) fn record_geometry(ctx: &mut FrameContext<'_>) -> Result
         let map = |index: Option<usize>| index.map_or(frame.white, |i| frame.textures[i]);
         let mesh = frame.mesh(object);
         draws.push(Draw {
-            pipeline,
+            pipeline: pipelines.of(object),
             bindings: vec![
                 binding(0, BindingResource::Buffer(uniform)),
                 binding(1, BindingResource::Texture(map(m.base_color_map))),
@@ -160,9 +204,9 @@ pub(in crate::renderer) fn record_geometry(ctx: &mut FrameContext<'_>) -> Result
 pub(in crate::renderer) fn record_mask(ctx: &mut FrameContext<'_>) -> Result<(), RenderError> {
     let gbuffer_shader = gbuffer_shader(ctx)?;
     let frame = ctx.frame;
-    let pipeline = ctx.scope.pipeline(
-        ctx.backend,
-        &PipelineDesc {
+    let pipelines = culling_pipelines(
+        ctx,
+        PipelineDesc {
             label: "mask".to_owned(),
             shader: gbuffer_shader,
             vertex_entry: "vs_main".to_owned(),
@@ -209,7 +253,7 @@ pub(in crate::renderer) fn record_mask(ctx: &mut FrameContext<'_>) -> Result<(),
         .map(|(object, &uniform)| {
             let mesh = frame.mesh(object);
             Draw {
-                pipeline,
+                pipeline: pipelines.of(object),
                 bindings: vec![binding(0, BindingResource::Buffer(uniform))],
                 vertex_buffers: vec![mesh.vertices],
                 index_buffer: Some((mesh.indices, IndexFormat::U32)),
