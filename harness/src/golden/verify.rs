@@ -157,35 +157,6 @@ pub fn inputs_digest(store: &GoldenStore, case: &Case) -> String {
 
 pub use super::scene_inputs::file_digest;
 
-/// The files the values of the scene file at `path` name (its assets), each as named and as
-/// found beside the scene file.
-pub(crate) fn named_files(path: &Path) -> Vec<(String, std::path::PathBuf)> {
-    let text = std::fs::read_to_string(path).unwrap_or_default();
-    let (Ok(table), Some(dir)) = (text.parse::<toml::Table>(), path.parent()) else {
-        return Vec::new();
-    };
-    let mut named = Vec::new();
-    collect_strings(&toml::Value::Table(table), &mut named);
-    named
-        .into_iter()
-        .map(|name| {
-            let file = dir.join(&name);
-            (name, file)
-        })
-        .filter(|(_, file)| file.is_file())
-        .collect()
-}
-
-/// Every string value in `value`, depth first.
-fn collect_strings(value: &toml::Value, into: &mut Vec<String>) {
-    match value {
-        toml::Value::String(s) => into.push(s.clone()),
-        toml::Value::Array(items) => items.iter().for_each(|v| collect_strings(v, into)),
-        toml::Value::Table(table) => table.values().for_each(|v| collect_strings(v, into)),
-        _ => {}
-    }
-}
-
 /// Renders `case` under each of [`SOURCES`] (children of `exe`, the harness binary) against a
 /// temporary copy of its golden folder holding `candidates`, and returns where a candidate pass
 /// fails its limits under the first source where one does (empty: verified). `progress` is told

@@ -6,8 +6,8 @@
 //! brightened) is checked, blessed and accepted by several tests.
 //!
 //! The key covers every input a child check reads; where one cannot be read or named with
-//! certainty (no driver library mapped in this process, an asset folder too large to hash), the
-//! verification is neither looked up nor kept. Only outcomes every source gave are kept (a child
+//! certainty (no driver library mapped in this process, a scene file changed since it was
+//! loaded, a golden folder too large to hash), the verification is neither looked up nor kept. Only outcomes every source gave are kept (a child
 //! that could not run says nothing about the candidates).
 
 use std::collections::hash_map::DefaultHasher;
@@ -32,7 +32,7 @@ const ENV_PREFIXES: [&str; 12] = [
 /// (the IBL maps' own key covers their inputs); the cache's folder changes no outcome.
 const NOT_IN_THE_KEY: [&str; 3] = ["HARNESS_ROOT", "HARNESS_IBL_CACHE", CACHE_ENV];
 
-/// An asset folder larger than this is not hashed (and its scene's verifications not kept).
+/// A golden folder larger than this is not hashed (and its scene's verifications not kept).
 const MAX_HASHED_BYTES: u64 = 256 << 20;
 
 /// The folder verifications are kept in, when [`CACHE_ENV`] names one.
@@ -49,22 +49,19 @@ pub fn folder() -> Option<PathBuf> {
 /// input cannot be hashed with certainty.
 pub fn key(inputs: &str, case: &Case, golden: &Path, candidates: &[TargetId]) -> Option<String> {
     let mut hasher = DefaultHasher::new();
-    "verification 1".hash(&mut hasher);
+    "verification 2".hash(&mut hasher);
     inputs.hash(&mut hasher);
     candidates.hash(&mut hasher);
     hash_tree(golden, &mut hasher)?;
-    // The folders of the scene file and of every file it names, whole: an OBJ's material
-    // library and textures lie beside it, and the scene file does not name them.
-    let scene = &case.loaded.path;
-    let mut folders: Vec<PathBuf> = super::verify::named_files(scene)
-        .into_iter()
-        .filter_map(|(_, file)| file.parent().map(Path::to_path_buf))
-        .collect();
-    folders.push(scene.parent()?.to_path_buf());
-    folders.sort();
-    folders.dedup();
-    for folder in &folders {
-        hash_tree(folder, &mut hasher)?;
+    // The scene's files are in `inputs`, digested when the scene was loaded; the children read
+    // them as they are now, so a file edited since gives no key (their outcome would be the
+    // edited scene's).
+    if !case
+        .inputs
+        .changed_on_disk(&crate::workspace_root())
+        .is_empty()
+    {
+        return None;
     }
     // The environment the children inherit.
     let mut vars: Vec<(String, String)> = std::env::vars()
