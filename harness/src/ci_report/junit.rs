@@ -78,6 +78,29 @@ pub fn junit(run: &CheckRun) -> Result<String, quick_junit::SerializeError> {
         }
         report.add_test_suite(suite);
     }
+    // Where a backend is unavailable, a case for each backend: nothing of an absent one was
+    // checked (skipped, or failed where it was asked for by name).
+    if run.backends.iter().any(|b| b.unavailable.is_some()) {
+        let mut suite = TestSuite::new("backends");
+        for b in &run.backends {
+            let (status, message) = match &b.unavailable {
+                None => (Status::Passed, "available".to_owned()),
+                Some(reason) if b.required => (
+                    Status::Failed,
+                    format!("asked for (--backend) but unavailable: {reason}"),
+                ),
+                Some(reason) => (Status::Skipped, format!("unavailable: {reason}")),
+            };
+            suite.add_test_case(case(
+                "backends",
+                b.backend.name().to_owned(),
+                status,
+                &message,
+                None,
+            ));
+        }
+        report.add_test_suite(suite);
+    }
     if !run.speed.errors.is_empty() {
         let mut suite = TestSuite::new("speed probes");
         for (i, error) in run.speed.errors.iter().enumerate() {

@@ -36,12 +36,15 @@ fn speed_status(check: &SpeedCheck) -> Status {
 
 /// How many cases a run has, and how many did not pass (failed or errors).
 fn counts(run: &CheckRun) -> (usize, usize) {
+    let missing = run.backends.iter().filter(|b| b.missing()).count();
     let total = run.results.len()
+        + missing
         + run.render_errors.len()
         + run.load_errors.len()
         + run.speed.checks.len()
         + run.speed.errors.len();
     let bad = run.results.iter().filter(|r| !r.outcome.passed()).count()
+        + missing
         + run.render_errors.len()
         + run.load_errors.len()
         + run

@@ -22,6 +22,13 @@ pub fn summary(run: &CheckRun, report: &Path) -> String {
         report.display()
     );
     let mut failing: Vec<[String; 5]> = Vec::new();
+    for b in run.backends.iter().filter(|b| b.missing()) {
+        let why = format!(
+            "asked for (`--backend`) but unavailable: {}",
+            b.unavailable.as_deref().unwrap_or_default()
+        );
+        failing.push(row("-", "-", b.backend.name(), "UNAVAILABLE", &why));
+    }
     for b in &run.load_errors {
         failing.push(row(&b.scene, "-", "-", "LOAD", &b.error));
     }
@@ -89,9 +96,39 @@ pub fn summary(run: &CheckRun, report: &Path) -> String {
             let _ = writeln!(out, "- {}", cell(&orphan.to_string()));
         }
     }
+    not_checked(&mut out, run);
     speed_coverage(&mut out, run);
     passing(&mut out, run);
     out
+}
+
+/// The backends this machine lacks that the check was not asked for by name: nothing of
+/// theirs was checked, which a green run must not hide.
+fn not_checked(out: &mut String, run: &CheckRun) {
+    let absent: Vec<_> = run
+        .backends
+        .iter()
+        .filter(|b| b.unavailable.is_some() && !b.required)
+        .collect();
+    if absent.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        out,
+        "
+### Not checked
+
+Unavailable on this machine (name a backend with `--backend` to          make its absence fail the check):
+"
+    );
+    for b in absent {
+        let _ = writeln!(
+            out,
+            "- `{}`: {}",
+            b.backend.name(),
+            cell(b.unavailable.as_deref().unwrap_or_default())
+        );
+    }
 }
 
 /// What the speed checks can catch on the host that ran them, per backend, and what to do

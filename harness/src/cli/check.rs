@@ -123,8 +123,15 @@ pub(crate) fn run(
         eprintln!("note: orphan: {orphan} (`harness bless --prune` removes it)");
     }
     for b in &run.backends {
-        if let Some(reason) = &b.unavailable {
-            eprintln!("note: {} unavailable: {reason}", b.backend);
+        match &b.unavailable {
+            Some(reason) if b.required => {
+                eprintln!("error: {} was asked for but is unavailable: {reason}", b.backend);
+            }
+            Some(reason) => eprintln!(
+                "note: {} unavailable, not checked: {reason} (name it with --backend to make                  its absence fail the check)",
+                b.backend
+            ),
+            None => {}
         }
     }
     if run.backends.iter().all(|b| b.unavailable.is_some()) {
@@ -295,6 +302,15 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
             b.scene, "-", "-", b.error
         );
     }
+    for b in run.backends.iter().filter(|b| b.missing()) {
+        println!(
+            "{:<8} {:<17} {:<12} FAILED       asked for (--backend) but unavailable: {}",
+            "-",
+            "-",
+            b.backend,
+            b.unavailable.as_deref().unwrap_or_default()
+        );
+    }
     let worst_cross = run
         .cross
         .iter()
@@ -324,11 +340,15 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
     let failed = run.results.iter().filter(|r| !r.outcome.passed()).count()
         + run.speed.checks.iter().filter(|c| c.failed()).count()
         + run.speed.errors.len();
-    let unloaded = if run.load_errors.is_empty() {
+    let mut unloaded = if run.load_errors.is_empty() {
         String::new()
     } else {
         format!(", {} scene(s) did not load", run.load_errors.len())
     };
+    let missing = run.backends.iter().filter(|b| b.missing()).count();
+    if missing > 0 {
+        unloaded.push_str(&format!(", {missing} backend(s) asked for are unavailable"));
+    }
     println!(
         "{} checks ({} of speed), {failed} failed{unloaded}; report: {}",
         run.results.len() + run.speed.checks.len(),

@@ -26,6 +26,17 @@ pub struct BackendRun {
     pub fingerprint: Option<String>,
     /// Why it was not run.
     pub unavailable: Option<String>,
+    /// Asked for by name (`check --backend`): unavailable, it fails the run (not asked for,
+    /// it is a note: the check runs on what this machine has).
+    #[serde(default)]
+    pub required: bool,
+}
+
+impl BackendRun {
+    /// Asked for and not available: a failure of the run.
+    pub fn missing(&self) -> bool {
+        self.required && self.unavailable.is_some()
+    }
 }
 
 /// The largest disagreement between two backends on one pass.
@@ -108,6 +119,7 @@ impl CheckRun {
     pub fn passed(&self) -> bool {
         self.render_errors.is_empty()
             && self.load_errors.is_empty()
+            && !self.backends.iter().any(BackendRun::missing)
             && self.results.iter().all(|r| r.outcome.passed())
             && self.speed.passed()
     }
@@ -256,8 +268,8 @@ pub fn worst_pair(
     })
 }
 
-/// Runs the check on the backends in `only` (every one when empty; an unavailable one is
-/// reported as such), writing failure images under `failures` (each checked scene's old ones
+/// Runs the check on the backends in `only` (every available one when empty, an unavailable
+/// one noted; those named in `only` are asked for, and their absence fails the run), writing failure images under `failures` (each checked scene's old ones
 /// there are removed first). `progress` is called before each render with (done, total, what).
 /// Returns the run and every golden pass output, for the report.
 pub fn run(
@@ -315,6 +327,7 @@ pub fn run_with(
                     status.fix.unwrap_or_default()
                 )
             }),
+            required: only.contains(&kind),
         });
     }
     let total = cases.len() * available.len();

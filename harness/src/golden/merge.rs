@@ -73,8 +73,13 @@ pub fn merge(shards: &[PathBuf]) -> Result<(CheckRun, Outputs), MergeError> {
         }
         for b in run.backends {
             match merged.backends.iter_mut().find(|m| m.backend == b.backend) {
-                // Available in any shard is available; the first fingerprint seen is kept.
-                Some(m) if m.unavailable.is_some() && b.unavailable.is_none() => *m = b,
+                // Asked for and missing in any shard fails the joined run as it failed that
+                // shard (its scenes went unchecked there); otherwise available in any shard
+                // is available, and the first fingerprint seen is kept.
+                Some(m) if m.missing() => {}
+                Some(m) if b.missing() || (m.unavailable.is_some() && b.unavailable.is_none()) => {
+                    *m = b;
+                }
                 Some(_) => {}
                 None => merged.backends.push(b),
             }

@@ -54,7 +54,14 @@ pub(super) fn cases(
         page.failing_case(out, blobs, scene, pass);
     }
     if !any {
-        out.push_str("<p>None.</p>");
+        if run.speed.checks.iter().any(|c| c.failed()) {
+            out.push_str(
+                "<p>No image failed; <a href=\"#speed\">speed checks</a> did (listed at the \
+                 top and in the speed table).</p>",
+            );
+        } else {
+            out.push_str("<p>None.</p>");
+        }
     }
 
     out.push_str("<h2 id=\"passing\">Passing passes</h2><div class=\"thumbs\">");

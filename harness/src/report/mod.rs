@@ -148,6 +148,41 @@ pub fn html(
             escape(error)
         );
     }
+    for b in &run.backends {
+        let Some(reason) = &b.unavailable else {
+            continue;
+        };
+        let (class, what) = if b.required {
+            ("failed", "was asked for but is unavailable")
+        } else {
+            ("note", "is unavailable here, so nothing was checked on it")
+        };
+        let _ = write!(
+            out,
+            "<p class=\"{class}\">{} {what}: {}</p>",
+            b.backend,
+            escape(reason)
+        );
+    }
+    // A failing speed check is as much a failure as a changed pixel: named here, above the
+    // image tables, with a link to its row.
+    for c in run.speed.checks.iter().filter(|c| c.failed()) {
+        let _ = write!(
+            out,
+            "<p class=\"failed\"><a href=\"#speed\">speed</a> of {}/{} on {}: {}</p>",
+            escape(&c.scene),
+            c.pass,
+            c.backend,
+            escape(&c.describe())
+        );
+    }
+    for e in &run.speed.errors {
+        let _ = write!(
+            out,
+            "<p class=\"failed\">speed probe failed: {}</p>",
+            escape(e)
+        );
+    }
     let commands = run.bless_commands();
     if !commands.is_empty() {
         out.push_str(

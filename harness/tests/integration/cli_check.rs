@@ -449,3 +449,101 @@ fn check_notes_a_driver_other_than_the_blessing_one() {
         "the report does not say it"
     );
 }
+
+/// A backend this machine lacks (the Vulkan driver hidden): not asked for, the check passes on
+/// the others and says what it did not check, on stderr, in the summary and as a skipped JUnit
+/// case; asked for by name (`--backend`), its absence fails the check everywhere it reports.
+#[test]
+fn a_backend_asked_for_and_missing_fails_the_check_and_one_not_asked_for_is_named() {
+    if !common::available_backends().contains(&engine::BackendKind::Gl) {
+        return;
+    }
+    let root = common::temp_workspace();
+    let check = |named: &[&str]| {
+        let out = root.path().join(format!("out{}", named.len()));
+        let mut command = common::harness_command();
+        command
+            .args(["check", "--no-verify", "--no-speed", "--scene", "arrow"])
+            .args(named.iter().flat_map(|b| ["--backend", b]))
+            .arg("--out")
+            .arg(&out)
+            .arg("--junit")
+            .arg(out.join("junit.xml"))
+            .arg("--summary")
+            .arg(out.join("summary.md"))
+            .env("HARNESS_ROOT", root.path())
+            .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+            .env("VK_DRIVER_FILES", "/nonexistent/icd.json");
+        let output = command.output().unwrap();
+        let text = String::from_utf8_lossy(&output.stdout).into_owned()
+            + &String::from_utf8_lossy(&output.stderr);
+        let read = |file: &str| std::fs::read_to_string(out.join(file)).unwrap();
+        let junit = quick_junit::Report::deserialize_from_str(&read("junit.xml")).unwrap();
+        let backends = junit
+            .test_suites
+            .iter()
+            .find(|s| s.name.as_str() == "backends")
+            .unwrap_or_else(|| panic!("no backends suite: {}", read("junit.xml")))
+            .clone();
+        let vulkan = backends
+            .test_cases
+            .iter()
+            .find(|c| c.name.as_str() == "wgpu-vulkan")
+            .unwrap()
+            .status
+            .clone();
+        (
+            output.status.code(),
+            text,
+            read("summary.md"),
+            read("report.html"),
+            vulkan,
+        )
+    };
+    use quick_junit::{NonSuccessKind, TestCaseStatus};
+
+    let (code, text, summary, page, vulkan) = check(&[]);
+    assert_eq!(code, Some(0), "{text}");
+    assert!(
+        text.contains("note: wgpu-vulkan unavailable, not checked"),
+        "{text}"
+    );
+    assert!(
+        summary.contains("### Not checked") && summary.contains("- `wgpu-vulkan`: "),
+        "{summary}"
+    );
+    assert!(
+        matches!(vulkan, TestCaseStatus::Skipped { .. }),
+        "{vulkan:?}"
+    );
+    assert!(page.contains("wgpu-vulkan is unavailable here"), "the page");
+
+    let (code, text, summary, page, vulkan) = check(&["gl", "wgpu-vulkan"]);
+    assert_eq!(code, Some(1), "{text}");
+    assert!(
+        text.contains("error: wgpu-vulkan was asked for but is unavailable")
+            && text.contains("FAILED       asked for (--backend) but unavailable")
+            && text.contains("1 backend(s) asked for are unavailable"),
+        "{text}"
+    );
+    assert!(
+        summary.starts_with("## Render check FAILED")
+            && summary.contains("| - | - | wgpu-vulkan | UNAVAILABLE |"),
+        "{summary}"
+    );
+    assert!(
+        matches!(
+            vulkan,
+            TestCaseStatus::NonSuccess {
+                kind: NonSuccessKind::Failure,
+                ..
+            }
+        ),
+        "{vulkan:?}"
+    );
+    assert!(
+        page.contains("<title>Render check: FAILED")
+            && page.contains("wgpu-vulkan was asked for but is unavailable"),
+        "the page"
+    );
+}
