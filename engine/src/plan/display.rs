@@ -19,6 +19,30 @@ fn format_name(format: TextureFormat) -> &'static str {
     }
 }
 
+impl RenderPlan {
+    /// What pass `id` writes, as text: each target's name, size and format, comma-separated
+    /// (`shadow_0 1536x1024 depth32f`). A speed floor writes the same targets, so a pass's
+    /// ratio to its floor compares only between frames where this is the same.
+    pub fn written_targets(&self, id: PassId) -> Option<String> {
+        let pass = self.pass(id)?;
+        let written: Vec<String> = pass
+            .writes
+            .iter()
+            .filter_map(|&t| self.target(t))
+            .map(|t| {
+                format!(
+                    "{} {}x{} {}",
+                    t.id,
+                    t.width,
+                    t.height,
+                    format_name(t.format)
+                )
+            })
+            .collect();
+        Some(written.join(", "))
+    }
+}
+
 /// Targets' names, comma-separated.
 fn names(targets: &[TargetId]) -> String {
     let names: Vec<String> = targets.iter().map(ToString::to_string).collect();

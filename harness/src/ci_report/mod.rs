@@ -29,7 +29,9 @@ enum Status {
 fn speed_status(check: &SpeedCheck) -> Status {
     match check.outcome {
         SpeedOutcome::Passed | SpeedOutcome::Faster => Status::Passed,
-        SpeedOutcome::Slower | SpeedOutcome::MissingGolden => Status::Failed,
+        SpeedOutcome::Slower | SpeedOutcome::MissingGolden | SpeedOutcome::TargetsChanged(_) => {
+            Status::Failed
+        }
         SpeedOutcome::Untimed(_) => Status::Skipped,
     }
 }

@@ -55,10 +55,10 @@ pub fn summary(run: &CheckRun, report: &Path) -> String {
         .iter()
         .filter(|c| speed_status(c) == Status::Failed)
     {
-        let label = if c.outcome == SpeedOutcome::Slower {
-            "SLOWER"
-        } else {
-            "MISSING"
+        let label = match c.outcome {
+            SpeedOutcome::Slower => "SLOWER",
+            SpeedOutcome::TargetsChanged(_) => "TARGETS CHANGED",
+            _ => "MISSING",
         };
         let pass = format!("speed {}", c.pass);
         failing.push(row(&c.scene, &pass, c.backend.name(), label, &c.describe()));

@@ -476,6 +476,7 @@ fn print_speed(run: &CheckRun) {
             SpeedOutcome::Faster => "faster",
             SpeedOutcome::Untimed(_) => "untimed",
             SpeedOutcome::MissingGolden => "MISSING",
+            SpeedOutcome::TargetsChanged(_) => "TARGETS",
         };
         println!(
             "{:<8} {:<22} {:<12} {label:<8} {}",

@@ -268,7 +268,10 @@ pub fn speed_candidates(
         .filter(|c| {
             matches!(
                 c.outcome,
-                SpeedOutcome::Slower | SpeedOutcome::Faster | SpeedOutcome::MissingGolden
+                SpeedOutcome::Slower
+                    | SpeedOutcome::Faster
+                    | SpeedOutcome::MissingGolden
+                    | SpeedOutcome::TargetsChanged(_)
             )
         })
         .filter(|c| {
@@ -436,6 +439,7 @@ pub fn accept_timings(
                 pass: c.pass,
                 pass_ms: vec![c.ms],
                 floor_ms: vec![c.ms / c.ratio],
+                targets: c.targets.clone(),
             }],
         };
         let stamp = Stamp {

@@ -37,6 +37,11 @@ pub struct PassSpeed {
     /// Its floor's GPU ms, one per round, each timed right after the pass (the mean of its
     /// copies where a short floor is repeated to last [`MIN_FLOOR_MS`]).
     pub floor_ms: Vec<f64>,
+    /// What the pass and its floor write ([`engine::plan::RenderPlan::written_targets`]): a
+    /// ratio compares only with one of the same targets (None: not known, from an older
+    /// probe).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub targets: Option<String>,
 }
 
 impl PassSpeed {
@@ -115,6 +120,8 @@ pub struct PreparedProbe {
     recorded: RecordedFrame,
     floors: Floors,
     passes: Vec<PassId>,
+    /// What each pass writes, as its samples will carry it.
+    targets: Vec<(PassId, String)>,
 }
 
 impl PreparedProbe {
@@ -153,6 +160,12 @@ impl PreparedProbe {
             recorded,
             floors,
             passes: prepared.plan().passes.iter().map(|p| p.id).collect(),
+            targets: prepared
+                .plan()
+                .passes
+                .iter()
+                .filter_map(|p| Some((p.id, prepared.plan().written_targets(p.id)?)))
+                .collect(),
         };
         match probe.warm_up() {
             Ok(()) => Ok(probe),
@@ -194,7 +207,14 @@ impl PreparedProbe {
             &self.passes,
             rounds,
         ) {
-            Ok(passes) => {
+            Ok(mut passes) => {
+                for pass in &mut passes {
+                    pass.targets = self
+                        .targets
+                        .iter()
+                        .find(|(id, _)| *id == pass.pass)
+                        .map(|(_, t)| t.clone());
+                }
                 let (scene, kind) = (self.scene.clone(), self.kind);
                 self.destroy();
                 Ok(SceneSpeed {
@@ -411,6 +431,7 @@ fn sample(
                 pass: id,
                 pass_ms: Vec::with_capacity(rounds),
                 floor_ms: Vec::with_capacity(rounds),
+                targets: None,
             });
             copies.push(floor_copies(floor_ns / 1e6));
         }

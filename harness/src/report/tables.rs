@@ -155,6 +155,7 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
             SpeedOutcome::Faster => ("passed", "faster"),
             SpeedOutcome::Untimed(_) => ("passed", "untimed"),
             SpeedOutcome::MissingGolden => ("failed", "no golden"),
+            SpeedOutcome::TargetsChanged(_) => ("failed", "targets changed"),
         };
         let factor = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("x{v:.3}"));
         let detail = match &c.outcome {

@@ -221,7 +221,10 @@ pub fn bless_scenes(
             for check in &checks {
                 let moved = matches!(
                     check.outcome,
-                    SpeedOutcome::Slower | SpeedOutcome::Faster | SpeedOutcome::MissingGolden
+                    SpeedOutcome::Slower
+                        | SpeedOutcome::Faster
+                        | SpeedOutcome::MissingGolden
+                        | SpeedOutcome::TargetsChanged(_)
                 );
                 let written = every_pass || moved;
                 if written {

@@ -18,6 +18,7 @@ const HEADER: &str = "\
 # Per backend and pass: the speed ratio `harness check` compares (the pass submitted alone,
 # its fastest time over its floor's fastest, one rasterizer thread). `ms`, `floor_ms` and
 # `host` are for information only: milliseconds do not travel between hosts, ratios do.
+# `targets` is what the pass and its floor write: a ratio compares only at the same targets.
 ";
 
 /// One pass's timing golden.
@@ -30,6 +31,11 @@ pub struct PassTiming {
     pub ms: f64,
     /// Its floor's fastest time, ms (information).
     pub floor_ms: f64,
+    /// What the pass and its floor wrote ([`engine::plan::RenderPlan::written_targets`]): a
+    /// probe of other targets is not compared with this ratio. Absent in goldens blessed before
+    /// it was kept (then nothing is compared but the ratio).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub targets: Option<String>,
     /// Why the pass's cost changed, as the person blessing said it (`harness bless --reason`);
     /// dropped when the pass is recorded again without one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -133,6 +139,7 @@ impl TimingGoldens {
                     ratio: round(ratio, 4),
                     ms: round(ms, 3),
                     floor_ms: round(floor_ms, 3),
+                    targets: pass.targets.clone(),
                     reason: stamp.reason.map(str::to_owned),
                 },
             );

@@ -22,6 +22,11 @@ pub enum SpeedOutcome {
     Untimed(String),
     /// No timing golden for this backend and pass: a failure, like a missing image golden.
     MissingGolden,
+    /// The pass writes other targets than when its timing golden was blessed (what they were
+    /// and are): its floor writes them too, so the ratios do not compare (a smaller shadow map
+    /// shrinks the floor more than the pass and reads as a slowdown). A failure, like an image
+    /// golden of another size: bless the timing with the change.
+    TargetsChanged(String),
 }
 
 /// One speed check.
@@ -37,6 +42,10 @@ pub struct SpeedCheck {
     pub ratio: f64,
     /// The pass's fastest time, ms.
     pub ms: f64,
+    /// What the pass wrote ([`PassSpeed::targets`](crate::measure::speed::PassSpeed::targets)),
+    /// which accepting this check's ratio records beside it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub targets: Option<String>,
     /// The golden ratio.
     pub golden: Option<f64>,
     /// The limit, a factor (ratio / golden above it fails).
@@ -67,7 +76,7 @@ impl SpeedCheck {
     pub fn failed(&self) -> bool {
         matches!(
             self.outcome,
-            SpeedOutcome::Slower | SpeedOutcome::MissingGolden
+            SpeedOutcome::Slower | SpeedOutcome::MissingGolden | SpeedOutcome::TargetsChanged(_)
         )
     }
 
@@ -81,6 +90,12 @@ impl SpeedCheck {
                     self.ratio, self.ms
                 )
             }
+            (SpeedOutcome::TargetsChanged(what), ..) => format!(
+                "not comparable: {what}; its floor writes the same targets, so its ratio to the \
+                 floor compares only at equal targets: bless its timing with the change ({:.2} \
+                 ms now)",
+                self.ms
+            ),
             (outcome, Some(slowdown), Some(limit)) => {
                 let noise = self
                     .noise
@@ -161,9 +176,14 @@ pub fn check_speed_with(
         let (Some(ratio), Some(ms)) = (pass.ratio(), pass.min_ms()) else {
             continue;
         };
-        let blessed = golden_backend
-            .and_then(|g| g.passes.get(&pass.pass))
-            .map(|g| g.ratio);
+        let blessed_pass = golden_backend.and_then(|g| g.passes.get(&pass.pass));
+        let blessed = blessed_pass.map(|g| g.ratio);
+        let targets_changed = match (blessed_pass.and_then(|g| g.targets.as_ref()), &pass.targets) {
+            (Some(then), Some(now)) if then != now => Some(format!(
+                "it writes {now}, where it wrote {then} when blessed"
+            )),
+            _ => None,
+        };
         let own = recording.and_then(|(name, r)| {
             let recorded = r
                 .scenes
@@ -202,6 +222,9 @@ pub fn check_speed_with(
             .map(|(n, _)| noise.limit_for(n.max(floor), ms));
         let outcome = match (golden, &noise_figure, limit) {
             (None, ..) => SpeedOutcome::MissingGolden,
+            _ if targets_changed.is_some() => {
+                SpeedOutcome::TargetsChanged(targets_changed.unwrap_or_default())
+            }
             _ if ms < MIN_PASS_MS => SpeedOutcome::Untimed(format!(
                 "too short to time ({ms:.3} ms, under {MIN_PASS_MS} ms)"
             )),
@@ -236,6 +259,7 @@ pub fn check_speed_with(
             pass: pass.pass,
             ratio,
             ms,
+            targets: pass.targets.clone(),
             golden,
             limit,
             noise: noise_figure,
@@ -322,7 +346,7 @@ pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
         let group = &mut groups[index];
         match (&c.outcome, c.limit) {
             (SpeedOutcome::Untimed(_), _) => group.3 += 1,
-            (SpeedOutcome::MissingGolden, _) | (_, None) => {}
+            (SpeedOutcome::MissingGolden | SpeedOutcome::TargetsChanged(_), _) | (_, None) => {}
             (_, Some(limit)) => group.2.push(limit),
         }
     }

@@ -16,6 +16,7 @@ fn slower(backend: BackendKind) -> SpeedCheck {
         pass: PassId::Geometry,
         ratio: 6.0,
         ms: 3.0,
+        targets: None,
         golden: Some(2.0),
         limit: Some(1.44),
         noise: None,
@@ -59,6 +60,7 @@ fn a_timing_golden_is_accepted_only_on_the_host_that_blessed_it() {
             pass: PassId::Geometry,
             pass_ms: vec![2.0],
             floor_ms: vec![1.0],
+            targets: None,
         }],
     };
     let cpu = cpu_signature();

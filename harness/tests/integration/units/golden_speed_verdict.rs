@@ -19,11 +19,13 @@ fn probe(tonemap_ms: f64, geometry_ms: f64) -> SceneSpeed {
                 pass: PassId::ToneMap,
                 pass_ms: vec![tonemap_ms],
                 floor_ms: vec![0.5],
+                targets: None,
             },
             PassSpeed {
                 pass: PassId::Geometry,
                 pass_ms: vec![geometry_ms],
                 floor_ms: vec![1.0],
+                targets: None,
             },
         ],
     }
@@ -255,6 +257,7 @@ fn covered(
         pass: PassId::ToneMap,
         ratio: 2.0,
         ms: 1.0,
+        targets: None,
         golden: Some(2.0),
         limit,
         noise: None,
@@ -311,4 +314,62 @@ fn stamp<'a>(host: &'a str, cpu: &'a str) -> harness::golden::speed::Stamp<'a> {
         blessed: "t",
         reason: None,
     }
+}
+
+/// A pass whose targets changed since its golden (a smaller shadow map: its floor shrinks with
+/// it) is not compared, whichever way its ratio moved: it fails as not comparable, naming both,
+/// and its ratio is not called slower or faster. Goldens that kept no targets compare the ratio
+/// alone, as before.
+#[test]
+fn a_pass_whose_targets_changed_is_not_compared_with_its_golden() {
+    let with_targets = |tonemap_ms: f64, targets: &str| {
+        let mut p = probe(tonemap_ms, 4.0);
+        for pass in &mut p.passes {
+            pass.targets = Some(format!("{} {targets}", pass.pass));
+        }
+        p
+    };
+    let mut goldens = TimingGoldens::default();
+    goldens.record(
+        &with_targets(3.0, "1024x1024 depth32f"),
+        &[],
+        &stamp("here", &cpu_signature()),
+    );
+    let noise = model();
+    let tonemap = |p: &SceneSpeed, goldens: &TimingGoldens| {
+        check_speed(p, goldens, &noise, "here")
+            .into_iter()
+            .find(|c| c.pass == PassId::ToneMap)
+            .unwrap()
+    };
+    let same = tonemap(&with_targets(3.0, "1024x1024 depth32f"), &goldens);
+    assert_eq!(same.outcome, SpeedOutcome::Passed);
+    for ms in [1.0, 3.0, 9.0] {
+        let other = tonemap(&with_targets(ms, "256x256 depth32f"), &goldens);
+        let SpeedOutcome::TargetsChanged(what) = &other.outcome else {
+            panic!("{:?}", other.outcome);
+        };
+        assert!(
+            what.contains("tonemap 256x256 depth32f") && what.contains("tonemap 1024x1024"),
+            "{what}"
+        );
+        assert!(other.failed());
+        assert!(
+            other.describe().starts_with("not comparable: ")
+                && other
+                    .describe()
+                    .contains("bless its timing with the change"),
+            "{}",
+            other.describe()
+        );
+    }
+    // Blessed before targets were kept: the ratio alone.
+    let mut old = goldens.clone();
+    for timings in old.backends.values_mut() {
+        for pass in timings.passes.values_mut() {
+            pass.targets = None;
+        }
+    }
+    let slower = tonemap(&with_targets(9.0, "256x256 depth32f"), &old);
+    assert_eq!(slower.outcome, SpeedOutcome::Slower);
 }
