@@ -25,6 +25,15 @@ pub(crate) fn pass_table(
         ..Default::default()
     };
     let loaded = load_scenes(scenes)?;
+    // An injected slowdown is a test of the speed checks, not this build's speed: said on every
+    // output, and kept out of the history (whose series are an unchanged build's ratios).
+    let injected = slow.map(|s| format!("{} slowed x{} (--slow-pass)", s.pass, s.factor));
+    if let Some(injected) = &injected {
+        eprintln!(
+            "note: injected slowdown: {injected}; these timings are not this build's, and \
+             the speed history is not appended"
+        );
+    }
     let (results, failed) = each_scene_and_backend(&loaded, backends, |scene, kind| {
         eprintln!("timing {} on {kind} ({frames} frames) ...", scene.name);
         let result = harness::measure::bench::bench_scene_with(scene, kind, frames, variations)?;
@@ -40,11 +49,15 @@ pub(crate) fn pass_table(
             println!("  {:<44} {:>8.3} ms  ({})", p.what, p.ms, p.on);
         }
     }
-    let text = serde_json::to_string_pretty(
-        &serde_json::json!({ "precompute": precompute, "scenes": results }),
-    )?;
+    let text = serde_json::to_string_pretty(&serde_json::json!({
+        "precompute": precompute,
+        "scenes": results,
+        "injected": injected,
+    }))?;
     save_bench_json(out, harness::measure::bench::BENCH_JSON, &text)?;
-    append_bench_history(out, &results);
+    if injected.is_none() {
+        append_bench_history(out, &results);
+    }
     if json {
         println!("{text}");
     }

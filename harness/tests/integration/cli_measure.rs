@@ -8,7 +8,7 @@ use common::cli::{darken, harness};
 /// `harness bench --json`: for each scene, backend and pass, the median GPU time and its ratio
 /// to the floor (a trivial pass writing the same targets): each frame's ratio, with the floor
 /// submitted right after that frame, and their lower quartile; kept for the check report and
-/// appended to the speed history.
+/// appended to the speed history, unless a slowdown was injected.
 #[test]
 fn bench_json_gives_each_pass_its_time_and_ratio_to_the_floor() {
     let dir = tempfile::tempdir().unwrap();
@@ -75,6 +75,32 @@ fn bench_json_gives_each_pass_its_time_and_ratio_to_the_floor() {
     assert_eq!(entries[0].command, "bench");
     assert_eq!(entries[0].ratios.len(), passes.len());
     assert!(entries[0].hosts.contains_key(&engine::BackendKind::Gl));
+
+    // An injected slowdown is said, kept in bench.json for the page, and not appended to the
+    // history (an unchanged build's series).
+    let (code, stdout, stderr) = harness(&[
+        "bench",
+        "--scene",
+        "arrow",
+        "--backend",
+        "gl",
+        "--frames",
+        "2",
+        "--slow-pass",
+        "tonemap",
+        "--json",
+        "--out",
+        out,
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("note: injected slowdown: tonemap slowed x2 (--slow-pass)"),
+        "{stderr}"
+    );
+    let json: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(json["injected"], "tonemap slowed x2 (--slow-pass)");
+    let (entries, _) = harness::golden::speed::history::read(dir.path());
+    assert_eq!(entries.len(), 1, "the injected run went into the history");
 }
 
 /// `harness sweep --out DIR` keeps its results in DIR, where `harness check --out DIR` finds

@@ -71,14 +71,22 @@ pub fn series_svg(points: &[SeriesPoint]) -> String {
 /// (per-pass times against floors, scaling series plots); empty when there are none.
 pub fn report_sections(dir: &std::path::Path) -> String {
     let mut out = String::new();
-    if let Some(benches) = std::fs::read(dir.join(BENCH_JSON))
+    let bench = std::fs::read(dir.join(BENCH_JSON))
         .ok()
-        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
-        .and_then(|v| v["scenes"].as_array().cloned())
-    {
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok());
+    if let Some((benches, injected)) = bench.as_ref().and_then(|v| {
+        let injected = v["injected"].as_str().map(crate::html::escape);
+        Some((v["scenes"].as_array()?.clone(), injected))
+    }) {
+        out.push_str("<h2>Pass time against floor (latest <code>harness bench</code>)</h2>");
+        if let Some(injected) = injected {
+            out.push_str(&format!(
+                "<p class=\"note\">With an injected slowdown: {injected}. Not this build's \
+                 timings.</p>"
+            ));
+        }
         out.push_str(
-            "<h2>Pass time against floor (latest <code>harness bench</code>)</h2>\
-             <table><tr><th>scene</th><th>backend</th><th>pass</th><th>ms</th><th>floor ms</th>\
+            "<table><tr><th>scene</th><th>backend</th><th>pass</th><th>ms</th><th>floor ms</th>\
              <th>ratio</th></tr>",
         );
         let cell = |v: &serde_json::Value, digits: usize| {
