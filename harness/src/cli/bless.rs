@@ -165,7 +165,16 @@ pub(crate) fn run(
         refused = bless_images(&cases, &store, &locks, passes, kind, &options)?;
     }
     if options.speed {
-        bless_speed(&cases, &store, &options)?;
+        let refused_timings = bless_speed(&cases, &store, &options)?;
+        // Timings alone were asked for: a backend whose goldens another host blessed, kept,
+        // is a refusal (with images, keeping them is what a bless elsewhere does).
+        if refused_timings > 0 && !options.images {
+            eprintln!(
+                "error: {refused_timings} scene and backend timing golden(s) were kept as \
+                 another host's, not blessed (each line above says why and what to run)"
+            );
+            refused += refused_timings;
+        }
     }
     Ok(if refused == 0 {
         ExitCode::SUCCESS
@@ -174,12 +183,13 @@ pub(crate) fn run(
     })
 }
 
-/// Probes every available backend and rewrites the timing goldens that moved.
+/// Probes every available backend and rewrites the timing goldens that moved; returns how
+/// many scenes' backends it kept whole as another host's.
 fn bless_speed(
     cases: &[harness::golden::suite::Case],
     store: &harness::golden::GoldenStore,
     options: &Options,
-) -> anyhow::Result<()> {
+) -> anyhow::Result<usize> {
     let backends: Vec<(BackendKind, String)> = BackendKind::ALL
         .into_iter()
         .filter_map(|kind| {
@@ -211,10 +221,13 @@ fn bless_speed(
         },
         |what| eprintln!("{what} ..."),
     )?;
-    for line in lines {
+    for line in &lines {
         println!("{line}");
     }
-    Ok(())
+    Ok(lines
+        .iter()
+        .filter(|l| l.pass.is_none() && l.fate == harness::golden::speed::bless::Fate::Kept)
+        .count())
 }
 
 /// Whether `candidates`, the new goldens of `case`, reproduce under every verification source

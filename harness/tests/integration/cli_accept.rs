@@ -366,3 +366,46 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
     assert_eq!(reason_of("geometry").as_deref(), Some(why));
     assert_eq!(check(), (Some(0), vec![]));
 }
+
+/// `bless --speed-only` where another host blessed every backend's timing goldens writes
+/// nothing and says so: each backend kept with why and the command that moves them, and exit
+/// 1 (a script must not take it for a bless). Nothing is probed.
+#[test]
+fn a_speed_only_bless_that_keeps_another_hosts_goldens_fails() {
+    let root = common::temp_workspace();
+    let timing = root.path().join("golden/arrow/timing.toml");
+    let text = std::fs::read_to_string(&timing).unwrap();
+    let elsewhere: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("host = ") {
+                "host = \"a host that is not this one\"".to_owned()
+            } else {
+                l.to_owned()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(&timing, &elsewhere).unwrap();
+    let output = common::harness_command()
+        .args(["bless", "--scene", "arrow", "--speed-only", "--reason", "r"])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    if common::available_backends().is_empty() {
+        return;
+    }
+    assert_eq!(output.status.code(), Some(1), "{stdout}{stderr}");
+    assert!(
+        stdout.contains("(speed): kept: ") && stdout.contains("--every-pass"),
+        "{stdout}"
+    );
+    assert!(
+        stderr.contains("timing golden(s) were kept as another host's, not blessed"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("probe 1 of"), "{stderr}");
+    assert_eq!(std::fs::read_to_string(&timing).unwrap(), elsewhere);
+}
