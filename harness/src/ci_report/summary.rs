@@ -78,7 +78,8 @@ pub fn summary(run: &CheckRun, report: &Path) -> String {
             let _ = writeln!(
                 out,
                 "\nAfter reviewing the page, bless what changed on purpose (each command \
-                 rewrites only its scene's passes outside tolerance or without a golden):\n\n```sh"
+                 rewrites only its scene's passes outside tolerance or without a golden).{}\n\n```sh",
+                crate::golden::command_line::moves_timings_note(&commands)
             );
             for command in commands {
                 let _ = writeln!(out, "{command}");

@@ -357,13 +357,19 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
     );
     if failed > 0 {
         println!("failure images: {failures}");
+        let commands = run.bless_commands();
+        let kept = if run.verifications.is_empty() {
+            ""
+        } else {
+            "; or accept what this check kept, as above"
+        };
         println!(
             "after reviewing the report, bless what changed on purpose (one command per \
              scene; it renders again and rewrites only the passes outside tolerance or without \
-             a golden; add --reason \"why\" to record why; or accept what this check kept, \
-             as above):"
+             a golden; add --reason \"why\" to record why{kept}).{}",
+            harness::golden::command_line::moves_timings_note(&commands)
         );
-        for command in run.bless_commands() {
+        for command in commands {
             println!("  {command}");
         }
     }
@@ -461,9 +467,9 @@ fn print_speed(run: &CheckRun) {
     println!(
         "\nspeed: each pass alone over its floor, against its timing golden \
          (golden/<scene>/timing.toml; limits from golden/timing-noise.toml), or on a recorded \
-         host against its own recording (golden/evidence/<host>/timing.toml); \"s of it\" places \
-         the ratio on the way to its limit, ln(ratio / golden) / ln(limit): 0 unchanged, 1 at the \
-         limit (fails above), negative faster"
+         host against its own recording (golden/evidence/<host>/timing.toml); \"0.52 of it\" after \
+         the limit places the ratio on the way to it, ln(ratio / golden) / ln(limit): 0 \
+         unchanged, 1 at the limit (fails above), negative faster"
     );
     println!(
         "{:<8} {:<22} {:<12} {:<8} value",

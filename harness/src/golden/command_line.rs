@@ -41,6 +41,22 @@ pub fn speed_bless_command(scene: &str, on_blessing_host: bool) -> String {
     format!("{} --speed-only{every_pass}", bless_command(scene))
 }
 
+/// What to add where `commands` ([`crate::golden::check::CheckRun::bless_commands`]) are
+/// printed under "each rewrites only what moved": a `--speed-only --every-pass` command among
+/// them rewrites more, so it is said what (empty when there is none).
+pub fn moves_timings_note(commands: &[String]) -> &'static str {
+    if commands
+        .iter()
+        .any(|c| c.ends_with("--speed-only --every-pass"))
+    {
+        " A command with `--speed-only --every-pass` is for timings this host did not bless: it \
+         moves the backend's timing goldens to this host, every pass; then measure this host's \
+         timing noise (`harness noise --timing --write`)."
+    } else {
+        ""
+    }
+}
+
 /// The command that accepts what the last check rendered and verified, without rendering
 /// again (`bless --from-last-check`), naming the check's `--out` folder when it was not the
 /// default (`None`), and the workspace as [`bless_command`] does.

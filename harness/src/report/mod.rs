@@ -185,9 +185,11 @@ pub fn html(
     }
     let commands = run.bless_commands();
     if !commands.is_empty() {
-        out.push_str(
+        let _ = write!(
+            out,
             "<p>After reviewing, bless what changed on purpose (each command rewrites only its \
-             scene's passes outside tolerance or without a golden):</p><ul>",
+             scene's passes outside tolerance or without a golden).{}</p><ul>",
+            escape(crate::golden::command_line::moves_timings_note(&commands))
         );
         for command in &commands {
             let _ = write!(out, "<li>{}</li>", bless_html(command));
