@@ -58,11 +58,27 @@ pub(crate) struct NoiseArgs {
     /// unless its --out said otherwise): the drift of an unchanged build over many runs.
     #[arg(long, value_name = "OUT", requires = "record_host")]
     history: Option<std::path::PathBuf>,
+    /// With --timing: measure although other tasks keep this machine busy (by default
+    /// --write and --record-host refuse to: the figures would be that load's).
+    #[arg(long, requires = "timing")]
+    busy_ok: bool,
 }
 
 /// `harness noise` as its command line asks: a host's recording, the timing-noise model, or
 /// the image noise model, each with its default margin unless one is given.
 pub(crate) fn entry(args: NoiseArgs) -> anyhow::Result<ExitCode> {
+    if args.timing && !args.busy_ok {
+        let cpus = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+        let busy = harness::golden::speed::measure::others_running(10)
+            .and_then(|others| harness::golden::speed::measure::too_busy(others, cpus));
+        match busy {
+            Some(why) if args.write || args.record_host.is_some() => {
+                anyhow::bail!("{why}");
+            }
+            Some(why) => eprintln!("warning: {why}"),
+            None => {}
+        }
+    }
     if let Some(name) = &args.record_host {
         return super::noise_timing::record_host(name, &args.scenes, args.history.as_deref());
     }

@@ -323,3 +323,42 @@ pub fn scores(
         })
         .collect()
 }
+
+/// Tasks running on this machine besides the reader: the median of `samples` readings of
+/// `/proc/stat`'s `procs_running` (which counts the reading thread itself) a tenth of a second
+/// apart. None where it cannot be read (not Linux).
+pub fn others_running(samples: usize) -> Option<usize> {
+    let mut readings = Vec::with_capacity(samples);
+    for i in 0..samples.max(1) {
+        if i > 0 {
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        }
+        let stat = std::fs::read_to_string("/proc/stat").ok()?;
+        let running = stat
+            .lines()
+            .find_map(|l| l.strip_prefix("procs_running "))?
+            .trim()
+            .parse::<usize>()
+            .ok()?;
+        readings.push(running.saturating_sub(1));
+    }
+    readings.sort_unstable();
+    Some(readings[readings.len() / 2])
+}
+
+/// Why a machine with `others` tasks running besides the measurement, on `cpus` CPUs, is too
+/// busy to measure timing noise on (None: quiet enough). From half the CPUs busy: the probes
+/// run one rasterizer thread, and the busy-neighbour source adds a spinning process itself,
+/// so another load on top measures a host that is not this one at rest, and a figure taken
+/// then stays (a pass's noise is its largest spread; a recording only adds probes).
+pub fn too_busy(others: usize, cpus: usize) -> Option<String> {
+    (others >= (cpus / 2).max(1)).then(|| {
+        format!(
+            "this machine is busy: {others} other task(s) running on {cpus} CPU(s) (the median \
+             of ten readings of /proc/stat's procs_running). Timing figures measured now \
+             measure that load, and a pass's noise is its largest spread, kept for good: one \
+             busy probe can leave it too noisy to time. Measure on a quiet machine (stop builds, \
+             tests and other checks), or pass --busy-ok to measure anyway"
+        )
+    })
+}

@@ -33,3 +33,24 @@ fn the_model_keeps_each_tiers_worst_source_and_scores_stay_at_half_the_limit() {
         assert!(score <= 0.5 + 1e-9, "{m:?}: {score}");
     }
 }
+
+/// Timing noise is measured on a quiet machine only: from half the CPUs busy with other tasks
+/// (at least one), `noise --timing --write` and `--record-host` refuse, saying why and how to
+/// measure anyway; the reading works where /proc/stat exists.
+#[test]
+fn timing_noise_is_not_measured_on_a_busy_machine() {
+    use harness::golden::speed::measure::{others_running, too_busy};
+    assert_eq!(too_busy(0, 2), None);
+    let why = too_busy(1, 2).expect("one other task on two CPUs is busy");
+    assert!(
+        why.contains("1 other task(s) running on 2 CPU(s)") && why.contains("--busy-ok"),
+        "{why}"
+    );
+    assert_eq!(too_busy(0, 1), None);
+    assert!(too_busy(1, 1).is_some());
+    assert_eq!(too_busy(7, 16), None);
+    assert!(too_busy(8, 16).is_some());
+    if cfg!(target_os = "linux") {
+        assert!(others_running(1).is_some());
+    }
+}
