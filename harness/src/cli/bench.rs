@@ -450,7 +450,8 @@ fn append_bench_history(out: &Path, results: &[harness::measure::bench::SceneBen
             }
         }
     }
-    history::record(out, "bench", hosts, ratios);
+    // A bench's ratios are not pooled with a recording's: no scene digests needed.
+    history::record(out, "bench", hosts, ratios, Default::default());
 }
 
 /// The backends asked for, or every one when none is.

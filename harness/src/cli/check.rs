@@ -38,6 +38,11 @@ pub(crate) fn run(
     options: Options,
 ) -> anyhow::Result<ExitCode> {
     let (mut cases, broken) = load_cases_isolated(scenes)?;
+    // What each scene was loaded from, for the speed history (before `--pass` narrows).
+    let input_digests: std::collections::BTreeMap<String, String> = cases
+        .iter()
+        .map(|c| (c.name().to_owned(), c.inputs.digest()))
+        .collect();
     // Every scene's speed, before `--pass` narrows the image checks.
     let speed_scenes: Vec<(String, String)> = cases
         .iter()
@@ -103,7 +108,12 @@ pub(crate) fn run(
         // The history is the series of an unchanged build's ratios (drift, a host's record):
         // a run with the debug slowdown is not one.
         if !options.unspecialised_lighting {
-            harness::golden::speed::append_history(out, &run.speed, &available);
+            harness::golden::speed::append_history(
+                out,
+                &run.speed,
+                &available,
+                input_digests.clone(),
+            );
         }
     }
     bar.finish_and_clear();

@@ -230,7 +230,15 @@ pub(super) fn record_host(
         anyhow::bail!("--record-host {name:?}: a host's name is letters, digits, '-' and '_'");
     }
     let store = GoldenStore::workspace();
-    let scenes = named_scenes(scenes)?;
+    let cases = load_cases(scenes)?;
+    let input_digests: std::collections::BTreeMap<String, String> = cases
+        .iter()
+        .map(|c| (c.name().to_owned(), c.inputs.digest()))
+        .collect();
+    let scenes: Vec<(String, String)> = cases
+        .iter()
+        .map(|c| (c.name().to_owned(), c.argument()))
+        .collect();
     let backends: Vec<(BackendKind, String)> = BackendKind::ALL
         .into_iter()
         .filter_map(|kind| {
@@ -291,7 +299,19 @@ pub(super) fn record_host(
                     skipped
                 );
             }
-            entries
+            // Only an unchanged build's checks: this executable, each scene loaded from the
+            // bytes it is now (a check of an edited scene, or of a rebuilt harness, under the
+            // same commit measured something else).
+            let (kept, left_out) =
+                harness::golden::speed::history::of_this_build(&entries, &input_digests);
+            if left_out > 0 {
+                eprintln!(
+                    "note: {left_out} check(s) of the history left out: another build of the \
+                     harness, or their scenes edited since (only this executable's checks of \
+                     the scenes as they are now count)"
+                );
+            }
+            kept
         }
         None => Vec::new(),
     };

@@ -40,6 +40,26 @@ impl SceneInputs {
         }
     }
 
+    /// One digest of every file and its digest (SHA-256, hex): equal exactly when the scene was
+    /// loaded from the same bytes.
+    pub fn digest(&self) -> String {
+        use sha2::Digest as _;
+        let mut files = self.files.clone();
+        files.sort();
+        let mut hasher = sha2::Sha256::new();
+        for (file, digest) in &files {
+            hasher.update(file.to_string_lossy().as_bytes());
+            hasher.update([0]);
+            hasher.update(digest.as_deref().unwrap_or("unreadable").as_bytes());
+            hasher.update([b'\n']);
+        }
+        hasher
+            .finalize()
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect()
+    }
+
     /// The files that differ between these inputs and `now`'s: changed, gone, or read by only
     /// one of the two loads.
     pub fn changed(&self, now: &SceneInputs) -> Vec<PathBuf> {

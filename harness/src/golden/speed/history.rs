@@ -40,6 +40,60 @@ pub struct HistoryEntry {
     pub hosts: BTreeMap<BackendKind, String>,
     /// The ratios.
     pub ratios: Vec<HistoryRatio>,
+    /// Per scene, what it was loaded from
+    /// ([`SceneInputs::digest`](crate::golden::scene_inputs::SceneInputs::digest); `check`'s
+    /// entries): a scene edited between two runs of one commit is another scene's series.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub inputs: BTreeMap<String, String>,
+    /// The harness executable that measured ([`build`]): an uncommitted change to the engine
+    /// is another build of the same commit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub build: Option<String>,
+}
+
+/// This harness executable's identity: a digest of its size and modification time (None where
+/// they cannot be read). Two builds of the same commit with edits between them differ.
+pub fn build() -> Option<String> {
+    use sha2::Digest as _;
+    let meta = std::env::current_exe().and_then(std::fs::metadata).ok()?;
+    let modified = meta
+        .modified()
+        .ok()?
+        .duration_since(std::time::UNIX_EPOCH)
+        .ok()?;
+    let identity = format!("{} {}", meta.len(), modified.as_nanos());
+    let digest = sha2::Sha256::digest(identity.as_bytes());
+    Some(digest.iter().take(8).map(|b| format!("{b:02x}")).collect())
+}
+
+/// Of `entries`, what an unchanged build measured: the `check` entries of this executable
+/// ([`build`]), each keeping only the ratios of scenes loaded from the bytes `inputs` names
+/// (scene to [`SceneInputs::digest`](crate::golden::scene_inputs::SceneInputs::digest)); with
+/// how many `check` entries were left out whole (another build, or every scene edited).
+pub fn of_this_build(
+    entries: &[HistoryEntry],
+    inputs: &BTreeMap<String, String>,
+) -> (Vec<HistoryEntry>, usize) {
+    let this = build();
+    let mut kept = Vec::new();
+    let mut left_out = 0;
+    for entry in entries.iter().filter(|e| e.command == "check") {
+        let mut entry = entry.clone();
+        if this.is_none() || entry.build != this {
+            entry.ratios.clear();
+        }
+        entry.ratios.retain(|r| {
+            inputs
+                .get(&r.scene)
+                .is_some_and(|d| entry.inputs.get(&r.scene) == Some(d))
+        });
+        if entry.ratios.is_empty() {
+            left_out += 1;
+        } else {
+            kept.push(entry);
+        }
+    }
+    (kept, left_out)
 }
 
 /// The workspace's commit, when it is a git tree and git is there.
@@ -75,13 +129,14 @@ pub fn append(out: &Path, entry: &HistoryEntry) {
 }
 
 /// Appends one entry of `command` (`check` or `bench`) to the history in `out`, stamped with
-/// the time and the commit: `hosts` by backend, `ratios` as measured. Nothing when there are
-/// no ratios.
+/// the time, the commit and the build: `hosts` by backend, `ratios` as measured, `inputs` the
+/// scenes' digests. Nothing when there are no ratios.
 pub fn record(
     out: &Path,
     command: &str,
     hosts: BTreeMap<BackendKind, String>,
     ratios: Vec<HistoryRatio>,
+    inputs: BTreeMap<String, String>,
 ) {
     if ratios.is_empty() {
         return;
@@ -94,6 +149,8 @@ pub fn record(
             commit: commit(),
             hosts,
             ratios,
+            inputs,
+            build: build(),
         },
     );
 }

@@ -320,7 +320,12 @@ pub fn check_scenes(
 }
 
 /// Appends a check's ratios to the speed history in `out` ([`history`]).
-pub fn append_history(out: &std::path::Path, run: &SpeedRun, backends: &[(BackendKind, String)]) {
+pub fn append_history(
+    out: &std::path::Path,
+    run: &SpeedRun,
+    backends: &[(BackendKind, String)],
+    inputs: std::collections::BTreeMap<String, String>,
+) {
     let hosts = backends
         .iter()
         .map(|(kind, driver)| (*kind, host_fingerprint(driver)))
@@ -336,5 +341,5 @@ pub fn append_history(out: &std::path::Path, run: &SpeedRun, backends: &[(Backen
             ms: c.ms,
         })
         .collect();
-    history::record(out, "check", hosts, ratios);
+    history::record(out, "check", hosts, ratios, inputs);
 }
