@@ -107,8 +107,10 @@ pub(super) fn details(out: &mut String, run: &CheckRun) {
     }
     out.push_str("</table>");
     out.push_str(
-        "<h2>GPU time per pass (ms)</h2><table><tr><th>scene</th><th>backend</th><th>pass</th>\
-         <th>ms</th></tr>",
+        "<h2>GPU time per pass (ms)</h2><p>Of the check's image renders: each is a fresh \
+         backend's first frame, so the drivers' shader compiles are in it. The speed table's ms \
+         are each pass's fastest of many submissions after a warm-up, what the speed checks \
+         compare.</p><table><tr><th>scene</th><th>backend</th><th>pass</th><th>ms</th></tr>",
     );
     for t in &run.timings {
         let _ = write!(

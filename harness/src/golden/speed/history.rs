@@ -246,10 +246,14 @@ fn history_svg(title: &str, passes: &PassSeries, runs: usize) -> String {
             .x_label_area_size(28)
             .y_label_area_size(44)
             .build_cartesian_2d(0.0..(runs.max(2) - 1) as f64, (lo * 0.98)..(hi * 1.02))?;
+        // Whole runs on the x axis (numbered from 1), and a mark on each point, so that a pass
+        // seen in one run only still shows.
         chart
             .configure_mesh()
             .x_desc("check run")
             .y_desc("ratio / first")
+            .x_labels(runs.clamp(2, 11))
+            .x_label_formatter(&|x| format!("{:.0}", x + 1.0))
             .label_style(("sans-serif", 10))
             .draw()?;
         for (index, (name, line)) in lines.iter().enumerate() {
@@ -258,6 +262,10 @@ fn history_svg(title: &str, passes: &PassSeries, runs: usize) -> String {
                 .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))?
                 .label(name.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], color));
+            chart.draw_series(
+                line.iter()
+                    .map(|&point| Circle::new(point, 2, color.filled())),
+            )?;
         }
         chart
             .configure_series_labels()
