@@ -154,7 +154,7 @@ fn print_timing_table(
         .filter(|(_, _, s)| *s > MAX_NOISE_RATIO)
         .count();
     println!(
-        "{:<8} {:<12} {:<22} {:>14} {:>14} {:>10} {:>10}",
+        "{:<8} {:<12} {:<22} {:>20} {:>20} {:>10} {:>10}",
         "scene", "backend", "pass", "host noise", "driver noise", "limit", "elsewhere"
     );
     for (scene, backends) in &model.scenes {
@@ -170,7 +170,7 @@ fn print_timing_table(
                     }
                 };
                 println!(
-                    "{scene:<8} {backend:<12} {pass:<22} {:>14} {:>14} {:>10} {:>10} {}",
+                    "{scene:<8} {backend:<12} {pass:<22} {:>20} {:>20} {:>10} {:>10} {}",
                     format!("x{:.2} {}", noise.host, short(&noise.host_at)),
                     format!("x{:.2} {}", noise.drivers, short(&noise.drivers_at)),
                     format!("x{here:.2}{}", untimed(here)),
@@ -205,9 +205,9 @@ fn named_scenes(scenes: &[String]) -> anyhow::Result<Vec<(String, String)>> {
         .collect())
 }
 
-/// A source name short enough for the table.
+/// A source name short enough for the table (`busy-neighbour` whole).
 fn short(source: &str) -> &str {
-    source.get(..source.len().min(12)).unwrap_or(source)
+    source.get(..source.len().min(14)).unwrap_or(source)
 }
 
 /// `harness noise --timing --record-host NAME`: on a host that did not bless the timing goldens,
@@ -350,6 +350,7 @@ pub(super) fn record_host(
         std::fs::create_dir_all(dir)?;
     }
     recorded.save(&path)?;
+    start_readme(&path, name, &recorded)?;
     println!(
         "{:<8} {:<12} {:<22} {:>24} {:>8}",
         "scene", "backend", "pass", "largest of golden", "lowest"
@@ -371,4 +372,39 @@ pub(super) fn record_host(
         path.display()
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// Writes the README.md beside the recording at `path` of host `name`, where there is none: what
+/// the tool knows of the host (its drivers as the checks fingerprint them, its CPU signature,
+/// when and at which commit), and what the person committing it must add.
+fn start_readme(
+    path: &std::path::Path,
+    name: &str,
+    recorded: &harness::golden::speed::recorded::RecordedTimings,
+) -> anyhow::Result<()> {
+    let readme = path.with_file_name("README.md");
+    if !readme.exists() {
+        let hosts: Vec<String> = recorded
+            .hosts
+            .iter()
+            .map(|(kind, host)| format!("- {kind}: `{host}`"))
+            .collect();
+        let text = format!(
+            "# {name}\n\nSpeed ratios recorded with `harness noise --timing --record-host {name}` \
+             on {} (commit {}), CPU signature {}.\n\nDrivers as the checks fingerprint them:\n\n{}\n\n\
+             TODO before committing: say what this host is (the machine or CI runner class, its \
+             CPU, cores and memory, the OS and Mesa release), why it was recorded, and anything \
+             that was running beside it.\n",
+            recorded.recorded,
+            recorded.commit.as_deref().unwrap_or("not a git tree"),
+            recorded.cpu,
+            hosts.join("\n")
+        );
+        std::fs::write(&readme, text)?;
+        eprintln!(
+            "wrote {}: a start; say there what this host is before committing",
+            readme.display()
+        );
+    }
+    Ok(())
 }
