@@ -39,7 +39,9 @@ enum Command {
         /// Only these scenes (canonical names or scene files; repeatable).
         #[arg(long = "scene")]
         scenes: Vec<String>,
-        /// Only this backend: gl, wgpu-vulkan or wgpu-gl (repeatable). Default: every available one.
+        /// Only this backend: gl, wgpu-vulkan or wgpu-gl (repeatable). Default: every available
+        /// one (the others noted as not checked). A backend named here is asked for: if it is
+        /// unavailable, the check fails.
         #[arg(long = "backend")]
         backends: Vec<BackendKind>,
         /// Only these golden passes' image checks (repeatable; the renders run only what they

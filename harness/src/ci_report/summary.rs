@@ -6,7 +6,6 @@ use std::path::Path;
 
 use super::{counts, speed_status, Status};
 use crate::golden::check::CheckRun;
-use crate::golden::speed::SpeedOutcome;
 
 /// The run as Markdown; `report` is where its review page was written.
 pub fn summary(run: &CheckRun, report: &Path) -> String {
@@ -55,11 +54,7 @@ pub fn summary(run: &CheckRun, report: &Path) -> String {
         .iter()
         .filter(|c| speed_status(c) == Status::Failed)
     {
-        let label = match c.outcome {
-            SpeedOutcome::Slower => "SLOWER",
-            SpeedOutcome::TargetsChanged(_) => "TARGETS CHANGED",
-            _ => "MISSING",
-        };
+        let label = c.outcome.label();
         let pass = format!("speed {}", c.pass);
         failing.push(row(&c.scene, &pass, c.backend.name(), label, &c.describe()));
     }
@@ -116,11 +111,8 @@ fn not_checked(out: &mut String, run: &CheckRun) {
     }
     let _ = writeln!(
         out,
-        "
-### Not checked
-
-Unavailable on this machine (name a backend with `--backend` to          make its absence fail the check):
-"
+        "\n### Not checked\n\nUnavailable on this machine (name a backend with `--backend` to \
+         make its absence fail the check):\n"
     );
     for b in absent {
         let _ = writeln!(

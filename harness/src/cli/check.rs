@@ -39,10 +39,7 @@ pub(crate) fn run(
 ) -> anyhow::Result<ExitCode> {
     let (mut cases, broken) = load_cases_isolated(scenes)?;
     // What each scene was loaded from, for the speed history (before `--pass` narrows).
-    let input_digests: std::collections::BTreeMap<String, String> = cases
-        .iter()
-        .map(|c| (c.name().to_owned(), c.inputs.digest()))
-        .collect();
+    let input_digests = harness::golden::scene_inputs::digests(cases.iter().map(|c| &c.inputs));
     // Every scene's speed, before `--pass` narrows the image checks.
     let speed_scenes: Vec<(String, String)> = cases
         .iter()
@@ -135,16 +132,26 @@ pub(crate) fn run(
     for b in &run.backends {
         match &b.unavailable {
             Some(reason) if b.required => {
-                eprintln!("error: {} was asked for but is unavailable: {reason}", b.backend);
+                eprintln!(
+                    "error: {} was asked for but is unavailable: {reason}",
+                    b.backend
+                );
             }
             Some(reason) => eprintln!(
-                "note: {} unavailable, not checked: {reason} (name it with --backend to make                  its absence fail the check)",
+                "note: {} unavailable, not checked: {reason} (name it with --backend to make \
+                 its absence fail the check)",
                 b.backend
             ),
             None => {}
         }
     }
-    if run.backends.iter().all(|b| b.unavailable.is_some()) {
+    // Nothing available and nothing asked for by name: no run to report. A backend asked for
+    // and missing is reported as the run's failure (page, JUnit, summary).
+    if run
+        .backends
+        .iter()
+        .all(|b| b.unavailable.is_some() && !b.required)
+    {
         anyhow::bail!("no backend is available; run `harness backends` for the reasons");
     }
     for note in &run.driver_notes {
@@ -486,14 +493,7 @@ fn print_speed(run: &CheckRun) {
         "scene", "pass", "backend", "result"
     );
     for c in &run.speed.checks {
-        let label = match c.outcome {
-            SpeedOutcome::Passed => "ok",
-            SpeedOutcome::Slower => "SLOWER",
-            SpeedOutcome::Faster => "faster",
-            SpeedOutcome::Untimed(_) => "untimed",
-            SpeedOutcome::MissingGolden => "MISSING",
-            SpeedOutcome::TargetsChanged(_) => "TARGETS",
-        };
+        let label = c.outcome.label();
         println!(
             "{:<8} {:<22} {:<12} {label:<8} {}",
             c.scene,

@@ -67,26 +67,33 @@ pub(crate) struct NoiseArgs {
 /// `harness noise` as its command line asks: a host's recording, the timing-noise model, or
 /// the image noise model, each with its default margin unless one is given.
 pub(crate) fn entry(args: NoiseArgs) -> anyhow::Result<ExitCode> {
-    if args.timing && !args.busy_ok {
-        let cpus = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
-        let busy = harness::golden::speed::measure::others_running(10)
-            .and_then(|others| harness::golden::speed::measure::too_busy(others, cpus));
-        match busy {
-            Some(why) if args.write || args.record_host.is_some() => {
-                anyhow::bail!("{why}");
-            }
-            Some(why) => eprintln!("warning: {why}"),
-            None => {}
-        }
+    if args.timing {
+        // What is written is refused on a busy machine; a report only warns.
+        let writes = args.write || args.record_host.is_some();
+        super::noise_timing::refuse_if_busy(args.busy_ok, !writes, "before measuring")?;
     }
     if let Some(name) = &args.record_host {
-        return super::noise_timing::record_host(name, &args.scenes, args.history.as_deref());
+        return super::noise_timing::record_host(
+            name,
+            &args.scenes,
+            args.history.as_deref(),
+            args.busy_ok,
+        );
     }
     if args.timing {
         let margin = args
             .margin
             .unwrap_or(harness::golden::speed::DEFAULT_TIMING_MARGIN);
-        super::noise_timing::timing(&args.sources, &args.scenes, args.write, margin, args.json)
+        super::noise_timing::timing(
+            &args.sources,
+            &args.scenes,
+            super::noise_timing::Writing {
+                write: args.write,
+                busy_ok: args.busy_ok,
+            },
+            margin,
+            args.json,
+        )
     } else {
         let margin = args
             .margin

@@ -10,6 +10,34 @@ use harness::golden::GoldenStore;
 
 use super::load_cases;
 
+/// Whether `noise --timing` writes the model, and whether it may measure on a busy machine.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Writing {
+    /// `--write`: record golden/timing-noise.toml.
+    pub write: bool,
+    /// `--busy-ok`: measure and write although other tasks keep the machine busy.
+    pub busy_ok: bool,
+}
+
+/// Refuses to measure or write timing noise on a busy machine
+/// ([`too_busy`](harness::golden::speed::measure::too_busy)), unless `busy_ok`; with
+/// `warn_only`, a warning instead. `when` says at which point it was found busy.
+pub(super) fn refuse_if_busy(busy_ok: bool, warn_only: bool, when: &str) -> anyhow::Result<()> {
+    use harness::golden::speed::measure::{machine_load, too_busy};
+    if busy_ok {
+        return Ok(());
+    }
+    let Some(why) = machine_load(10).and_then(|(others, cpus)| too_busy(others, cpus)) else {
+        return Ok(());
+    };
+    if warn_only {
+        eprintln!("warning: {why}");
+        Ok(())
+    } else {
+        anyhow::bail!("{when}: {why}")
+    }
+}
+
 /// `harness noise --timing`: probes the scenes named (every canonical one by default) on every
 /// available backend under every timing source (or those named), counts the hosts recorded in
 /// golden/evidence/, prints each pass's worst factor per tier with its limit and its score (or
@@ -19,10 +47,11 @@ use super::load_cases;
 pub(super) fn timing(
     only: &[String],
     scenes: &[String],
-    write: bool,
+    writing: Writing,
     margin: f64,
     json: bool,
 ) -> anyhow::Result<ExitCode> {
+    let write = writing.write;
     use harness::golden::speed::{measure, recorded, TimingNoise};
     let store = GoldenStore::workspace();
     let scenes = named_scenes(scenes)?;
@@ -81,6 +110,11 @@ pub(super) fn timing(
         eprintln!("error: {e}");
     }
     let model = if write {
+        // A model with a probe missing, or measured beside a load, is not this host's noise.
+        if !errors.is_empty() {
+            anyhow::bail!("{} probe(s) failed; nothing written", errors.len());
+        }
+        refuse_if_busy(writing.busy_ok, false, "after the probes, nothing written")?;
         let measured = measure::model_from(&measurements, &sources, margin);
         let model = match TimingNoise::load(store.root()) {
             Ok(old) if !only.is_empty() => measure::merged(old, measured),
@@ -220,6 +254,7 @@ pub(super) fn record_host(
     name: &str,
     scenes: &[String],
     history: Option<&std::path::Path>,
+    busy_ok: bool,
 ) -> anyhow::Result<ExitCode> {
     use harness::golden::speed::{host_fingerprint, measure, recorded, TimingGoldens};
     if name.is_empty()
@@ -231,10 +266,7 @@ pub(super) fn record_host(
     }
     let store = GoldenStore::workspace();
     let cases = load_cases(scenes)?;
-    let input_digests: std::collections::BTreeMap<String, String> = cases
-        .iter()
-        .map(|c| (c.name().to_owned(), c.inputs.digest()))
-        .collect();
+    let input_digests = harness::golden::scene_inputs::digests(cases.iter().map(|c| &c.inputs));
     let scenes: Vec<(String, String)> = cases
         .iter()
         .map(|c| (c.name().to_owned(), c.argument()))
@@ -346,6 +378,7 @@ pub(super) fn record_host(
             );
         }
     }
+    refuse_if_busy(busy_ok, false, "after the probes, nothing written")?;
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir)?;
     }

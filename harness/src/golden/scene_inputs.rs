@@ -119,6 +119,17 @@ impl SceneInputs {
     }
 }
 
+/// Each scene's [`SceneInputs::digest`], by scene name: what a speed history line keeps of the
+/// scenes it timed.
+pub fn digests<'a>(
+    inputs: impl IntoIterator<Item = &'a SceneInputs>,
+) -> std::collections::BTreeMap<String, String> {
+    inputs
+        .into_iter()
+        .map(|i| (i.scene.clone(), i.digest()))
+        .collect()
+}
+
 /// `file` as a check records it: relative to `workspace` when it lies inside (so that a check
 /// made in another checkout, a CI job's, compares with this checkout's files, and two
 /// workspaces share a verification), else absolute; symbolic links and `..` resolved.

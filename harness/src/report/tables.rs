@@ -151,17 +151,11 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
     let mut rows: Vec<_> = run.speed.checks.iter().collect();
     rows.sort_by_key(|c| !c.failed());
     for c in rows {
-        let (class, label) = match &c.outcome {
-            SpeedOutcome::Passed => ("passed", "ok"),
-            SpeedOutcome::Slower => ("failed", "SLOWER"),
-            SpeedOutcome::Faster => ("passed", "faster"),
-            SpeedOutcome::Untimed(_) => ("passed", "untimed"),
-            SpeedOutcome::MissingGolden => ("failed", "no golden"),
-            SpeedOutcome::TargetsChanged(_) => ("failed", "targets changed"),
-        };
+        let class = if c.failed() { "failed" } else { "passed" };
+        let label = c.outcome.label();
         let factor = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("x{v:.3}"));
         let detail = match &c.outcome {
-            SpeedOutcome::Untimed(why) => why.clone(),
+            SpeedOutcome::Untimed(why) | SpeedOutcome::TargetsChanged(why) => why.clone(),
             _ => c
                 .noise
                 .as_ref()

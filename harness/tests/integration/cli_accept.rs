@@ -335,6 +335,16 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
         Some("the lighting got slower on purpose")
     );
     assert_eq!(reason_of("geometry"), None);
+    // What the pass writes is recorded beside the ratio accepted, from the check's probe.
+    let goldens =
+        harness::golden::speed::TimingGoldens::load(&root.path().join("golden"), "arrow").unwrap();
+    assert_eq!(
+        goldens.backends[&engine::backend::BackendKind::Gl].passes
+            [&engine::plan::PassId::Lighting(engine::scene::LightingModel::Pbr)]
+            .targets
+            .as_deref(),
+        Some("route 512x512 depth32f, light 512x512 rgba16f")
+    );
     let server = crate::review::Server::start(root.path(), &out);
     let why = "the G-buffer got slower on purpose";
     if let Some(executable) = crate::report::chromium() {

@@ -546,4 +546,17 @@ fn a_backend_asked_for_and_missing_fails_the_check_and_one_not_asked_for_is_name
             && page.contains("wgpu-vulkan was asked for but is unavailable"),
         "the page"
     );
+
+    // The only backend asked for, missing: nothing rendered, and still the reports.
+    let (code, text, summary, page, vulkan) = check(&["wgpu-vulkan"]);
+    assert_eq!(code, Some(1), "{text}");
+    assert!(summary.contains("| UNAVAILABLE |"), "{summary}");
+    assert!(
+        matches!(vulkan, TestCaseStatus::NonSuccess { .. }),
+        "{vulkan:?}"
+    );
+    assert!(
+        page.contains("wgpu-vulkan was asked for but is unavailable"),
+        "the page"
+    );
 }

@@ -206,6 +206,12 @@ pub fn measure_timing(
                         else {
                             continue;
                         };
+                        if let Some(why) = targets_changed(&probe.scene, kind, pass, g) {
+                            if !errors.contains(&why) {
+                                errors.push(why);
+                            }
+                            continue;
+                        }
                         let factor = ratio / g.ratio;
                         let key = (source.name.clone(), probe.scene.clone(), kind, pass.pass);
                         let entry = worst.entry(key).or_insert((source.tier, factor));
@@ -324,10 +330,19 @@ pub fn scores(
         .collect()
 }
 
-/// Tasks running on this machine besides the reader: the median of `samples` readings of
-/// `/proc/stat`'s `procs_running` (which counts the reading thread itself) a tenth of a second
-/// apart. None where it cannot be read (not Linux).
-pub fn others_running(samples: usize) -> Option<usize> {
+/// The load on the kernel's CPUs: tasks running besides the reader, the median of `samples`
+/// readings of `/proc/stat`'s `procs_running` (which counts the reading thread itself) a tenth
+/// of a second apart, and the CPUs that count covers (its `cpuN` lines: in a container, the
+/// host's, as `procs_running` is the host's). None where it cannot be read (not Linux).
+pub fn machine_load(samples: usize) -> Option<(usize, usize)> {
+    let cpus = std::fs::read_to_string("/proc/stat")
+        .ok()?
+        .lines()
+        .filter(|l| {
+            l.strip_prefix("cpu")
+                .is_some_and(|n| n.starts_with(|c: char| c.is_ascii_digit()))
+        })
+        .count();
     let mut readings = Vec::with_capacity(samples);
     for i in 0..samples.max(1) {
         if i > 0 {
@@ -343,7 +358,7 @@ pub fn others_running(samples: usize) -> Option<usize> {
         readings.push(running.saturating_sub(1));
     }
     readings.sort_unstable();
-    Some(readings[readings.len() / 2])
+    Some((readings[readings.len() / 2], cpus.max(1)))
 }
 
 /// Why a machine with `others` tasks running besides the measurement, on `cpus` CPUs, is too
@@ -354,11 +369,32 @@ pub fn others_running(samples: usize) -> Option<usize> {
 pub fn too_busy(others: usize, cpus: usize) -> Option<String> {
     (others >= (cpus / 2).max(1)).then(|| {
         format!(
-            "this machine is busy: {others} other task(s) running on {cpus} CPU(s) (the median \
-             of ten readings of /proc/stat's procs_running). Timing figures measured now \
+            "this machine is busy: {others} other task(s) running on its {cpus} CPU(s) (the \
+             median of ten readings of /proc/stat's procs_running). Timing figures measured now \
              measure that load, and a pass's noise is its largest spread, kept for good: one \
              busy probe can leave it too noisy to time. Measure on a quiet machine (stop builds, \
              tests and other checks), or pass --busy-ok to measure anyway"
+        )
+    })
+}
+
+/// Why `pass`'s ratio (a probe of `scene` on `kind`) says nothing of the noise against its
+/// golden `golden`: it writes other targets than when the golden was blessed, so the two ratios
+/// do not compare (None where they do, or where either does not say).
+pub fn targets_changed(
+    scene: &str,
+    kind: BackendKind,
+    pass: &crate::measure::speed::PassSpeed,
+    golden: &super::PassTiming,
+) -> Option<String> {
+    let (Some(then), Some(now)) = (&golden.targets, &pass.targets) else {
+        return None;
+    };
+    (then != now).then(|| {
+        format!(
+            "{scene} {} on {kind}: it writes {now}, where its timing golden's pass wrote {then}: \
+             bless its timing before measuring its noise",
+            pass.pass
         )
     })
 }

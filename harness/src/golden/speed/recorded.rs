@@ -360,6 +360,14 @@ pub fn record(
                         else {
                             continue;
                         };
+                        if let Some(why) =
+                            super::measure::targets_changed(&speed.scene, *kind, pass, g)
+                        {
+                            if !errors.contains(&why) {
+                                errors.push(why);
+                            }
+                            continue;
+                        }
                         recorded
                             .scenes
                             .entry(speed.scene.clone())

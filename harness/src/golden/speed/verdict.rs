@@ -29,6 +29,20 @@ pub enum SpeedOutcome {
     TargetsChanged(String),
 }
 
+impl SpeedOutcome {
+    /// The verdict as one word, as the console, the summary and the review page show it.
+    pub fn label(&self) -> &'static str {
+        match self {
+            SpeedOutcome::Passed => "ok",
+            SpeedOutcome::Slower => "SLOWER",
+            SpeedOutcome::Faster => "faster",
+            SpeedOutcome::Untimed(_) => "untimed",
+            SpeedOutcome::MissingGolden => "MISSING",
+            SpeedOutcome::TargetsChanged(_) => "TARGETS",
+        }
+    }
+}
+
 /// One speed check.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SpeedCheck {
@@ -61,8 +75,12 @@ pub struct SpeedCheck {
 }
 
 impl SpeedCheck {
-    /// ratio / golden: above 1 slower.
+    /// ratio / golden: above 1 slower (None without a golden, or where the pass's targets
+    /// changed since it: the two ratios do not compare).
     pub fn slowdown(&self) -> Option<f64> {
+        if matches!(self.outcome, SpeedOutcome::TargetsChanged(_)) {
+            return None;
+        }
         self.golden.map(|g| self.ratio / g)
     }
 

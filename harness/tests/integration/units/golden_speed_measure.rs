@@ -39,11 +39,11 @@ fn the_model_keeps_each_tiers_worst_source_and_scores_stay_at_half_the_limit() {
 /// measure anyway; the reading works where /proc/stat exists.
 #[test]
 fn timing_noise_is_not_measured_on_a_busy_machine() {
-    use harness::golden::speed::measure::{others_running, too_busy};
+    use harness::golden::speed::measure::{machine_load, too_busy};
     assert_eq!(too_busy(0, 2), None);
     let why = too_busy(1, 2).expect("one other task on two CPUs is busy");
     assert!(
-        why.contains("1 other task(s) running on 2 CPU(s)") && why.contains("--busy-ok"),
+        why.contains("1 other task(s) running on its 2 CPU(s)") && why.contains("--busy-ok"),
         "{why}"
     );
     assert_eq!(too_busy(0, 1), None);
@@ -51,6 +51,53 @@ fn timing_noise_is_not_measured_on_a_busy_machine() {
     assert_eq!(too_busy(7, 16), None);
     assert!(too_busy(8, 16).is_some());
     if cfg!(target_os = "linux") {
-        assert!(others_running(1).is_some());
+        let (_, cpus) = machine_load(1).expect("/proc/stat");
+        assert!(cpus >= 1);
     }
+}
+
+/// A probe of other targets than its golden's measures no noise: named, not counted.
+#[test]
+fn a_probe_of_other_targets_is_not_a_noise_measurement() {
+    use harness::golden::speed::measure::targets_changed;
+    use harness::golden::speed::PassTiming;
+    use harness::measure::speed::PassSpeed;
+    let probe = |targets: Option<&str>| PassSpeed {
+        pass: engine::plan::PassId::Geometry,
+        pass_ms: vec![2.0],
+        floor_ms: vec![1.0],
+        targets: targets.map(str::to_owned),
+    };
+    let golden = |targets: Option<&str>| PassTiming {
+        ratio: 2.0,
+        ms: 2.0,
+        floor_ms: 1.0,
+        targets: targets.map(str::to_owned),
+        reason: None,
+    };
+    let gl = engine::backend::BackendKind::Gl;
+    let why = targets_changed(
+        "s",
+        gl,
+        &probe(Some("depth 256x256")),
+        &golden(Some("depth 1024x1024")),
+    )
+    .expect("other targets");
+    assert!(
+        why.contains("s geometry on gl: it writes depth 256x256")
+            && why.contains("wrote depth 1024x1024"),
+        "{why}"
+    );
+    assert_eq!(
+        targets_changed("s", gl, &probe(Some("a")), &golden(Some("a"))),
+        None
+    );
+    assert_eq!(
+        targets_changed("s", gl, &probe(None), &golden(Some("a"))),
+        None
+    );
+    assert_eq!(
+        targets_changed("s", gl, &probe(Some("a")), &golden(None)),
+        None
+    );
 }
