@@ -303,6 +303,11 @@ pub struct SpeedCoverage {
     pub untimed: usize,
     /// The timed passes' limits as factors: the smallest, the median and the largest.
     pub limits: Option<[f64; 3]>,
+    /// How much slower than this run each timed pass must get to fail (its limit over its
+    /// ratio to the golden now): the smallest, the median and the largest. Where the passes
+    /// run below their goldens (on a host that did not bless, ratios lie x0.4 to x1.75 from
+    /// the blessing host's) a limit of x1.6 can mean x3.5 from here.
+    pub fails_beyond: Option<[f64; 3]>,
 }
 
 impl SpeedCoverage {
@@ -323,8 +328,21 @@ impl SpeedCoverage {
             }
             None => String::new(),
         };
+        // Said where it tells more than the limits: some pass must slow down a tenth more
+        // than its limit from where it runs now.
+        let from_now = match (self.fails_beyond, self.limits) {
+            (Some([low, median, high]), Some([_, limit_median, limit_high]))
+                if high > limit_high * 1.1 || median > limit_median * 1.1 =>
+            {
+                format!(
+                    "; from their speed in this run a pass fails only beyond x{low:.2} to \
+                     x{high:.2} slower (median x{median:.2})"
+                )
+            }
+            _ => String::new(),
+        };
         format!(
-            "{} passes timed {how}{limits}; {} untimed",
+            "{} passes timed {how}{limits}{from_now}; {} untimed",
             self.timed, self.untimed
         )
     }
@@ -349,43 +367,65 @@ pub fn record_advice(coverage: &[SpeedCoverage]) -> Option<&'static str> {
 /// Per backend and tier, in the order the checks came: what the speed checks of a run can
 /// catch on this host. Checks without a golden count in neither column (they fail).
 pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
-    let mut groups: Vec<(BackendKind, Tier, Vec<f64>, usize)> = Vec::new();
+    /// One backend and tier's checks as they are gathered.
+    struct Group {
+        backend: BackendKind,
+        tier: Tier,
+        limits: Vec<f64>,
+        untimed: usize,
+        fails_beyond: Vec<f64>,
+    }
+    let mut groups: Vec<Group> = Vec::new();
     for c in checks {
         let index = match groups
             .iter()
-            .position(|(b, t, ..)| *b == c.backend && *t == c.tier)
+            .position(|g| g.backend == c.backend && g.tier == c.tier)
         {
             Some(i) => i,
             None => {
-                groups.push((c.backend, c.tier, Vec::new(), 0));
+                groups.push(Group {
+                    backend: c.backend,
+                    tier: c.tier,
+                    limits: Vec::new(),
+                    untimed: 0,
+                    fails_beyond: Vec::new(),
+                });
                 groups.len() - 1
             }
         };
         let group = &mut groups[index];
         match (&c.outcome, c.limit) {
-            (SpeedOutcome::Untimed(_), _) => group.3 += 1,
+            (SpeedOutcome::Untimed(_), _) => group.untimed += 1,
             (SpeedOutcome::MissingGolden | SpeedOutcome::TargetsChanged(_), _) | (_, None) => {}
-            (_, Some(limit)) => group.2.push(limit),
+            (_, Some(limit)) => {
+                group.limits.push(limit);
+                if let Some(slowdown) = c.slowdown().filter(|s| *s > 0.0) {
+                    group.fails_beyond.push(limit / slowdown);
+                }
+            }
         }
     }
     groups
         .into_iter()
-        .map(|(backend, tier, mut limits, untimed)| {
-            limits.sort_by(f64::total_cmp);
-            let range = (!limits.is_empty()).then(|| {
-                [
-                    limits[0],
-                    limits[limits.len() / 2],
-                    limits[limits.len() - 1],
-                ]
-            });
-            SpeedCoverage {
-                backend,
-                tier,
-                timed: limits.len(),
-                untimed,
-                limits: range,
-            }
+        .map(|g| SpeedCoverage {
+            backend: g.backend,
+            tier: g.tier,
+            timed: g.limits.len(),
+            untimed: g.untimed,
+            limits: spread(g.limits),
+            fails_beyond: spread(g.fails_beyond),
         })
         .collect()
+}
+
+/// The smallest, the median and the largest of `values` (None when empty).
+fn spread(mut values: Vec<f64>) -> Option<[f64; 3]> {
+    values.sort_by(f64::total_cmp);
+    (!values.is_empty()).then(|| {
+        [
+            values[0],
+            values[values.len() / 2],
+            values[values.len() - 1],
+        ]
+    })
 }

@@ -304,6 +304,18 @@ fn coverage_counts_the_timed_and_untimed_passes_per_backend_and_tier() {
         "0 passes timed on a host that did not bless; 1 untimed"
     );
     assert!(coverage(&[]).is_empty());
+    // Passes running below their goldens (another host's ratios): the limits say x1.5, but
+    // from here a pass must get x3 slower (ratio at half its golden) to fail, and it is said.
+    let mut below = covered(Gl, Tier::OtherHost, SpeedOutcome::Passed, Some(1.5));
+    below.ratio = 1.0;
+    let at = covered(Gl, Tier::OtherHost, SpeedOutcome::Passed, Some(1.5));
+    let found = coverage(&[below, at]);
+    assert_eq!(found[0].fails_beyond, Some([1.5, 3.0, 3.0]));
+    assert_eq!(
+        found[0].describe(),
+        "2 passes timed on a host that did not bless, limits x1.50; from their speed in this \
+         run a pass fails only beyond x1.50 to x3.00 slower (median x3.00); 0 untimed"
+    );
 }
 
 /// A timing bless's stamp at time "t", without a reason.
