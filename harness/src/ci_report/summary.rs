@@ -138,6 +138,9 @@ fn speed_coverage(out: &mut String, run: &CheckRun) {
     if let Some(advice) = crate::golden::speed::verdict::record_advice(&coverage) {
         let _ = writeln!(out, "\nNote: {advice}.");
     }
+    for note in &run.speed.host_notes {
+        let _ = writeln!(out, "\nNote: {}.", cell(note));
+    }
 }
 
 /// A table row, each cell made safe for a Markdown table.

@@ -544,4 +544,7 @@ fn print_speed(run: &CheckRun) {
     if let Some(advice) = harness::golden::speed::verdict::record_advice(&coverage) {
         println!("note: {advice}");
     }
+    for note in &run.speed.host_notes {
+        println!("note: {note}");
+    }
 }

@@ -96,6 +96,11 @@ pub fn merge(shards: &[PathBuf]) -> Result<(CheckRun, Outputs), MergeError> {
         }
         merged.speed.checks.extend(run.speed.checks);
         merged.speed.errors.extend(run.speed.errors);
+        for note in run.speed.host_notes {
+            if !merged.speed.host_notes.contains(&note) {
+                merged.speed.host_notes.push(note);
+            }
+        }
         merged.diagnoses.extend(run.diagnoses);
         merged.verifications.extend(run.verifications);
         merged.inputs.extend(run.inputs);

@@ -192,4 +192,7 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
     if let Some(advice) = crate::golden::speed::verdict::record_advice(&coverage) {
         let _ = write!(out, "<p class=\"note\">Note: {}.</p>", escape(advice));
     }
+    for note in &run.speed.host_notes {
+        let _ = write!(out, "<p class=\"note\">Note: {}.</p>", escape(note));
+    }
 }

@@ -184,6 +184,61 @@ pub struct SpeedRun {
     pub checks: Vec<SpeedCheck>,
     /// Probes that failed (a backend or scene), each a failure of the run.
     pub errors: Vec<String>,
+    /// Where a backend's checks read at another host's limits although a recording of this
+    /// CPU exists: what in the driver fingerprint differs from it ([`near_recordings`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub host_notes: Vec<String>,
+}
+
+/// Why `kind`'s checks on this host (fingerprint `host`, CPU signature `cpu`) are not read
+/// against a recording that has this CPU: per such recording, the parts of the fingerprint
+/// (the ` | `-separated driver, Mesa, LLVM and driver variables) found only here and only there.
+/// None where no recording has this CPU, or one matches whole.
+pub fn near_recordings(
+    recordings: &[(String, recorded::RecordedTimings)],
+    kind: BackendKind,
+    host: &str,
+    cpu: &str,
+) -> Option<String> {
+    let same_cpu: Vec<(&String, &String)> = recordings
+        .iter()
+        .filter(|(_, r)| r.cpu == cpu)
+        .filter_map(|(name, r)| Some((name, r.hosts.get(&kind)?)))
+        .collect();
+    if same_cpu.is_empty() || same_cpu.iter().any(|(_, there)| *there == host) {
+        return None;
+    }
+    let parts = |fingerprint: &str| -> Vec<String> {
+        fingerprint.split(" | ").map(str::to_owned).collect()
+    };
+    let differences: Vec<String> = same_cpu
+        .iter()
+        .map(|(name, there)| {
+            let (here, there) = (parts(host), parts(there));
+            let only = |a: &[String], b: &[String]| -> String {
+                let only: Vec<String> = a
+                    .iter()
+                    .filter(|p| !b.contains(p))
+                    .map(|p| format!("`{p}`"))
+                    .collect();
+                if only.is_empty() {
+                    "nothing".to_owned()
+                } else {
+                    only.join(", ")
+                }
+            };
+            format!(
+                "{name}'s recording has this CPU, but here {} where it has {}",
+                only(&here, &there),
+                only(&there, &here)
+            )
+        })
+        .collect();
+    Some(format!(
+        "{kind}: {} (a variable that selects a driver is part of the fingerprint: run as the \
+         recording ran, or record this setup under a name of its own)",
+        differences.join("; ")
+    ))
 }
 
 impl SpeedRun {
@@ -284,6 +339,11 @@ pub fn check_scenes(
             continue;
         };
         let host = host_fingerprint(driver);
+        if let Some(note) = near_recordings(&recordings, kind, &host, &cpu_signature()) {
+            if !run.host_notes.contains(&note) {
+                run.host_notes.push(note);
+            }
+        }
         let goldens = match TimingGoldens::load(root, &probe.scene) {
             Ok(goldens) => goldens,
             Err(e) => {

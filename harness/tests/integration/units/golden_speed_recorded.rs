@@ -221,3 +221,47 @@ fn a_second_recording_of_a_host_adds_to_the_first_and_takes_the_check_history_an
     assert_eq!(later.probes["runs"], 2);
     assert_eq!(later.probes[CHECKS_SOURCE], 2);
 }
+
+/// A host whose CPU a recording has but whose driver fingerprint differs (a variable that
+/// points the loader at a driver file, another Mesa) is told what differs, per backend: the
+/// parts found only here and only in the recording. Nothing where one matches, or none has
+/// this CPU.
+#[test]
+fn a_recording_of_this_cpu_that_does_not_match_says_what_differs() {
+    use harness::golden::speed::near_recordings;
+    use harness::golden::speed::recorded::RecordedTimings;
+    let recording = |host: &str, cpu: &str| RecordedTimings {
+        recorded: "t".to_owned(),
+        commit: None,
+        probes: Default::default(),
+        hosts: [(BackendKind::WgpuVulkan, host.to_owned())]
+            .into_iter()
+            .collect(),
+        cpu: cpu.to_owned(),
+        scenes: Default::default(),
+    };
+    let there = "Vulkan Mesa 22.3.6 | llvmpipe | Mesa 22.3.6 | CPU Xeon";
+    let here = "Vulkan Mesa 22.3.6 | llvmpipe | Mesa 22.3.6 | VK_DRIVER_FILES=/x.json | CPU Xeon";
+    let recordings = vec![("host-c".to_owned(), recording(there, "family 6"))];
+    let note =
+        near_recordings(&recordings, BackendKind::WgpuVulkan, here, "family 6").expect("a note");
+    assert!(
+        note.starts_with(
+            "wgpu-vulkan: host-c's recording has this CPU, but here \
+             `VK_DRIVER_FILES=/x.json` where it has nothing"
+        ),
+        "{note}"
+    );
+    assert_eq!(
+        near_recordings(&recordings, BackendKind::WgpuVulkan, there, "family 6"),
+        None
+    );
+    assert_eq!(
+        near_recordings(&recordings, BackendKind::WgpuVulkan, here, "family 25"),
+        None
+    );
+    assert_eq!(
+        near_recordings(&recordings, BackendKind::Gl, here, "family 6"),
+        None
+    );
+}
