@@ -132,12 +132,26 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
     if run.speed.checks.is_empty() && run.speed.errors.is_empty() {
         return;
     }
-    out.push_str(
+    // A timing bless writes on the host that blessed the goldens only; elsewhere the command
+    // that moves them here is the one to offer.
+    let elsewhere = run
+        .speed
+        .checks
+        .iter()
+        .any(|c| c.tier != crate::golden::speed::Tier::SameHost);
+    let bless = if elsewhere {
+        "on the host that blessed the timing goldens, bless it with <code>harness bless \
+         --scene S --speed-only</code> if intended (this host did not bless them: <code>--speed-only \
+         --every-pass</code> moves them here, every pass)"
+    } else {
+        "bless it with <code>harness bless --scene S --speed-only</code> if intended"
+    };
+    let _ = write!(
+        out,
         "<h2 id=\"speed\">Speed</h2><p>Each pass submitted alone, its fastest time over its \
          floor's, against its timing golden (<code>golden/&lt;scene&gt;/timing.toml</code>; \
          limits from <code>golden/timing-noise.toml</code>). A slower pass beyond its limit \
-         fails; a faster one is a note: bless it with <code>harness bless --scene S \
-         --speed-only</code> if intended.</p><table class=\"summary\"><tr><th>scene</th>\
+         fails; a faster one is a note: {bless}.</p><table class=\"summary\"><tr><th>scene</th>\
          <th>pass</th><th>backend</th><th>result</th><th>against golden</th><th>limit</th>\
          <th>value / limit</th><th>ms</th><th>detail</th></tr>",
     );
