@@ -114,11 +114,11 @@ fn inspect_environment(path: &Path) -> Result<Value, InspectError> {
 /// A scene file: its objects, lights, environment, textures and render plan.
 fn inspect_scene(path: &Path) -> Result<Value, InspectError> {
     let loaded = scene_file::load(path)?;
-    // Its tolerances read against its golden passes, as `check` reads them (the scene is
-    // loaded again for that, only when it has any; the rules, not the noise model's limits).
+    // Its tolerances read against its golden passes, as `check` reads them (only when it has
+    // any; the rules, not the noise model's limits).
     if !loaded.tolerances.is_empty() {
         let model = crate::golden::noise::NoiseModel::default();
-        crate::golden::suite::Case::load_with(&path.to_string_lossy(), &model).map_err(Box::new)?;
+        crate::golden::suite::Case::from_loaded(loaded.clone(), &model).map_err(Box::new)?;
     }
     let scene = &loaded.scene;
     let objects: Vec<Value> = scene.objects.iter().map(object_json).collect();

@@ -78,6 +78,7 @@ pub enum SceneFileError {
 }
 
 /// A loaded scene with what the harness needs from its file.
+#[derive(Clone)]
 pub struct LoadedScene {
     /// The scene.
     pub scene: Scene,

@@ -105,12 +105,7 @@ pub(crate) fn run(
         // The history is the series of an unchanged build's ratios (drift, a host's record):
         // a run with the debug slowdown is not one.
         if !options.unspecialised_lighting {
-            harness::golden::speed::append_history(
-                out,
-                &run.speed,
-                &available,
-                input_digests.clone(),
-            );
+            harness::golden::speed::append_history(out, &run.speed, &available, input_digests);
         }
     }
     bar.finish_and_clear();

@@ -87,10 +87,11 @@ pub(crate) fn plan(scene: &str) -> anyhow::Result<ExitCode> {
     print!("{}", prepared.plan());
     // The shadow terms are debug outputs, planned only when asked for (`render --pass`, and
     // the golden suite, which always asks): named here, since they have goldens too.
-    let mut with_terms = loaded.scene.clone();
+    let mut with_terms = prepared.scene().clone();
     with_terms.quality.debug_shadow_terms = true;
     let planned = prepared.plan().target_ids();
-    let terms: Vec<engine::plan::TargetId> = engine::renderer::PreparedFrame::new(&with_terms)?
+    let terms: Vec<engine::plan::TargetId> = prepared
+        .varied(with_terms)?
         .plan()
         .target_ids()
         .into_iter()

@@ -54,7 +54,7 @@ pub(super) fn timing(
     let write = writing.write;
     use harness::golden::speed::{measure, recorded, TimingNoise};
     let store = GoldenStore::workspace();
-    let scenes = named_scenes(scenes)?;
+    let scenes = named(&load_cases(scenes)?);
     let (mut sources, mut missing) = measure::timing_sources();
     let mut recorded_measurements = Vec::new();
     for (source, measurements) in recorded::recorded_hosts(store.root())? {
@@ -230,13 +230,12 @@ fn print_timing_table(
     );
 }
 
-/// The scenes named (every canonical one when none is), each as its name and the argument a
-/// probe child takes (a name or a scene file).
-fn named_scenes(scenes: &[String]) -> anyhow::Result<Vec<(String, String)>> {
-    Ok(load_cases(scenes)?
+/// Each of `cases` as its name and the argument a probe child takes (a name or a scene file).
+fn named(cases: &[harness::golden::suite::Case]) -> Vec<(String, String)> {
+    cases
         .iter()
         .map(|c| (c.name().to_owned(), c.argument()))
-        .collect())
+        .collect()
 }
 
 /// A source name short enough for the table (`busy-neighbour` whole).
@@ -267,10 +266,7 @@ pub(super) fn record_host(
     let store = GoldenStore::workspace();
     let cases = load_cases(scenes)?;
     let input_digests = harness::golden::scene_inputs::digests(cases.iter().map(|c| &c.inputs));
-    let scenes: Vec<(String, String)> = cases
-        .iter()
-        .map(|c| (c.name().to_owned(), c.argument()))
-        .collect();
+    let scenes = named(&cases);
     let backends: Vec<(BackendKind, String)> = BackendKind::ALL
         .into_iter()
         .filter_map(|kind| {

@@ -270,7 +270,8 @@ pub fn worst_pair(
 
 /// Runs the check on the backends in `only` (every available one when empty, an unavailable
 /// one noted; those named in `only` are asked for, and their absence fails the run), writing
-/// failure images under `failures` (each checked scene's old ones there are removed first). `progress` is called before each render with (done, total, what).
+/// failure images under `failures` (each checked scene's old ones there are removed first).
+/// `progress` is called before each render with (done, total, what).
 /// Returns the run and every golden pass output, for the report.
 pub fn run(
     cases: &[Case],

@@ -33,22 +33,22 @@ pub fn check_command(scene: &str, out: Option<&std::path::Path>) -> String {
 /// host that blessed its timing goldens; elsewhere, where a bless keeps another host's timing
 /// goldens, with `--every-pass`, which moves a backend's to this host whole.
 pub fn speed_bless_command(scene: &str, on_blessing_host: bool) -> String {
-    let every_pass = if on_blessing_host {
-        ""
+    let flags = if on_blessing_host {
+        "--speed-only"
     } else {
-        " --every-pass"
+        MOVE_TIMINGS_HERE
     };
-    format!("{} --speed-only{every_pass}", bless_command(scene))
+    format!("{} {flags}", bless_command(scene))
 }
+
+/// The flags of a timing bless that moves another host's timing goldens to this one.
+const MOVE_TIMINGS_HERE: &str = "--speed-only --every-pass";
 
 /// What to add where `commands` ([`crate::golden::check::CheckRun::bless_commands`]) are
 /// printed under "each rewrites only what moved": a `--speed-only --every-pass` command among
 /// them rewrites more, so it is said what (empty when there is none).
 pub fn moves_timings_note(commands: &[String]) -> &'static str {
-    if commands
-        .iter()
-        .any(|c| c.ends_with("--speed-only --every-pass"))
-    {
+    if commands.iter().any(|c| c.ends_with(MOVE_TIMINGS_HERE)) {
         " A command with `--speed-only --every-pass` is for timings this host did not bless: it \
          moves the backend's timing goldens to this host, every pass; then measure this host's \
          timing noise (`harness noise --timing --write`)."

@@ -126,7 +126,11 @@ impl Case {
 
     /// [`Case::load`] with the limits of `model`.
     pub fn load_with(name_or_path: &str, model: &NoiseModel) -> Result<Case, SuiteError> {
-        let mut loaded = crate::load_scene(name_or_path)?;
+        Case::from_loaded(crate::load_scene(name_or_path)?, model)
+    }
+
+    /// [`Case::load_with`] of a scene already loaded.
+    pub fn from_loaded(mut loaded: LoadedScene, model: &NoiseModel) -> Result<Case, SuiteError> {
         let inputs = crate::golden::scene_inputs::SceneInputs::of(&loaded);
         // A shadowed light's shadow term is where a shadow change first shows: golden renders
         // read it back (a full-screen pass per shadowed light).

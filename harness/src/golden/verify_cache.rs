@@ -7,8 +7,9 @@
 //!
 //! The key covers every input a child check reads; where one cannot be read or named with
 //! certainty (no driver library mapped in this process, a scene file changed since it was
-//! loaded, a golden folder too large to hash), the verification is neither looked up nor kept. Only outcomes every source gave are kept (a child
-//! that could not run says nothing about the candidates).
+//! loaded, a golden folder too large to hash), the verification is neither looked up nor kept.
+//! Only outcomes every source gave are kept (a child that could not run says nothing about
+//! the candidates).
 
 use std::collections::hash_map::DefaultHasher;
 use std::hash::{Hash, Hasher};
