@@ -350,9 +350,10 @@ impl SpeedCoverage {
 
 /// What to do where checks ran at [`Tier::OtherHost`]: record the host, so that its checks
 /// read against its own ratios.
-pub const RECORD_THIS_HOST: &str = "this host's driver fingerprint and CPU match neither the \
-    timing goldens' nor a recording's, so its speed checks use limits wide enough for any host, \
-    and catch less. `harness noise --timing --record-host NAME` records it \
+pub const RECORD_THIS_HOST: &str = "this host is neither the one that blessed the timing \
+    goldens nor a recorded one (by driver fingerprint and CPU signature; goldens that keep no \
+    signature name no host), so its speed checks use limits wide enough for any host, and \
+    catch less. `harness noise --timing --record-host NAME` records it \
     (golden/evidence/NAME/timing.toml, to commit); its checks then read against its own ratios";
 
 /// [`RECORD_THIS_HOST`] where some of `coverage` ran at [`Tier::OtherHost`]: the advice every
