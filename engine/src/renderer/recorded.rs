@@ -15,6 +15,8 @@ pub struct RecordedFrame {
     scope: ResourceScope,
     passes: Vec<RenderPass>,
     owners: Vec<PassId>,
+    /// A [`SlowPass`]'s pass and its render passes without the injected copies.
+    unslowed: Option<(PassId, Vec<RenderPass>)>,
 }
 
 impl RecordedFrame {
@@ -28,6 +30,10 @@ impl RecordedFrame {
         let mut scope = ResourceScope::default();
         match record(backend, prepared, &mut scope) {
             Ok(Recorded { passes, owners, .. }) => Ok(Self {
+                unslowed: prepared
+                    .variations
+                    .slow_pass
+                    .map(|slow| (slow.pass, originals(&passes, &owners, slow))),
                 scene,
                 scope,
                 passes,
@@ -74,6 +80,32 @@ impl RecordedFrame {
         Ok(timings.iter().map(|t| t.gpu_ns).sum())
     }
 
+    /// The pass a [`SlowPass`] slowed down in this frame, if any.
+    pub fn slowed_pass(&self) -> Option<PassId> {
+        self.unslowed.as_ref().map(|(pass, _)| *pass)
+    }
+
+    /// Submits a [`SlowPass`]'s pass without its injected copies: the pass and its GPU ns (None
+    /// without a slowed pass or timestamps). Timed in the same rounds as the slowed pass, it
+    /// says what slowdown the copies delivered in this process: a copy that finds its inputs
+    /// still in the caches costs less than the pass did.
+    pub fn submit_unslowed(
+        &self,
+        backend: &mut dyn Backend,
+    ) -> Result<Option<(PassId, f64)>, RenderError> {
+        let Some((pass, originals)) = &self.unslowed else {
+            return Ok(None);
+        };
+        let timings = backend
+            .submit(originals)
+            .map_err(|e| named(&self.scene, e.into()))?;
+        Ok(timings
+            .iter()
+            .map(|t| t.gpu_ns)
+            .sum::<Option<f64>>()
+            .map(|ns| (*pass, ns)))
+    }
+
     /// Destroys the frame's resources.
     pub fn destroy(self, backend: &mut dyn Backend) {
         self.scope.destroy(backend);
@@ -93,6 +125,19 @@ pub(super) fn named(scene: &str, e: RenderError) -> RenderError {
         },
         other => other,
     }
+}
+
+/// `slow`'s pass's render passes as recorded, without the copies [`slowed`] put right after
+/// each of them.
+fn originals(passes: &[RenderPass], owners: &[PassId], slow: SlowPass) -> Vec<RenderPass> {
+    let step = 1 + slow.extra_copies().len();
+    passes
+        .iter()
+        .zip(owners)
+        .filter(|(_, owner)| **owner == slow.pass)
+        .step_by(step)
+        .map(|(pass, _)| pass.clone())
+        .collect()
 }
 
 /// `passes` with `slow`'s extra copies of its pass's render passes right after each of them

@@ -167,8 +167,11 @@ pub(crate) fn speed(
         );
     } else {
         println!(
-            "Injected slowdowns: value / limit in the pass slowed (above 1 is flagged), the \
-             worst other pass of the scene, and the smallest slowdown each pass detects"
+            "Injected slowdowns: the slowdown the copies delivered in the probe's own process \
+             (the pass timed with and without them), the slowdown measured against the timing \
+             golden (their quotient is how fast that process ran the unslowed pass against the \
+             golden), value / limit in the pass slowed (above 1 is flagged), the smallest \
+             slowdown each pass detects, and the worst other pass of the scene"
         );
         print!("{}", selftest::table(&injections));
         for e in &errors {

@@ -440,6 +440,7 @@ pub fn accept_timings(
                 pass_ms: vec![c.ms],
                 floor_ms: vec![c.ms / c.ratio],
                 targets: c.targets.clone(),
+                unslowed_ms: Vec::new(),
             }],
         };
         let stamp = Stamp {

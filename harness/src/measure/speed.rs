@@ -42,9 +42,22 @@ pub struct PassSpeed {
     /// probe).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub targets: Option<String>,
+    /// Where the speed self-test slowed this pass down ([`SlowPass`](engine::renderer::SlowPass)):
+    /// its GPU ms without the injected copies, one per round, timed right after its floor.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unslowed_ms: Vec<f64>,
 }
 
 impl PassSpeed {
+    /// The slowdown an injected [`SlowPass`](engine::renderer::SlowPass) delivered in this
+    /// probe's process: the pass's fastest time over its fastest without the copies (None where
+    /// nothing was injected).
+    pub fn delivered(&self) -> Option<f64> {
+        let unslowed = self.unslowed_ms.iter().copied().reduce(f64::min)?;
+        let slowed = self.min_ms()?;
+        (unslowed > 0.0).then(|| slowed / unslowed)
+    }
+
     /// The fastest of the pass's samples, ms.
     pub fn min_ms(&self) -> Option<f64> {
         self.pass_ms.iter().copied().reduce(f64::min)
@@ -85,6 +98,7 @@ impl SceneSpeed {
             if let Some(more) = other.pass(pass.pass) {
                 pass.pass_ms.extend(&more.pass_ms);
                 pass.floor_ms.extend(&more.floor_ms);
+                pass.unslowed_ms.extend(&more.unslowed_ms);
             }
         }
         merged
@@ -432,6 +446,7 @@ fn sample(
                 pass_ms: Vec::with_capacity(rounds),
                 floor_ms: Vec::with_capacity(rounds),
                 targets: None,
+                unslowed_ms: Vec::new(),
             });
             copies.push(floor_copies(floor_ns / 1e6));
         }
@@ -452,6 +467,15 @@ fn sample(
                 speed.pass_ms.push(pass_ns / 1e6);
                 speed.floor_ms.push(floor_ns / 1e6);
                 sampled = true;
+            }
+            // A slowed pass again without its copies, in the same round: what they delivered.
+            if recorded.slowed_pass() == Some(speed.pass) {
+                if let Some((_, ns)) = recorded
+                    .submit_unslowed(backend)
+                    .map_err(SampleError::Render)?
+                {
+                    speed.unslowed_ms.push(ns / 1e6);
+                }
             }
         }
         if !sampled {

@@ -97,3 +97,35 @@ fn unspecialised_gives_the_same_picture(backend: &mut dyn Backend, scene: &Scene
         );
     }
 }
+
+/// A probe of a slowed pass also times it without its copies, in the same rounds: the slowdown
+/// the copies delivered in that process (what the speed self-test reports and calibrates by).
+/// Only the slowed pass carries it.
+#[test]
+fn a_probe_of_a_slowed_pass_says_what_slowdown_its_copies_delivered() {
+    let scene = test_scenes::five_models(64);
+    let Some(&kind) = common::available_backends().first() else {
+        return;
+    };
+    let slowed = renderer::Variations {
+        slow_pass: Some(renderer::SlowPass {
+            pass: PassId::ToneMap,
+            factor: 3.0,
+        }),
+        ..Default::default()
+    };
+    let probe = harness::measure::speed::probe(&scene, kind, 4, slowed).unwrap();
+    let plain = harness::measure::speed::probe(&scene, kind, 4, Default::default()).unwrap();
+    let Some(tonemap) = probe.pass(PassId::ToneMap) else {
+        return; // no timestamps on this backend
+    };
+    assert_eq!(tonemap.unslowed_ms.len(), tonemap.pass_ms.len());
+    let delivered = tonemap.delivered().unwrap();
+    // Three submissions of a pass that clears and redraws its target: well over one, and not
+    // beyond what three of them and a timer's rounding could cost.
+    assert!(delivered > 1.5 && delivered < 4.5, "x{delivered:.2}");
+    for pass in probe.passes.iter().filter(|p| p.pass != PassId::ToneMap) {
+        assert!(pass.unslowed_ms.is_empty(), "{}", pass.pass);
+    }
+    assert!(plain.passes.iter().all(|p| p.delivered().is_none()));
+}

@@ -2,6 +2,12 @@
 //! other. Each pass of each scene is slowed down in turn ([`SlowPass`]: its work submitted
 //! ×1.5 and ×2), on every backend, and the check must flag it there and nowhere else. The
 //! unchanged side (every source at or below half its limit) is `harness noise --timing`'s.
+//!
+//! Each probe also times the slowed pass without its copies, in the same rounds
+//! ([`PassSpeed::delivered`](crate::measure::speed::PassSpeed::delivered)), so the table shows
+//! what slowdown the injection delivered in its own process beside what the check measured
+//! against the golden: where a doubling is missed, whether the copies fell short or the
+//! process ran the pass faster than the golden's.
 
 use engine::backend::BackendKind;
 use engine::plan::PassId;
@@ -23,6 +29,9 @@ pub struct Injection {
     pub pass: PassId,
     /// By how much its work was multiplied.
     pub factor: f32,
+    /// The slowdown its copies delivered in the probe's own process: the pass's time over its
+    /// time without them, timed in the same rounds (None without timestamps).
+    pub delivered: Option<f64>,
     /// The slowdown measured in that pass (ratio / golden).
     pub measured: Option<f64>,
     /// Its score (`ln slowdown / ln limit`; above 1 is flagged).
@@ -87,6 +96,7 @@ pub fn run(
                         backend: backend.0,
                         pass,
                         factor,
+                        delivered: own.and_then(|c| c.delivered),
                         measured: own.and_then(SpeedCheck::slowdown),
                         score: own.and_then(SpeedCheck::score),
                         limit: own.and_then(|c| c.limit),
@@ -113,11 +123,12 @@ pub fn run(
 /// worst other pass, and the smallest slowdown the pass's limit detects.
 pub fn table(injections: &[Injection]) -> String {
     let mut out = format!(
-        "{:<8} {:<12} {:<22} {:>6} {:>10} {:>12} {:>10} {:>14}  {}\n",
+        "{:<8} {:<12} {:<22} {:>6} {:>9} {:>10} {:>12} {:>10} {:>14}  {}\n",
         "scene",
         "backend",
         "pass",
         "inject",
+        "delivered",
         "measured",
         "value/limit",
         "detects",
@@ -132,11 +143,12 @@ pub fn table(injections: &[Injection]) -> String {
             (None, false) => format!("ALSO FLAGGED {}", crate::names(&i.flagged_elsewhere)),
         };
         out += &format!(
-            "{:<8} {:<12} {:<22} {:>6} {:>10} {:>12} {:>10} {:>14}  {verdict}\n",
+            "{:<8} {:<12} {:<22} {:>6} {:>9} {:>10} {:>12} {:>10} {:>14}  {verdict}\n",
             i.scene,
             i.backend.name(),
             i.pass.to_string(),
             format!("x{}", i.factor),
+            i.delivered.map_or("-".to_owned(), |d| format!("x{d:.2}")),
             i.measured.map_or("-".to_owned(), |m| format!("x{m:.3}")),
             i.score.map_or("-".to_owned(), |s| format!("{s:.2}")),
             i.limit.map_or("-".to_owned(), |l| format!("x{l:.2}")),

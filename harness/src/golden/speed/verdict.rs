@@ -60,6 +60,10 @@ pub struct SpeedCheck {
     /// which accepting this check's ratio records beside it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub targets: Option<String>,
+    /// In the speed self-test, the slowdown its injection delivered in the probe's own process
+    /// ([`PassSpeed::delivered`](crate::measure::speed::PassSpeed::delivered)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub delivered: Option<f64>,
     /// The golden ratio.
     pub golden: Option<f64>,
     /// The limit, a factor (ratio / golden above it fails).
@@ -278,6 +282,7 @@ pub fn check_speed_with(
             ratio,
             ms,
             targets: pass.targets.clone(),
+            delivered: pass.delivered(),
             golden,
             limit,
             noise: noise_figure,

@@ -17,6 +17,7 @@ fn slower(backend: BackendKind) -> SpeedCheck {
         ratio: 6.0,
         ms: 3.0,
         targets: None,
+        delivered: None,
         golden: Some(2.0),
         limit: Some(1.44),
         noise: None,
@@ -61,6 +62,7 @@ fn a_timing_golden_is_accepted_only_on_the_host_that_blessed_it() {
             pass_ms: vec![2.0],
             floor_ms: vec![1.0],
             targets: None,
+            unslowed_ms: Vec::new(),
         }],
     };
     let cpu = cpu_signature();

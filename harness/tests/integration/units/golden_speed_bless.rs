@@ -17,12 +17,14 @@ fn the_median_probe_takes_each_pass_from_its_median_run() {
                 pass_ms: vec![tonemap],
                 floor_ms: vec![1.0],
                 targets: None,
+                unslowed_ms: Vec::new(),
             },
             PassSpeed {
                 pass: PassId::Geometry,
                 pass_ms: vec![geometry],
                 floor_ms: vec![1.0],
                 targets: None,
+                unslowed_ms: Vec::new(),
             },
         ],
     };

@@ -19,12 +19,14 @@ fn goldens_round_trip_and_a_partial_bless_keeps_the_other_passes() {
                 pass_ms: vec![ratio, ratio * 2.0],
                 floor_ms: vec![1.0],
                 targets: None,
+                unslowed_ms: Vec::new(),
             },
             PassSpeed {
                 pass: PassId::ToneMap,
                 pass_ms: vec![ratio],
                 floor_ms: vec![1.0],
                 targets: None,
+                unslowed_ms: Vec::new(),
             },
         ],
     };

@@ -67,6 +67,7 @@ fn a_probe_of_other_targets_is_not_a_noise_measurement() {
         pass_ms: vec![2.0],
         floor_ms: vec![1.0],
         targets: targets.map(str::to_owned),
+        unslowed_ms: Vec::new(),
     };
     let golden = |targets: Option<&str>| PassTiming {
         ratio: 2.0,

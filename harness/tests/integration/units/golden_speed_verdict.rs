@@ -20,12 +20,14 @@ fn probe(tonemap_ms: f64, geometry_ms: f64) -> SceneSpeed {
                 pass_ms: vec![tonemap_ms],
                 floor_ms: vec![0.5],
                 targets: None,
+                unslowed_ms: Vec::new(),
             },
             PassSpeed {
                 pass: PassId::Geometry,
                 pass_ms: vec![geometry_ms],
                 floor_ms: vec![1.0],
                 targets: None,
+                unslowed_ms: Vec::new(),
             },
         ],
     }
@@ -258,6 +260,7 @@ fn covered(
         ratio: 2.0,
         ms: 1.0,
         targets: None,
+        delivered: None,
         golden: Some(2.0),
         limit,
         noise: None,

@@ -11,6 +11,7 @@ fn a_pass_settles_once_its_last_rounds_find_nothing_faster() {
         pass_ms: pass_ms.to_vec(),
         floor_ms: floor_ms.to_vec(),
         targets: None,
+        unslowed_ms: Vec::new(),
     };
     let floor = [1.0; 4];
     assert!(!settled(&speed(&[2.0, 2.0, 2.0], &floor[..3])));
@@ -38,6 +39,7 @@ fn merged_probes_keep_every_sample() {
             pass_ms: vec![pass_ms],
             floor_ms: vec![1.0],
             targets: None,
+            unslowed_ms: Vec::new(),
         }],
     };
     let merged = probe(3.0).merged(&probe(2.0));
@@ -53,6 +55,7 @@ fn the_ratio_is_fastest_over_fastest() {
         pass_ms: vec![3.0, 2.0, 9.0],
         floor_ms: vec![1.0, 4.0, 0.5],
         targets: None,
+        unslowed_ms: Vec::new(),
     };
     assert_eq!(speed.ratio(), Some(4.0));
     let empty = PassSpeed {
@@ -60,6 +63,7 @@ fn the_ratio_is_fastest_over_fastest() {
         pass_ms: vec![],
         floor_ms: vec![],
         targets: None,
+        unslowed_ms: Vec::new(),
     };
     assert_eq!(empty.ratio(), None);
 }
