@@ -84,16 +84,31 @@ pub(super) fn timing(
             "--write needs every timing source asked for; install the missing ones first"
         );
     }
-    let backends: Vec<BackendKind> = BackendKind::ALL
-        .into_iter()
-        .filter(|k| engine::backend::probe(*k).available)
-        .collect();
+    let hosts = this_hosts();
+    let backends: Vec<BackendKind> = hosts.iter().map(|(kind, _)| *kind).collect();
     let exe = std::env::current_exe()?;
     let probed: Vec<measure::TimingSource> = sources
         .iter()
         .filter(|s| s.probes > 0 && chosen(&s.name))
         .cloned()
         .collect();
+    if !probed.is_empty() {
+        if let Some(why) = blessed_elsewhere(store.root(), &scenes, &hosts)? {
+            if write {
+                anyhow::bail!(
+                    "{why}: this host's probes are another host's figures, and --write would \
+                     take them for the blessing host's own noise. Record them with `harness \
+                     noise --timing --record-host NAME` and count them with `harness noise \
+                     --timing --source NAME --write`"
+                );
+            }
+            eprintln!(
+                "note: {why}: this host's sources are read against another host's goldens, \
+                 so their factors are that host's offset as much as noise (`--record-host NAME` \
+                 records this host's own)"
+            );
+        }
+    }
     let (mut measurements, errors) =
         measure::measure_timing(&exe, store.root(), &scenes, &backends, &probed, |what| {
             eprintln!("timing noise: {what} ...")
@@ -150,6 +165,48 @@ pub(super) fn timing(
     } else {
         ExitCode::FAILURE
     })
+}
+
+/// Every available backend with this host's fingerprint for it (as the speed checks name it).
+fn this_hosts() -> Vec<(BackendKind, String)> {
+    BackendKind::ALL
+        .into_iter()
+        .filter_map(|kind| {
+            let info = engine::backend::probe(kind).info?;
+            Some((
+                kind,
+                harness::golden::speed::host_fingerprint(&harness::golden::store::fingerprint(
+                    &info,
+                )),
+            ))
+        })
+        .collect()
+}
+
+/// Where one of `scenes`' timing goldens on one of `hosts`' backends was not blessed on this
+/// host: which, and where it was (None where this host blessed them all).
+fn blessed_elsewhere(
+    root: &std::path::Path,
+    scenes: &[(String, String)],
+    hosts: &[(BackendKind, String)],
+) -> anyhow::Result<Option<String>> {
+    let cpu = harness::golden::speed::cpu_signature();
+    for (scene, _) in scenes {
+        let goldens = harness::golden::speed::TimingGoldens::load(root, scene)?;
+        if let Some((kind, g)) = goldens.blessed_elsewhere(hosts, &cpu) {
+            let signature = if g.cpu.is_empty() {
+                "no CPU signature, so no host can show it blessed them".to_owned()
+            } else {
+                g.cpu.clone()
+            };
+            return Ok(Some(format!(
+                "{scene}'s timing goldens on {kind} were blessed on {} ({signature}), not here \
+                 ({cpu})",
+                g.host
+            )));
+        }
+    }
+    Ok(None)
 }
 
 /// `harness noise --timing --json`: every measurement with its limit and score, and the errors.

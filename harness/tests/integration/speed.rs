@@ -129,3 +129,41 @@ fn the_probe_child_takes_no_timed_round_before_it_is_told_to() {
     );
     assert!(probes[0].passes.len() >= 5, "{:?}", probes[0].passes);
 }
+
+/// `noise --timing --write` measures and writes the blessing host's own noise: on a host that
+/// did not bless (here every host: the copy's corner goldens name another), it refuses before
+/// probing, names the scene, backend and host, and points at recording the host instead; the
+/// model is left as it was. Without `--write` it measures with a note saying the same.
+#[test]
+fn timing_noise_is_written_only_on_the_host_that_blessed() {
+    let root = common::temp_workspace();
+    let timing = root.path().join("golden/corner/timing.toml");
+    let text = std::fs::read_to_string(&timing).unwrap();
+    std::fs::write(
+        &timing,
+        text.replace("host = \"", "host = \"another host | "),
+    )
+    .unwrap();
+    let model = root.path().join("golden/timing-noise.toml");
+    let before = std::fs::read(&model).unwrap();
+    let output = common::harness_command()
+        .args([
+            "noise", "--timing", "--source", "runs", "--write", "--scene", "corner",
+        ])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    if common::available_backends().is_empty() {
+        return;
+    }
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("corner's timing goldens on")
+            && stderr.contains("were blessed on another host")
+            && stderr.contains("--record-host NAME")
+            && !stderr.contains("timing noise: runs on"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read(&model).unwrap(), before);
+}

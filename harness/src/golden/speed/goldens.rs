@@ -93,6 +93,22 @@ pub struct TimingGoldens {
 }
 
 impl TimingGoldens {
+    /// The first of `hosts` (each backend with this host's fingerprint for it) whose goldens
+    /// here were blessed on another host, or on no host a check can name (no CPU signature):
+    /// where this host's probes are another host's figures, not its own noise.
+    pub fn blessed_elsewhere<'a>(
+        &'a self,
+        hosts: &[(BackendKind, String)],
+        cpu: &str,
+    ) -> Option<(BackendKind, &'a BackendTimings)> {
+        hosts.iter().find_map(|(kind, host)| {
+            self.backends
+                .get(kind)
+                .filter(|g| !g.blessed_on(host, cpu))
+                .map(|g| (*kind, g))
+        })
+    }
+
     /// The file of `scene` under the golden root.
     pub fn path(root: &Path, scene: &str) -> PathBuf {
         root.join(scene).join(TIMING_FILE)

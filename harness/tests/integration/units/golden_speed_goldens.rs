@@ -114,3 +114,57 @@ fn goldens_without_a_cpu_signature_were_blessed_on_no_host_a_check_can_name() {
     let text = std::fs::read_to_string(TimingGoldens::path(dir.path(), "s")).unwrap();
     assert!(!text.contains("cpu"), "{text}");
 }
+
+/// `noise --timing` asks which backend's goldens this host did not bless: another host's
+/// fingerprint, another CPU behind it, or no CPU signature at all. Backends without goldens,
+/// or not asked about, are not in question.
+#[test]
+fn the_backends_blessed_elsewhere_are_named() {
+    let cpu = "family 26 model 2 stepping 1";
+    let section = |host: &str, cpu: &str| BackendTimings {
+        blessed: "t".to_owned(),
+        host: host.to_owned(),
+        cpu: cpu.to_owned(),
+        rounds: 4,
+        passes: Default::default(),
+    };
+    let goldens = TimingGoldens {
+        backends: [
+            (BackendKind::Gl, section("gl here", cpu)),
+            (BackendKind::WgpuVulkan, section("vulkan here", "")),
+        ]
+        .into(),
+    };
+    let here = |kinds: &[(BackendKind, &str)]| -> Vec<(BackendKind, String)> {
+        kinds.iter().map(|(k, h)| (*k, (*h).to_owned())).collect()
+    };
+    assert!(goldens
+        .blessed_elsewhere(&here(&[(BackendKind::Gl, "gl here")]), cpu)
+        .is_none());
+    // No goldens for wgpu-gl: nothing to compare with.
+    assert!(goldens
+        .blessed_elsewhere(&here(&[(BackendKind::WgpuGl, "anything")]), cpu)
+        .is_none());
+    let elsewhere = |hosts, cpu| goldens.blessed_elsewhere(&here(hosts), cpu).map(|(k, _)| k);
+    assert_eq!(
+        elsewhere(&[(BackendKind::Gl, "gl there")], cpu),
+        Some(BackendKind::Gl)
+    );
+    assert_eq!(
+        elsewhere(
+            &[(BackendKind::Gl, "gl here")],
+            "family 25 model 17 stepping 1"
+        ),
+        Some(BackendKind::Gl)
+    );
+    assert_eq!(
+        elsewhere(
+            &[
+                (BackendKind::Gl, "gl here"),
+                (BackendKind::WgpuVulkan, "vulkan here")
+            ],
+            cpu
+        ),
+        Some(BackendKind::WgpuVulkan)
+    );
+}
