@@ -109,6 +109,8 @@ pub(super) fn timing(
             );
         }
     }
+    // What is written is refused on a busy machine; a report only warns.
+    refuse_if_busy(writing.busy_ok, !write, "before measuring")?;
     let (mut measurements, errors) =
         measure::measure_timing(&exe, store.root(), &scenes, &backends, &probed, |what| {
             eprintln!("timing noise: {what} ...")
@@ -354,6 +356,7 @@ pub(super) fn record_host(
             }
         }
     }
+    refuse_if_busy(busy_ok, false, "before measuring")?;
     let path = recorded::RecordedTimings::path(store.root(), name);
     let earlier = recorded::RecordedTimings::load(&path)?;
     if let Some(earlier) = &earlier {
