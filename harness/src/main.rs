@@ -159,8 +159,9 @@ enum Command {
         #[arg(long)]
         json: bool,
         /// The speed self-test instead: each pass slowed down x1.5 and x2 in turn must fail
-        /// its own speed check and no other (run it on a host that blessed the timing goldens
-        /// or is recorded in golden/evidence/: elsewhere most passes are untimed).
+        /// its own speed check and no other (run it on a host recorded in golden/evidence/, or
+        /// the one that blessed the timing goldens where they name one: elsewhere most passes
+        /// are untimed).
         #[arg(long)]
         speed: bool,
         /// With --speed: only these scenes (repeatable).

@@ -521,8 +521,9 @@ fn print_speed(run: &CheckRun) {
     if !elsewhere.is_empty() {
         println!(
             "note: faster beyond the limit, on a host that did not bless the timing goldens \
-             (ratios differ between hosts: bless timing on the host that did, or record this \
-             one again with `harness noise --timing --record-host`): {}",
+             (ratios differ between hosts: record this host, or record it again, with `harness \
+             noise --timing --record-host NAME`, or move the timing goldens here whole with \
+             `harness bless --scene S --speed-only --every-pass`): {}",
             elsewhere.join(", ")
         );
     }

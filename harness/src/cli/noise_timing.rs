@@ -79,11 +79,6 @@ pub(super) fn timing(
     for (name, why) in &missing {
         eprintln!("note: timing source {name} not measured: {why}");
     }
-    if write && !missing.is_empty() {
-        anyhow::bail!(
-            "--write needs every timing source asked for; install the missing ones first"
-        );
-    }
     let hosts = this_hosts();
     let backends: Vec<BackendKind> = hosts.iter().map(|(kind, _)| *kind).collect();
     let exe = std::env::current_exe()?;
@@ -99,7 +94,9 @@ pub(super) fn timing(
                     "{why}: this host's probes are another host's figures, and --write would \
                      take them for the blessing host's own noise. Record them with `harness \
                      noise --timing --record-host NAME` and count them with `harness noise \
-                     --timing --source NAME --write`"
+                     --timing --source NAME --write`; or make this host the blessing one with \
+                     `harness bless --scene S --speed-only --every-pass` for every scene \
+                     first"
                 );
             }
             eprintln!(
@@ -108,6 +105,11 @@ pub(super) fn timing(
                  records this host's own)"
             );
         }
+    }
+    if write && !missing.is_empty() {
+        anyhow::bail!(
+            "--write needs every timing source asked for; install the missing ones first"
+        );
     }
     // What is written is refused on a busy machine; a report only warns.
     refuse_if_busy(writing.busy_ok, !write, "before measuring")?;
@@ -196,15 +198,9 @@ fn blessed_elsewhere(
     for (scene, _) in scenes {
         let goldens = harness::golden::speed::TimingGoldens::load(root, scene)?;
         if let Some((kind, g)) = goldens.blessed_elsewhere(hosts, &cpu) {
-            let signature = if g.cpu.is_empty() {
-                "no CPU signature, so no host can show it blessed them".to_owned()
-            } else {
-                g.cpu.clone()
-            };
             return Ok(Some(format!(
-                "{scene}'s timing goldens on {kind} were blessed on {} ({signature}), not here \
-                 ({cpu})",
-                g.host
+                "{scene}'s timing goldens on {kind} were blessed on {}, not here ({cpu})",
+                g.blessed_by()
             )));
         }
     }
@@ -314,7 +310,7 @@ pub(super) fn record_host(
     history: Option<&std::path::Path>,
     busy_ok: bool,
 ) -> anyhow::Result<ExitCode> {
-    use harness::golden::speed::{host_fingerprint, measure, recorded, TimingGoldens};
+    use harness::golden::speed::{measure, recorded, TimingGoldens};
     if name.is_empty()
         || !name
             .chars()
@@ -326,36 +322,38 @@ pub(super) fn record_host(
     let cases = load_cases(scenes)?;
     let input_digests = harness::golden::scene_inputs::digests(cases.iter().map(|c| &c.inputs));
     let scenes = named(&cases);
-    let backends: Vec<(BackendKind, String)> = BackendKind::ALL
-        .into_iter()
-        .filter_map(|kind| {
-            let status = engine::backend::probe(kind);
-            let info = status.info?;
-            Some((
-                kind,
-                host_fingerprint(&harness::golden::store::fingerprint(&info)),
-            ))
-        })
-        .collect();
+    let backends = this_hosts();
     if backends.is_empty() {
         anyhow::bail!("no backend is available here (`harness backends` says why)");
     }
+    // A scene whose goldens this host blessed (on some backend) is its own noise there, not
+    // another host's figures: left out, and refused only when that leaves nothing.
     let cpu = harness::golden::speed::cpu_signature();
-    for (scene, _) in &scenes {
-        let goldens = TimingGoldens::load(store.root(), scene)?;
-        for (kind, host) in &backends {
-            if goldens
+    let mut kept = Vec::new();
+    for (scene, argument) in scenes {
+        let goldens = TimingGoldens::load(store.root(), &scene)?;
+        let blessed_here = backends.iter().find(|(kind, host)| {
+            goldens
                 .backends
                 .get(kind)
                 .is_some_and(|g| g.blessed_on(host, &cpu))
-            {
-                anyhow::bail!(
-                    "this host blessed {scene}'s timing goldens on {kind} ({host}): its figures \
-                     are its own noise (`harness noise --timing`), not another host's"
-                );
-            }
+        });
+        match blessed_here {
+            Some((kind, host)) => eprintln!(
+                "note: {scene} left out: this host blessed its timing goldens on {kind} \
+                 ({host}), so its figures there are this host's own noise (`harness noise \
+                 --timing --scene {scene}`), not another host's"
+            ),
+            None => kept.push((scene, argument)),
         }
     }
+    if kept.is_empty() {
+        anyhow::bail!(
+            "this host blessed the timing goldens of every scene asked for: its figures are its \
+             own noise (`harness noise --timing`), not another host's"
+        );
+    }
+    let scenes = kept;
     refuse_if_busy(busy_ok, false, "before measuring")?;
     let path = recorded::RecordedTimings::path(store.root(), name);
     let earlier = recorded::RecordedTimings::load(&path)?;

@@ -419,11 +419,11 @@ pub fn accept_timings(
                 .is_some_and(|host| section.blessed_on(host, &cpu));
         if !blessed_here {
             done.kept.push(kept(format!(
-                "the check ran on a host that did not bless {}'s timing goldens (they are \
-                 {}'s), and a backend's timing goldens are one host's ratios. To move them all \
+                "the check ran on a host that did not bless {}'s timing goldens (blessed on \
+                 {}), and a backend's timing goldens are one host's ratios. To move them all \
                  to this host: `{}`",
                 c.backend,
-                section.host,
+                section.blessed_by(),
                 bless(false)
             )));
             continue;

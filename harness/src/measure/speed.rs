@@ -43,7 +43,8 @@ pub struct PassSpeed {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub targets: Option<String>,
     /// Where the speed self-test slowed this pass down ([`SlowPass`](engine::renderer::SlowPass)):
-    /// its GPU ms without the injected copies, one per round, timed right after its floor.
+    /// its GPU ms without the injected copies, timed in every other turn of the pass (each
+    /// after a turn with them, in the same place in the round).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub unslowed_ms: Vec<f64>,
 }
@@ -457,6 +458,24 @@ fn sample(
             if settled(speed) {
                 continue;
             }
+            // A slowed pass gives every other turn to itself without its copies, in the same
+            // place (after the previous pass's floor, before its own): what they delivered.
+            if recorded.slowed_pass() == Some(speed.pass)
+                && speed.unslowed_ms.len() < speed.pass_ms.len()
+            {
+                if let Some((_, ns)) = recorded
+                    .submit_unslowed(backend)
+                    .map_err(SampleError::Render)?
+                {
+                    speed.unslowed_ms.push(ns / 1e6);
+                }
+                // The floor as after the pass, so that the next pass follows the same work.
+                floors
+                    .time_repeated(backend, speed.pass, n)
+                    .map_err(SampleError::Backend)?;
+                sampled = true;
+                continue;
+            }
             let pass_ns = recorded
                 .submit_pass(backend, speed.pass)
                 .map_err(SampleError::Render)?;
@@ -467,15 +486,6 @@ fn sample(
                 speed.pass_ms.push(pass_ns / 1e6);
                 speed.floor_ms.push(floor_ns / 1e6);
                 sampled = true;
-            }
-            // A slowed pass again without its copies, in the same round: what they delivered.
-            if recorded.slowed_pass() == Some(speed.pass) {
-                if let Some((_, ns)) = recorded
-                    .submit_unslowed(backend)
-                    .map_err(SampleError::Render)?
-                {
-                    speed.unslowed_ms.push(ns / 1e6);
-                }
             }
         }
         if !sampled {

@@ -140,9 +140,9 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
         .iter()
         .any(|c| c.tier != crate::golden::speed::Tier::SameHost);
     let bless = if elsewhere {
-        "on the host that blessed the timing goldens, bless it with <code>harness bless \
-         --scene S --speed-only</code> if intended (this host did not bless them: <code>--speed-only \
-         --every-pass</code> moves them here, every pass)"
+        "this host did not bless the timing goldens: if intended, <code>harness bless --scene \
+         S --speed-only --every-pass</code> moves them here, every pass (or bless with \
+         <code>--speed-only</code> on the host that did, where the goldens name one)"
     } else {
         "bless it with <code>harness bless --scene S --speed-only</code> if intended"
     };

@@ -99,7 +99,7 @@ fn unspecialised_gives_the_same_picture(backend: &mut dyn Backend, scene: &Scene
 }
 
 /// A probe of a slowed pass also times it without its copies, in the same rounds: the slowdown
-/// the copies delivered in that process (what the speed self-test reports and calibrates by).
+/// the copies delivered in that process (what the speed self-test reports).
 /// Only the slowed pass carries it.
 #[test]
 fn a_probe_of_a_slowed_pass_says_what_slowdown_its_copies_delivered() {
@@ -119,7 +119,11 @@ fn a_probe_of_a_slowed_pass_says_what_slowdown_its_copies_delivered() {
     let Some(tonemap) = probe.pass(PassId::ToneMap) else {
         return; // no timestamps on this backend
     };
-    assert_eq!(tonemap.unslowed_ms.len(), tonemap.pass_ms.len());
+    // Every other turn of the pass is without its copies.
+    assert!(
+        !tonemap.unslowed_ms.is_empty() && tonemap.unslowed_ms.len() <= tonemap.pass_ms.len(),
+        "{tonemap:?}"
+    );
     let delivered = tonemap.delivered().unwrap();
     // Three submissions of a pass that clears and redraws its target: well over one, and not
     // beyond what three of them and a timer's rounding could cost.

@@ -120,7 +120,7 @@ pub fn kept_as_another_hosts(
     Some(format!(
         "blessed on another host ({}, {}); a backend's timing goldens are one host's ratios, \
          so none is rewritten from here. To move every backend's to this host: {}",
-        existing.host,
+        existing.blessed_by(),
         existing.blessed,
         crate::golden::command_line::speed_bless_command(argument, false)
     ))

@@ -80,7 +80,21 @@ impl BackendTimings {
     /// blessing EPYC's fingerprint, and its ratios lay up to x1.39 from the goldens, next to
     /// the blessing host's limits of x1.44.
     pub fn blessed_on(&self, host: &str, cpu: &str) -> bool {
-        self.host == host && !self.cpu.is_empty() && self.cpu == cpu
+        self.host == host && super::cpu_known(&self.cpu) && self.cpu == cpu
+    }
+
+    /// Where these goldens were blessed, as a refusal names it: the host's fingerprint and
+    /// CPU, or that they keep no CPU (so no host is taken for the one that blessed them).
+    pub fn blessed_by(&self) -> String {
+        if super::cpu_known(&self.cpu) {
+            format!("{}, {}", self.host, self.cpu)
+        } else {
+            format!(
+                "{}, a CPU they do not record (blessed before the CPU signature was kept, so \
+                 no host is taken for the one that blessed them)",
+                self.host
+            )
+        }
     }
 }
 

@@ -16,8 +16,9 @@
 //! on the log scale, where slowdowns multiply; `noise` is at least [`MIN_NOISE`] (at least
 //! [`MIN_NOISE_SHORT`] for a pass under [`SHORT_PASS_MS`]). A check is
 //! scored as `ln(ratio / golden) / ln(limit)`: 1 at the limit, and unchanged runs under every
-//! measured source at 1/margin or less. On a host whose driver fingerprint differs from the one
-//! that blessed, the other-host figures count too (the CPU code paths, the second Mesa, and the
+//! measured source at 1/margin or less. On a host whose driver fingerprint or CPU differs from
+//! the one that blessed (every host, for goldens that keep no CPU signature), the other-host
+//! figures count too (the CPU code paths, the second Mesa, and the
 //! hosts recorded in `golden/evidence/`, [`recorded`]), and a pass whose limit there would not
 //! catch a doubling is reported as untimed on that host, with the reason. A host that is itself
 //! recorded there (the same fingerprint and [`cpu_signature`]) is checked against its own
@@ -157,6 +158,13 @@ pub fn cpu_signature() -> String {
         field("model"),
         field("stepping")
     )
+}
+
+/// Whether a CPU signature names a CPU: not empty (goldens blessed before it was kept) and
+/// with every field found (`/proc/cpuinfo` on some architectures has no family or model, and
+/// two such hosts would otherwise match whatever their CPUs).
+pub fn cpu_known(signature: &str) -> bool {
+    !signature.is_empty() && !signature.contains('?')
 }
 
 /// The first CPU's `name` field in `/proc/cpuinfo`, trimmed. The file is read once per process
@@ -367,6 +375,12 @@ pub fn check_scenes(
             if let Some(again) = again.into_iter().find(|a| a.scene == probe.scene) {
                 checks =
                     check_speed_with(&probe.merged(&again), &goldens, &noise, &host, &recordings);
+                // What an injection delivered is one process's figure: the first probe's.
+                for check in &mut checks {
+                    check.delivered = probe
+                        .pass(check.pass)
+                        .and_then(crate::measure::speed::PassSpeed::delivered);
+                }
             }
         }
         // Read at the limits for any host: say what keeps a recording of this CPU from applying.

@@ -57,8 +57,8 @@ impl Injection {
 }
 
 /// Injects each slowdown of `factors` into each pass of each scene on each backend and checks
-/// it (a child process per scene, backend and injection, under the same-host limits: run this
-/// on the host that blessed). `passes` limits the passes slowed (all when empty).
+/// it (a child process per scene, backend and injection, at the limits the check would use
+/// here: run this on a recorded host, or the one that blessed where the goldens name one). `passes` limits the passes slowed (all when empty).
 pub fn run(
     exe: &std::path::Path,
     root: &std::path::Path,
@@ -119,8 +119,9 @@ pub fn run(
     (injections, errors)
 }
 
-/// The margin table: a row per injection with the value against the limit in its pass, the
-/// worst other pass, and the smallest slowdown the pass's limit detects.
+/// The margin table: a row per injection with the slowdown it delivered in its own process and
+/// the one measured against the golden, the value against the limit in its pass, the smallest
+/// slowdown the pass's limit detects, and the worst other pass.
 pub fn table(injections: &[Injection]) -> String {
     let mut out = format!(
         "{:<8} {:<12} {:<22} {:>6} {:>9} {:>10} {:>12} {:>10} {:>14}  {}\n",

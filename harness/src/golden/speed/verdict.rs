@@ -157,8 +157,9 @@ impl SpeedCheck {
 }
 
 /// The speed checks of one probe: each pass's ratio against its golden under the limit of
-/// the tier's figures. The goldens' host for this backend equal to `host` is the same host;
-/// any other is another host.
+/// the tier's figures. The goldens' host for this backend equal to `host`, on this CPU, is the
+/// same host ([`BackendTimings::blessed_on`](super::BackendTimings::blessed_on): goldens that
+/// keep no CPU signature name none); any other is another host.
 pub fn check_speed(
     probe: &SceneSpeed,
     goldens: &TimingGoldens,
@@ -189,7 +190,9 @@ pub fn check_speed_with(
     let recording = (host_tier == Tier::OtherHost && !recordings.is_empty())
         .then(|| {
             recordings.iter().find(|(_, r)| {
-                r.cpu == cpu && r.hosts.get(&probe.backend).is_some_and(|h| h == host)
+                super::cpu_known(&cpu)
+                    && r.cpu == cpu
+                    && r.hosts.get(&probe.backend).is_some_and(|h| h == host)
             })
         })
         .flatten();

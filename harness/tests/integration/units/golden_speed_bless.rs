@@ -62,12 +62,21 @@ fn a_bless_keeps_another_hosts_timing_goldens_unless_every_pass_moves() {
     );
     let why = kept_as_another_hosts(Some(&section), here.0, here.1, false, "arrow").unwrap();
     assert!(
-        why.contains("blessed on another host (the EPYC, 2026-11-25T10:00:00Z)")
-            && why.ends_with("bless --scene arrow --speed-only --every-pass"),
+        why.contains(
+            "blessed on another host (the EPYC, family 23 model 49 stepping 0, \
+             2026-11-25T10:00:00Z)"
+        ) && why.ends_with("bless --scene arrow --speed-only --every-pass"),
         "{why}"
     );
     // The same fingerprint on another CPU is another host.
     assert!(kept_as_another_hosts(Some(&section), "the EPYC", here.1, false, "arrow").is_some());
+    // Goldens that keep no CPU are kept on every host, and the refusal says why.
+    let unsigned = BackendTimings {
+        cpu: String::new(),
+        ..section.clone()
+    };
+    let why = kept_as_another_hosts(Some(&unsigned), "the EPYC", here.1, false, "arrow").unwrap();
+    assert!(why.contains("a CPU they do not record"), "{why}");
 }
 
 /// A dry run's lines say what would be written, not that it was.

@@ -108,6 +108,12 @@ fn goldens_without_a_cpu_signature_were_blessed_on_no_host_a_check_can_name() {
     assert_eq!(gl.cpu, "");
     assert!(!gl.blessed_on("h", "family 6 model 207 stepping 2"));
     assert!(!gl.blessed_on("h", ""));
+    // Nor does a signature with fields /proc/cpuinfo did not have.
+    let unknown = BackendTimings {
+        cpu: "family ? model ? stepping ?".to_owned(),
+        ..gl.clone()
+    };
+    assert!(!unknown.blessed_on("h", "family ? model ? stepping ?"));
     assert!(!gl.blessed_on("another", "family 6 model 207 stepping 2"));
     // Written again, an empty signature stays out of the file.
     old.save(dir.path(), "s").unwrap();
