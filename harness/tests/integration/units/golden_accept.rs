@@ -91,7 +91,9 @@ fn a_timing_golden_is_accepted_only_on_the_host_that_blessed_it() {
     assert!(
         done.written.is_empty()
             && why.starts_with("arrow/geometry on gl (speed): not accepted")
-            && why.contains("did not bless gl's timing goldens (they are the EPYC's)")
+            && why.contains(&format!(
+                "did not bless gl's timing goldens (blessed on the EPYC, {cpu})"
+            ))
             && why.contains("bless --scene scenes/arrow.toml --speed-only --every-pass"),
         "{why}"
     );
