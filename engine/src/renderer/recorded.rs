@@ -246,4 +246,45 @@ mod tests {
         let v = full_target.viewports[0];
         assert_eq!((v.x, v.y, v.width, v.height), (25.0, 10.0, 50.0, 20.0));
     }
+
+    /// A pass of several render passes (a point light's faces) slowed down: its copies follow
+    /// each face, and `originals` finds the faces again, for whole and fractional factors,
+    /// leaving the other passes out.
+    #[test]
+    fn the_originals_of_a_slowed_pass_are_its_render_passes_before_the_copies() {
+        let plan = RenderPlan {
+            scene: "s".to_owned(),
+            width: 4,
+            height: 4,
+            targets: vec![],
+            passes: vec![],
+            mask_channels: vec![],
+            lighting: vec![],
+        };
+        let passes = vec![
+            pass("face 0", vec![]),
+            pass("face 1", vec![]),
+            pass("geometry", vec![]),
+        ];
+        let owners = vec![
+            PassId::Shadow { light: 0 },
+            PassId::Shadow { light: 0 },
+            PassId::Geometry,
+        ];
+        for factor in [1.0, 1.5, 2.0, 3.25] {
+            let slow = SlowPass {
+                pass: PassId::Shadow { light: 0 },
+                factor,
+            };
+            let (slowed_passes, slowed_owners) =
+                slowed(&plan, passes.clone(), owners.clone(), slow);
+            let names: Vec<String> = originals(&slowed_passes, &slowed_owners, slow)
+                .into_iter()
+                .map(|p| p.name)
+                .collect();
+            assert_eq!(names, ["face 0", "face 1"], "x{factor}");
+            let copies = slow.extra_copies().len();
+            assert_eq!(slowed_passes.len(), 3 + 2 * copies, "x{factor}");
+        }
+    }
 }
