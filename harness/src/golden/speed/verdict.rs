@@ -274,8 +274,8 @@ pub fn check_speed_with(
             }
             _ => SpeedOutcome::Untimed(format!(
                 "no timing noise measured for {} on {} (measure it with `harness noise \
-                 --timing --write`)",
-                pass.pass, probe.backend
+                 --timing --write --scene {}` on the host that blessed its timing goldens)",
+                pass.pass, probe.backend, probe.scene
             )),
         };
         checks.push(SpeedCheck {
