@@ -51,7 +51,9 @@ pub fn moves_timings_note(commands: &[String]) -> &'static str {
     if commands.iter().any(|c| c.ends_with(MOVE_TIMINGS_HERE)) {
         " A command with `--speed-only --every-pass` is for timings this host did not bless: it \
          moves the backend's timing goldens to this host, every pass; then measure this host's \
-         timing noise (`harness noise --timing --write`)."
+         timing noise (`harness noise --timing --write`). The hosts recorded in \
+         golden/evidence/ were recorded against the goldens it replaces: there a pass whose \
+         golden moved is read at the limits for any host until that host is recorded again."
     } else {
         ""
     }
