@@ -74,8 +74,17 @@ impl RecordedFrame {
             .iter()
             .take_while(|owner| **owner == pass)
             .count();
+        self.submit_timed(backend, &self.passes[start..start + count])
+    }
+
+    /// Submits `passes` (this frame's): their GPU ns summed (None without timestamps).
+    fn submit_timed(
+        &self,
+        backend: &mut dyn Backend,
+        passes: &[RenderPass],
+    ) -> Result<Option<f64>, RenderError> {
         let timings = backend
-            .submit(&self.passes[start..start + count])
+            .submit(passes)
             .map_err(|e| named(&self.scene, e.into()))?;
         Ok(timings.iter().map(|t| t.gpu_ns).sum())
     }
@@ -96,14 +105,7 @@ impl RecordedFrame {
         let Some((pass, originals)) = &self.unslowed else {
             return Ok(None);
         };
-        let timings = backend
-            .submit(originals)
-            .map_err(|e| named(&self.scene, e.into()))?;
-        Ok(timings
-            .iter()
-            .map(|t| t.gpu_ns)
-            .sum::<Option<f64>>()
-            .map(|ns| (*pass, ns)))
+        Ok(self.submit_timed(backend, originals)?.map(|ns| (*pass, ns)))
     }
 
     /// Destroys the frame's resources.
