@@ -224,6 +224,23 @@ fn bless_speed(
     for line in &lines {
         println!("{line}");
     }
+    let moved: std::collections::BTreeSet<&str> = lines
+        .iter()
+        .filter(|l| l.fate == harness::golden::speed::bless::Fate::Rewritten)
+        .map(|l| l.scene.as_str())
+        .collect();
+    if options.every_pass && !options.images && !moved.is_empty() {
+        // The model's same-host figures are the previous blessing host's noise.
+        println!(
+            "note: {} timing goldens are this host's now, but golden/timing-noise.toml's \
+             same-host figures for them were measured where they were blessed before: measure \
+             this host's with `harness noise --timing --write --scene S` (without the second \
+             Mesa: `--source runs --source busy-neighbour --write --scene S`), or its checks \
+             read them at another machine's noise. The recordings in golden/evidence/ were \
+             taken against the goldens replaced, and no longer apply to them",
+            moved.into_iter().collect::<Vec<_>>().join(", ")
+        );
+    }
     Ok(lines
         .iter()
         .filter(|l| l.pass.is_none() && l.fate == harness::golden::speed::bless::Fate::Kept)

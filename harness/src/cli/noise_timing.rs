@@ -108,7 +108,13 @@ pub(super) fn timing(
     }
     if write && !missing.is_empty() {
         anyhow::bail!(
-            "--write needs every timing source asked for; install the missing ones first"
+            "--write needs every timing source asked for ({} missing); install them first, or \
+             name the ones to measure (`--source runs --source busy-neighbour --write`)",
+            missing
+                .iter()
+                .map(|(name, _)| name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
     // What is written is refused on a busy machine; a report only warns.
@@ -355,6 +361,22 @@ pub(super) fn record_host(
     }
     let scenes = kept;
     refuse_if_busy(busy_ok, false, "before measuring")?;
+    // Checks read a host against the first recording that matches it: a second name for the
+    // same host is never read.
+    for (other, recording) in recorded::load_all(store.root())? {
+        let same_host = other != name
+            && recording.cpu == cpu
+            && backends
+                .iter()
+                .all(|(kind, host)| recording.hosts.get(kind) == Some(host));
+        if same_host {
+            eprintln!(
+                "note: this host is recorded already, as {other} (golden/evidence/{other}/: the \
+                 same driver fingerprints and CPU); checks read it against that recording, not \
+                 a second one: `--record-host {other}` adds to it"
+            );
+        }
+    }
     let path = recorded::RecordedTimings::path(store.root(), name);
     let earlier = recorded::RecordedTimings::load(&path)?;
     if let Some(earlier) = &earlier {

@@ -408,7 +408,12 @@ pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
             (SpeedOutcome::MissingGolden | SpeedOutcome::TargetsChanged(_), _) | (_, None) => {}
             (_, Some(limit)) => {
                 group.limits.push(limit);
-                if let Some(slowdown) = c.slowdown().filter(|s| *s > 0.0) {
+                // From a pass's speed in this run, how much slower it may get; a pass already
+                // failing has no such room to report.
+                if let Some(slowdown) = c
+                    .slowdown()
+                    .filter(|s| *s > 0.0 && c.outcome != SpeedOutcome::Slower)
+                {
                     group.fails_beyond.push(limit / slowdown);
                 }
             }

@@ -319,6 +319,13 @@ fn coverage_counts_the_timed_and_untimed_passes_per_backend_and_tier() {
         "2 passes timed on a host that did not bless, limits x1.50; from their speed in this \
          run a pass fails only beyond x1.50 to x3.00 slower (median x3.00); 0 untimed"
     );
+    // A pass failing already has no room left to report (it read "beyond x0.20 slower").
+    let mut failing = covered(Gl, Tier::OtherHost, SpeedOutcome::Slower, Some(1.5));
+    failing.ratio = 15.0;
+    let mut below = covered(Gl, Tier::OtherHost, SpeedOutcome::Passed, Some(1.5));
+    below.ratio = 1.0;
+    let found = coverage(&[failing, below]);
+    assert_eq!(found[0].fails_beyond, Some([3.0, 3.0, 3.0]));
 }
 
 /// A timing bless's stamp at time "t", without a reason.
