@@ -213,6 +213,32 @@ fn blessed_elsewhere(
     Ok(None)
 }
 
+/// Says where this host (`backends`' fingerprints, `cpu`) is recorded already under another
+/// name than `name`: checks read a host against the first recording that matches it, so a
+/// second name for the same host would never be read.
+fn note_recorded_as_another(
+    root: &std::path::Path,
+    name: &str,
+    backends: &[(BackendKind, String)],
+    cpu: &str,
+) -> anyhow::Result<()> {
+    for (other, recording) in harness::golden::speed::recorded::load_all(root)? {
+        let same_host = other != name
+            && recording.cpu == cpu
+            && backends
+                .iter()
+                .all(|(kind, host)| recording.hosts.get(kind) == Some(host));
+        if same_host {
+            eprintln!(
+                "note: this host is recorded already, as {other} (golden/evidence/{other}/: the \
+                 same driver fingerprints and CPU); checks read it against that recording, not \
+                 a second one: `--record-host {other}` adds to it"
+            );
+        }
+    }
+    Ok(())
+}
+
 /// `harness noise --timing --json`: every measurement with its limit and score, and the errors.
 fn print_timing_json(
     scores: &[(harness::golden::speed::measure::TimingMeasurement, f64, f64)],
@@ -361,22 +387,7 @@ pub(super) fn record_host(
     }
     let scenes = kept;
     refuse_if_busy(busy_ok, false, "before measuring")?;
-    // Checks read a host against the first recording that matches it: a second name for the
-    // same host is never read.
-    for (other, recording) in recorded::load_all(store.root())? {
-        let same_host = other != name
-            && recording.cpu == cpu
-            && backends
-                .iter()
-                .all(|(kind, host)| recording.hosts.get(kind) == Some(host));
-        if same_host {
-            eprintln!(
-                "note: this host is recorded already, as {other} (golden/evidence/{other}/: the \
-                 same driver fingerprints and CPU); checks read it against that recording, not \
-                 a second one: `--record-host {other}` adds to it"
-            );
-        }
-    }
+    note_recorded_as_another(store.root(), name, &backends, &cpu)?;
     let path = recorded::RecordedTimings::path(store.root(), name);
     let earlier = recorded::RecordedTimings::load(&path)?;
     if let Some(earlier) = &earlier {
