@@ -388,6 +388,8 @@ pub(crate) struct Recorded {
     frame: FrameResources,
     passes: Vec<RenderPass>,
     owners: Vec<PassId>,
+    /// A [`SlowPass`]'s pass and its render passes without the injected copies.
+    unslowed: Option<(PassId, Vec<RenderPass>)>,
 }
 
 /// Creates the frame's resources in `scope` and records the passes of its plan in its order
@@ -406,14 +408,18 @@ fn record(
     }
     let passes::Recorded { passes, owners } = std::mem::take(&mut ctx.recorded);
     drop(ctx);
-    let (passes, owners) = match prepared.variations.slow_pass {
-        Some(slow) => recorded::slowed(plan, passes, owners, slow),
-        None => (passes, owners),
+    let (passes, owners, unslowed) = match prepared.variations.slow_pass {
+        Some(slow) => {
+            let (passes, owners, originals) = recorded::slowed(plan, passes, owners, slow);
+            (passes, owners, Some((slow.pass, originals)))
+        }
+        None => (passes, owners, None),
     };
     Ok(Recorded {
         frame,
         passes,
         owners,
+        unslowed,
     })
 }
 
@@ -430,6 +436,7 @@ fn record_and_submit(
         frame,
         mut passes,
         mut owners,
+        ..
     } = record(backend, prepared, scope)?;
     if wanted.cull {
         // The plan says which passes the wanted targets need. The recorded passes' attachments

@@ -29,11 +29,13 @@ impl RecordedFrame {
         let scene = prepared.scene().name.clone();
         let mut scope = ResourceScope::default();
         match record(backend, prepared, &mut scope) {
-            Ok(Recorded { passes, owners, .. }) => Ok(Self {
-                unslowed: prepared
-                    .variations
-                    .slow_pass
-                    .map(|slow| (slow.pass, originals(&passes, &owners, slow))),
+            Ok(Recorded {
+                passes,
+                owners,
+                unslowed,
+                ..
+            }) => Ok(Self {
+                unslowed,
                 scene,
                 scope,
                 passes,
@@ -94,18 +96,15 @@ impl RecordedFrame {
         self.unslowed.as_ref().map(|(pass, _)| *pass)
     }
 
-    /// Submits a [`SlowPass`]'s pass without its injected copies: the pass and its GPU ns (None
-    /// without a slowed pass or timestamps). Timed in the same rounds as the slowed pass, it
+    /// Submits a [`SlowPass`]'s pass ([`Self::slowed_pass`]) without its injected copies: its
+    /// GPU ns (None without a slowed pass or timestamps). Timed in the same rounds as the slowed pass, it
     /// says what slowdown the copies delivered in this process: a copy that finds its inputs
     /// still in the caches costs less than the pass did.
-    pub fn submit_unslowed(
-        &self,
-        backend: &mut dyn Backend,
-    ) -> Result<Option<(PassId, f64)>, RenderError> {
-        let Some((pass, originals)) = &self.unslowed else {
+    pub fn submit_unslowed(&self, backend: &mut dyn Backend) -> Result<Option<f64>, RenderError> {
+        let Some((_, originals)) = &self.unslowed else {
             return Ok(None);
         };
-        Ok(self.submit_timed(backend, originals)?.map(|ns| (*pass, ns)))
+        self.submit_timed(backend, originals)
     }
 
     /// Destroys the frame's resources.
@@ -129,28 +128,16 @@ pub(super) fn named(scene: &str, e: RenderError) -> RenderError {
     }
 }
 
-/// `slow`'s pass's render passes as recorded, without the copies [`slowed`] put right after
-/// each of them.
-fn originals(passes: &[RenderPass], owners: &[PassId], slow: SlowPass) -> Vec<RenderPass> {
-    let step = 1 + slow.extra_copies().len();
-    passes
-        .iter()
-        .zip(owners)
-        .filter(|(_, owner)| **owner == slow.pass)
-        .step_by(step)
-        .map(|(pass, _)| pass.clone())
-        .collect()
-}
-
 /// `passes` with `slow`'s extra copies of its pass's render passes right after each of them
 /// (see [`SlowPass`]): a fractional copy's viewports are centred boxes of that fraction of
-/// their area (a pass with none gets one in the target it writes first).
+/// their area (a pass with none gets one in the target it writes first). Also the slowed
+/// pass's render passes as they were, which the speed self-test times without the copies.
 pub(super) fn slowed(
     plan: &RenderPlan,
     passes: Vec<RenderPass>,
     owners: Vec<PassId>,
     slow: SlowPass,
-) -> (Vec<RenderPass>, Vec<PassId>) {
+) -> (Vec<RenderPass>, Vec<PassId>, Vec<RenderPass>) {
     let copies = slow.extra_copies();
     let target_size = plan
         .passes
@@ -160,8 +147,10 @@ pub(super) fn slowed(
         .map(|t| (t.width as f32, t.height as f32));
     let mut out = Vec::with_capacity(passes.len() + copies.len());
     let mut out_owners = Vec::with_capacity(out.capacity());
+    let mut originals = Vec::new();
     for (pass, owner) in passes.into_iter().zip(owners) {
         let extra: Vec<RenderPass> = if owner == slow.pass {
+            originals.push(pass.clone());
             copies
                 .iter()
                 .map(|&fraction| partial_copy(&pass, fraction, target_size))
@@ -176,7 +165,7 @@ pub(super) fn slowed(
             out_owners.push(owner);
         }
     }
-    (out, out_owners)
+    (out, out_owners, originals)
 }
 
 /// `pass` again, each viewport cut to a centred box of `fraction` of its area (the whole pass
@@ -250,8 +239,8 @@ mod tests {
     }
 
     /// A pass of several render passes (a point light's faces) slowed down: its copies follow
-    /// each face, and `originals` finds the faces again, for whole and fractional factors,
-    /// leaving the other passes out.
+    /// each face, and the faces as they were come back beside them, for whole and fractional
+    /// factors, without the other passes.
     #[test]
     fn the_originals_of_a_slowed_pass_are_its_render_passes_before_the_copies() {
         let plan = RenderPlan {
@@ -278,12 +267,8 @@ mod tests {
                 pass: PassId::Shadow { light: 0 },
                 factor,
             };
-            let (slowed_passes, slowed_owners) =
-                slowed(&plan, passes.clone(), owners.clone(), slow);
-            let names: Vec<String> = originals(&slowed_passes, &slowed_owners, slow)
-                .into_iter()
-                .map(|p| p.name)
-                .collect();
+            let (slowed_passes, _, originals) = slowed(&plan, passes.clone(), owners.clone(), slow);
+            let names: Vec<String> = originals.into_iter().map(|p| p.name).collect();
             assert_eq!(names, ["face 0", "face 1"], "x{factor}");
             let copies = slow.extra_copies().len();
             assert_eq!(slowed_passes.len(), 3 + 2 * copies, "x{factor}");

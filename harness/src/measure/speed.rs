@@ -463,7 +463,7 @@ fn sample(
             if recorded.slowed_pass() == Some(speed.pass)
                 && speed.unslowed_ms.len() < speed.pass_ms.len()
             {
-                if let Some((_, ns)) = recorded
+                if let Some(ns) = recorded
                     .submit_unslowed(backend)
                     .map_err(SampleError::Render)?
                 {
