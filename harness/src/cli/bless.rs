@@ -207,20 +207,6 @@ fn bless_speed(
         .iter()
         .map(|c| (c.name().to_owned(), c.argument()))
         .collect();
-    // The scenes whose timing goldens another host blessed (or none can be named): a timing
-    // bless of every pass moves them here.
-    let cpu = harness::golden::speed::cpu_signature();
-    let hosts: Vec<(BackendKind, String)> = backends
-        .iter()
-        .map(|(kind, driver)| (*kind, harness::golden::speed::host_fingerprint(driver)))
-        .collect();
-    let mut elsewhere = std::collections::BTreeSet::new();
-    for (scene, _) in &scenes {
-        let goldens = harness::golden::speed::TimingGoldens::load(store.root(), scene)?;
-        if goldens.blessed_elsewhere(&hosts, &cpu).is_some() {
-            elsewhere.insert(scene.clone());
-        }
-    }
     let lines = harness::golden::speed::bless_scenes(
         &std::env::current_exe()?,
         store.root(),
@@ -240,12 +226,10 @@ fn bless_speed(
     }
     let moved: std::collections::BTreeSet<&str> = lines
         .iter()
-        .filter(|l| {
-            l.fate == harness::golden::speed::bless::Fate::Rewritten && elsewhere.contains(&l.scene)
-        })
+        .filter(|l| l.moved_here && l.fate == harness::golden::speed::bless::Fate::Rewritten)
         .map(|l| l.scene.as_str())
         .collect();
-    if options.every_pass && !options.images && !moved.is_empty() {
+    if !moved.is_empty() {
         // The model's same-host figures are the previous blessing host's noise.
         println!(
             "note: {} timing goldens are this host's now, but golden/timing-noise.toml's \

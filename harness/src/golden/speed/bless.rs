@@ -58,6 +58,9 @@ pub struct SpeedBlessed {
     pub previous: String,
     /// What became of the golden.
     pub fate: Fate,
+    /// Whether the line's goldens were another host's (or named none) and are moving to this
+    /// host whole: the model's same-host figures for them are then that other host's noise.
+    pub moved_here: bool,
 }
 
 /// What a timing bless did, or in a dry run would do, with a golden.
@@ -176,6 +179,7 @@ pub fn bless_scenes(
                     pass: None,
                     previous: why,
                     fate: Fate::Kept,
+                    moved_here: false,
                 }),
                 None => {
                     // Moving another host's goldens here: every pass, the old section replaced.
@@ -236,6 +240,7 @@ pub fn bless_scenes(
                     pass: Some(check.pass),
                     previous: check.describe(),
                     fate: if written { fate } else { Fate::Kept },
+                    moved_here: *moving,
                 });
             }
             if !rewrite.is_empty() && !options.dry_run {

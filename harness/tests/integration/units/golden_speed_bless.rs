@@ -89,6 +89,7 @@ fn a_timing_bless_line_says_what_became_of_the_golden() {
             pass,
             previous: "x1.02 of golden".to_owned(),
             fate,
+            moved_here: false,
         }
         .to_string()
     };
