@@ -224,10 +224,9 @@ fn note_recorded_as_another(
 ) -> anyhow::Result<()> {
     for (other, recording) in harness::golden::speed::recorded::load_all(root)? {
         let same_host = other != name
-            && recording.cpu == cpu
             && backends
                 .iter()
-                .all(|(kind, host)| recording.hosts.get(kind) == Some(host));
+                .all(|(kind, host)| recording.records(*kind, host, cpu));
         if same_host {
             eprintln!(
                 "note: this host is recorded already, as {other} (golden/evidence/{other}/: the \

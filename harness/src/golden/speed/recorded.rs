@@ -132,6 +132,12 @@ pub struct RecordedTimings {
 }
 
 impl RecordedTimings {
+    /// Whether this is the recording of the host whose `kind` backend has fingerprint `host`,
+    /// on CPU signature `cpu` (a known one: see [`super::cpu_known`]).
+    pub fn records(&self, kind: BackendKind, host: &str, cpu: &str) -> bool {
+        super::cpu_known(cpu) && self.cpu == cpu && self.hosts.get(&kind).is_some_and(|h| h == host)
+    }
+
     /// The file of the host `name` under the golden root.
     pub fn path(root: &Path, name: &str) -> PathBuf {
         root.join("evidence").join(name).join(RECORDED_TIMING_FILE)

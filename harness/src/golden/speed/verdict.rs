@@ -189,11 +189,9 @@ pub fn check_speed_with(
     };
     let recording = (host_tier == Tier::OtherHost && !recordings.is_empty())
         .then(|| {
-            recordings.iter().find(|(_, r)| {
-                super::cpu_known(&cpu)
-                    && r.cpu == cpu
-                    && r.hosts.get(&probe.backend).is_some_and(|h| h == host)
-            })
+            recordings
+                .iter()
+                .find(|(_, r)| r.records(probe.backend, host, &cpu))
         })
         .flatten();
     let mut checks = Vec::new();
