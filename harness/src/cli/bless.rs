@@ -230,13 +230,14 @@ fn bless_speed(
         .map(|l| l.scene.as_str())
         .collect();
     if !moved.is_empty() {
-        // The model's same-host figures are the previous blessing host's noise.
+        // The model's same-host figures are the previous blessing host's noise, and a check
+        // here reads them at the limits for any host until they are measured here.
         println!(
             "note: {} timing goldens are this host's now, but golden/timing-noise.toml's \
              same-host figures for them were measured where they were blessed before: measure \
              this host's with `harness noise --timing --write --scene S` (without the second \
-             Mesa: `--source runs --source busy-neighbour --write --scene S`), or its checks \
-             read them at another machine's noise. The recordings in golden/evidence/ were \
+             Mesa: `--source runs --source busy-neighbour --write --scene S`); until then its \
+             checks read them at the limits for any host. The recordings in golden/evidence/ were \
              taken against the goldens replaced, and no longer apply to them",
             moved.into_iter().collect::<Vec<_>>().join(", ")
         );

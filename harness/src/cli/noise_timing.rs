@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use engine::backend::BackendKind;
 use harness::golden::noise::MAX_NOISE_RATIO;
+use harness::golden::speed::Tier;
 use harness::golden::GoldenStore;
 
 use super::load_cases;
@@ -149,11 +150,14 @@ pub(super) fn timing(
                 for (scene, figures) in old.scenes {
                     model.scenes.entry(scene).or_insert(figures);
                 }
+                model.measured_on = old.measured_on;
                 model
             }
             Err(e) if !only.is_empty() => return Err(e.into()),
             Err(_) => measured,
         };
+        let mut model = model;
+        stamp_this_host(&mut model, store.root(), &scenes, &hosts, &probed)?;
         model.save(store.root())?;
         eprintln!("wrote {}", TimingNoise::path(store.root()).display());
         model
@@ -175,6 +179,27 @@ pub(super) fn timing(
     } else {
         ExitCode::FAILURE
     })
+}
+
+/// Stamps the model's same-host figures of `scenes` on `hosts`' backends as this host's where
+/// `probed` measured them here (a same-host source among them) against goldens this host
+/// blessed: only there does a check read them as its own noise ([`Tier::SameHost`]).
+fn stamp_this_host(
+    model: &mut harness::golden::speed::TimingNoise,
+    root: &std::path::Path,
+    scenes: &[(String, String)],
+    hosts: &[(BackendKind, String)],
+    probed: &[harness::golden::speed::measure::TimingSource],
+) -> anyhow::Result<()> {
+    if !probed.iter().any(|s| s.tier == Tier::SameHost) {
+        return Ok(());
+    }
+    let cpu = harness::golden::speed::cpu_signature();
+    for (scene, _) in scenes {
+        let goldens = harness::golden::speed::TimingGoldens::load(root, scene)?;
+        model.stamp_where_blessed(scene, &goldens, hosts, &cpu);
+    }
+    Ok(())
 }
 
 /// Every available backend with this host's fingerprint for it (as the speed checks name it).
@@ -268,7 +293,6 @@ fn print_timing_table(
     model: &harness::golden::speed::TimingNoise,
     scores: &[(harness::golden::speed::measure::TimingMeasurement, f64, f64)],
 ) {
-    use harness::golden::speed::Tier;
     let too_noisy = scores
         .iter()
         .filter(|(_, _, s)| *s > MAX_NOISE_RATIO)

@@ -140,7 +140,8 @@ pub fn ibl_with_extracted_sun(dir: &std::path::Path, name: &str) -> std::path::P
 /// Makes this host the one that blessed `scene`'s timing goldens on `kind` in the workspace
 /// `root`: one probe here (`harness speed`, as a check probes), written as that backend's
 /// section with this host's fingerprint and CPU signature, each pass's ratio times `scale`
-/// (its pass) or `others` (every other pass). A test that accepts a timing golden needs its
+/// (its pass) or `others` (every other pass), and the timing-noise model's same-host figures
+/// for them stamped as measured here. A test that accepts a timing golden needs its
 /// check to run on the blessing host (another host's accept is refused), and ratios measured
 /// here, so that the passes it leaves alone are not judged against another CPU's.
 pub fn bless_timings_here(
@@ -189,4 +190,9 @@ pub fn bless_timings_here(
     };
     goldens.record(&probe, &[], &stamp);
     goldens.save(&golden, scene).unwrap();
+    // The model's same-host figures count as this host's, as after `noise --timing --write`
+    // here (the committed figures, not measured again).
+    let mut model = harness::golden::speed::TimingNoise::load(&golden).unwrap();
+    model.stamp_where_blessed(scene, &goldens, &[(kind, host)], &cpu);
+    model.save(&golden).unwrap();
 }

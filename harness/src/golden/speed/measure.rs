@@ -283,6 +283,9 @@ pub fn model_from(
 /// recorded, without probing the others.
 pub fn merged(mut model: TimingNoise, measured: TimingNoise) -> TimingNoise {
     model.sources.extend(measured.sources);
+    for (scene, backends) in measured.measured_on {
+        model.measured_on.entry(scene).or_default().extend(backends);
+    }
     for (scene, backends) in measured.scenes {
         for (backend, passes) in backends {
             for (pass, new) in passes {

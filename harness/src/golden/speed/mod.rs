@@ -17,7 +17,9 @@
 //! [`MIN_NOISE_SHORT`] for a pass under [`SHORT_PASS_MS`]). A check is
 //! scored as `ln(ratio / golden) / ln(limit)`: 1 at the limit, and unchanged runs under every
 //! measured source at 1/margin or less. On a host whose driver fingerprint or CPU differs from
-//! the one that blessed (every host, for goldens that keep no CPU signature), the other-host
+//! the one that blessed (every host, for goldens that keep no CPU signature), or where the
+//! model's same-host figures were measured on another host (goldens moved with `bless
+//! --speed-only --every-pass`, until `noise --timing --write` runs there), the other-host
 //! figures count too (the CPU code paths, the second Mesa, and the
 //! hosts recorded in `golden/evidence/`, [`recorded`]), and a pass whose limit there would not
 //! catch a doubling is reported as untimed on that host, with the reason. A host that is itself
@@ -44,7 +46,7 @@ pub use bless::{
     bless_scenes, kept_as_another_hosts, median_probe, Fate, SpeedBlessed, TimingBless,
 };
 pub use goldens::{BackendTimings, PassTiming, Stamp, TimingGoldens, TIMING_FILE};
-pub use model::{PassNoise, Tier, TimingNoise, TIMING_NOISE_FILE};
+pub use model::{MeasuredOn, PassNoise, Tier, TimingNoise, TIMING_NOISE_FILE};
 pub use verdict::{
     check_speed, check_speed_with, coverage, SpeedCheck, SpeedCoverage, SpeedOutcome,
 };
@@ -383,6 +385,10 @@ pub fn check_scenes(
                 }
             }
         }
+        // Goldens blessed here, read at the limits for any host: say why and what to run.
+        if let Some(note) = unmeasured_here(&goldens, &noise, &probe.scene, kind, &host) {
+            run.host_notes.push(note);
+        }
         // Read at the limits for any host: say what keeps a recording of this CPU from applying.
         if checks.iter().any(|c| c.tier == Tier::OtherHost) {
             if let Some(note) = near_recordings(&recordings, kind, &host, &cpu_signature()) {
@@ -394,6 +400,29 @@ pub fn check_scenes(
         run.checks.extend(checks);
     }
     run
+}
+
+/// Where `scene`'s timing goldens on `kind` were blessed on this host (`host`) but the model's
+/// same-host figures for them were not measured here (moved with `bless --speed-only
+/// --every-pass`): a note saying the check read them at the limits for any host, and how to
+/// measure this host's noise.
+pub fn unmeasured_here(
+    goldens: &TimingGoldens,
+    noise: &TimingNoise,
+    scene: &str,
+    kind: BackendKind,
+    host: &str,
+) -> Option<String> {
+    let cpu = cpu_signature();
+    let blessed_here = goldens
+        .backends
+        .get(&kind)
+        .is_some_and(|g| g.blessed_on(host, &cpu));
+    (blessed_here && !noise.measured_on_host(scene, kind, host, &cpu)).then(|| {
+        format!(
+            "{scene}'s timing goldens on {kind} were blessed on this host, but              golden/timing-noise.toml's same-host figures for them were measured on another              (or before the model kept where): they were read at the limits for any host.              Measure this host's with `harness noise --timing --write --scene {scene}`              (without the second Mesa: `--source runs --source busy-neighbour`)"
+        )
+    })
 }
 
 /// Appends a check's ratios to the speed history in `out` ([`history`]).

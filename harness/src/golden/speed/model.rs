@@ -19,7 +19,8 @@ const HEADER: &str = "\
 # under another host's (`drivers`: llvmpipe's other CPU code paths, the second Mesa, and the
 # hosts recorded in golden/evidence/), with where each was measured. A check's limit is
 # max(noise, min_noise) ^ margin (on the log scale, margin x the noise); on a host that did not
-# bless, the `drivers` figure counts too.
+# bless, the `drivers` figure counts too. `measured_on`: per scene and backend, the host whose
+# probes gave the `host` figures; only a check there reads them as its own noise.
 # See harness/src/golden/speed/mod.rs.
 ";
 
@@ -74,9 +75,25 @@ pub struct TimingNoise {
     /// What each source is (name: description).
     #[serde(default)]
     pub sources: BTreeMap<String, String>,
+    /// Per scene and backend, the host whose sources gave the same-host figures (`host`), as
+    /// `noise --timing --write` found it. Only there are they that host's own noise: a check
+    /// reads them in [`Tier::SameHost`] only on this host, so goldens moved to another host
+    /// (`bless --speed-only --every-pass`) are read at the limits for any host until the
+    /// model is measured there too.
+    #[serde(default)]
+    pub measured_on: BTreeMap<String, BTreeMap<BackendKind, MeasuredOn>>,
     /// Per scene, backend and pass.
     #[serde(default)]
     pub scenes: BTreeMap<String, BTreeMap<BackendKind, BTreeMap<PassId, PassNoise>>>,
+}
+
+/// The host a scene's same-host figures on one backend were measured on.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct MeasuredOn {
+    /// The host's fingerprint for the backend ([`super::host_fingerprint`]).
+    pub host: String,
+    /// Its CPU signature ([`super::cpu_signature`]).
+    pub cpu: String,
 }
 
 impl Default for TimingNoise {
@@ -86,6 +103,7 @@ impl Default for TimingNoise {
             min_noise: MIN_NOISE,
             regenerate: REGENERATE.to_owned(),
             sources: BTreeMap::new(),
+            measured_on: BTreeMap::new(),
             scenes: BTreeMap::new(),
         }
     }
@@ -123,6 +141,56 @@ impl TimingNoise {
     /// Writes the model atomically.
     pub fn save(&self, root: &Path) -> Result<(), SpeedError> {
         super::write_toml(&Self::path(root), HEADER, self)
+    }
+
+    /// Whether `scene`'s same-host figures on `backend` were measured on this host (`host`,
+    /// `cpu`): a model that names no host for them (written before hosts were kept), or
+    /// another, or a CPU it could not read, gives no host its same-host tier.
+    pub fn measured_on_host(
+        &self,
+        scene: &str,
+        backend: BackendKind,
+        host: &str,
+        cpu: &str,
+    ) -> bool {
+        self.measured_on
+            .get(scene)
+            .and_then(|b| b.get(&backend))
+            .is_some_and(|m| m.host == host && super::cpu_known(&m.cpu) && m.cpu == cpu)
+    }
+
+    /// Stamps `scene`'s same-host figures as measured on this host (`hosts`: each backend
+    /// with this host's fingerprint for it; `cpu`) on every backend whose timing goldens this
+    /// host blessed ([`super::BackendTimings::blessed_on`]), what `noise --timing --write`
+    /// does after probing this host's sources. Returns the backends stamped.
+    pub fn stamp_where_blessed(
+        &mut self,
+        scene: &str,
+        goldens: &super::TimingGoldens,
+        hosts: &[(BackendKind, String)],
+        cpu: &str,
+    ) -> Vec<BackendKind> {
+        let mut stamped = Vec::new();
+        for (kind, host) in hosts {
+            if goldens
+                .backends
+                .get(kind)
+                .is_some_and(|g| g.blessed_on(host, cpu))
+            {
+                self.measured_on
+                    .entry(scene.to_owned())
+                    .or_default()
+                    .insert(
+                        *kind,
+                        MeasuredOn {
+                            host: host.clone(),
+                            cpu: cpu.to_owned(),
+                        },
+                    );
+                stamped.push(*kind);
+            }
+        }
+        stamped
     }
 
     /// The figures of one pass: its own, or where the scene has none (a scene outside the

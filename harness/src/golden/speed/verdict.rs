@@ -159,7 +159,8 @@ impl SpeedCheck {
 /// The speed checks of one probe: each pass's ratio against its golden under the limit of
 /// the tier's figures. The goldens' host for this backend equal to `host`, on this CPU, is the
 /// same host ([`BackendTimings::blessed_on`](super::BackendTimings::blessed_on): goldens that
-/// keep no CPU signature name none); any other is another host.
+/// keep no CPU signature name none) where the model's same-host figures were measured there too
+/// ([`TimingNoise::measured_on_host`]); any other is another host.
 pub fn check_speed(
     probe: &SceneSpeed,
     goldens: &TimingGoldens,
@@ -183,8 +184,14 @@ pub fn check_speed_with(
 ) -> Vec<SpeedCheck> {
     let golden_backend = goldens.backends.get(&probe.backend);
     let cpu = super::cpu_signature();
+    // The same-host figures are the blessing host's noise only where it measured them.
     let host_tier = match golden_backend {
-        Some(g) if g.blessed_on(host, &cpu) => Tier::SameHost,
+        Some(g)
+            if g.blessed_on(host, &cpu)
+                && noise.measured_on_host(&probe.scene, probe.backend, host, &cpu) =>
+        {
+            Tier::SameHost
+        }
         _ => Tier::OtherHost,
     };
     let recording = (host_tier == Tier::OtherHost && !recordings.is_empty())

@@ -44,7 +44,17 @@ fn limits_are_noise_to_the_margin_and_another_host_counts_the_drivers() {
     assert!(model
         .figures("a", BackendKind::WgpuGl, PassId::ToneMap)
         .is_none());
+    // Where the same-host figures were measured survives the file, and a merge keeps it.
+    model.measured_on.entry("a".to_owned()).or_default().insert(
+        BackendKind::Gl,
+        MeasuredOn {
+            host: "gl on here".to_owned(),
+            cpu: "family 26 model 2 stepping 1".to_owned(),
+        },
+    );
     let dir = tempfile::tempdir().unwrap();
     model.save(dir.path()).unwrap();
     assert_eq!(TimingNoise::load(dir.path()).unwrap(), model);
+    let merged = harness::golden::speed::measure::merged(TimingNoise::default(), model.clone());
+    assert_eq!(merged.measured_on, model.measured_on);
 }

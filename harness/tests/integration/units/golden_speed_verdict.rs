@@ -33,8 +33,21 @@ fn probe(tonemap_ms: f64, geometry_ms: f64) -> SceneSpeed {
     }
 }
 
+/// The model, its same-host figures measured on host "here" (this CPU).
 fn model() -> TimingNoise {
+    model_measured_on("here")
+}
+
+/// The model, its same-host figures measured on `host` (this CPU).
+fn model_measured_on(host: &str) -> TimingNoise {
     let mut model = TimingNoise::default();
+    let mut goldens = TimingGoldens::default();
+    goldens.record(&probe(3.0, 4.0), &[], &stamp(host, &cpu_signature()));
+    let hosts = [(BackendKind::Gl, host.to_owned())];
+    assert_eq!(
+        model.stamp_where_blessed("s", &goldens, &hosts, &cpu_signature()),
+        [BackendKind::Gl]
+    );
     let figures = |host: f64, drivers: f64| PassNoise {
         host,
         host_at: "busy".to_owned(),
@@ -184,7 +197,7 @@ fn a_recorded_host_is_checked_against_its_own_recording_while_it_is_current() {
     );
     assert!(other_cpu.iter().all(|c| c.tier == Tier::OtherHost));
     let recordings = [("host-c".to_owned(), recording)];
-    let noise = model();
+    let noise = model_measured_on("there");
     let check = |tonemap_ms: f64, host: &str, pass: PassId| {
         check_speed_with(&probe(tonemap_ms, 4.0), &goldens, &noise, host, &recordings)
             .into_iter()
@@ -245,6 +258,66 @@ fn the_blessing_host_is_its_fingerprint_and_its_cpu() {
     assert_eq!(tier("family 0 model 0 stepping 0"), Tier::OtherHost);
     // Goldens that kept no signature: no host can show it blessed them.
     assert_eq!(tier(""), Tier::OtherHost);
+}
+
+/// Goldens moved to this host (blessed here) are read at the limits for any host until the
+/// model's same-host figures are measured here too: figures measured where the goldens were
+/// blessed before are that host's noise, not this one's. The check's note says so and names
+/// the command; a model stamped here, on this CPU, gives the same-host tier.
+#[test]
+fn same_host_figures_count_only_on_the_host_that_measured_them() {
+    let mut goldens = TimingGoldens::default();
+    goldens.record(&probe(3.0, 4.0), &[], &stamp("here", &cpu_signature()));
+    let tier = |noise: &TimingNoise| check_speed(&probe(3.0, 4.0), &goldens, noise, "here")[0].tier;
+    assert_eq!(tier(&model()), Tier::SameHost);
+    let before = model_measured_on("the previous blessing host");
+    assert_eq!(tier(&before), Tier::OtherHost);
+    let mut unstamped = model();
+    unstamped.measured_on.clear();
+    assert_eq!(tier(&unstamped), Tier::OtherHost);
+    // The same fingerprint, measured on a CPU it could not read or on another.
+    for cpu in ["", "family 0 model 0 stepping 0"] {
+        let mut elsewhere = model();
+        elsewhere
+            .measured_on
+            .get_mut("s")
+            .unwrap()
+            .get_mut(&BackendKind::Gl)
+            .unwrap()
+            .cpu = cpu.to_owned();
+        assert_eq!(tier(&elsewhere), Tier::OtherHost, "{cpu:?}");
+    }
+    let note =
+        harness::golden::speed::unmeasured_here(&goldens, &before, "s", BackendKind::Gl, "here")
+            .expect("a note for goldens blessed here with figures from elsewhere");
+    assert!(
+        note.contains("s's timing goldens on gl were blessed on this host")
+            && note.contains("read at the limits for any host")
+            && note.contains("harness noise --timing --write --scene s"),
+        "{note}"
+    );
+    assert_eq!(
+        harness::golden::speed::unmeasured_here(&goldens, &model(), "s", BackendKind::Gl, "here"),
+        None
+    );
+    // Goldens blessed elsewhere: the other-host tier by its own reason, and no such note.
+    assert_eq!(
+        harness::golden::speed::unmeasured_here(&goldens, &before, "s", BackendKind::Gl, "there"),
+        None
+    );
+    // Only backends whose goldens this host blessed are stamped.
+    let mut stamped = TimingNoise::default();
+    let hosts = [
+        (BackendKind::Gl, "here".to_owned()),
+        (BackendKind::WgpuVulkan, "here".to_owned()),
+    ];
+    assert_eq!(
+        stamped.stamp_where_blessed("s", &goldens, &hosts, &cpu_signature()),
+        [BackendKind::Gl]
+    );
+    assert!(stamped.measured_on_host("s", BackendKind::Gl, "here", &cpu_signature()));
+    assert!(!stamped.measured_on_host("s", BackendKind::WgpuVulkan, "here", &cpu_signature()));
+    assert!(!stamped.measured_on_host("t", BackendKind::Gl, "here", &cpu_signature()));
 }
 
 fn covered(
