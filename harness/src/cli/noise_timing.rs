@@ -172,7 +172,7 @@ pub(super) fn timing(
     if json {
         print_timing_json(&scores, &errors)?;
     } else {
-        print_timing_table(&model, &scores);
+        print_timing_table(&model, &wanted, &scores);
     }
     Ok(if too_noisy == 0 && errors.is_empty() {
         ExitCode::SUCCESS
@@ -287,10 +287,11 @@ fn print_timing_json(
     Ok(())
 }
 
-/// `harness noise --timing`'s table: each pass's figures per tier with its limits here and
-/// elsewhere, and the worst measurement against its limit.
+/// `harness noise --timing`'s table: each pass of the `wanted` scenes with its figures per tier
+/// and its limits here and elsewhere, and the worst measurement against its limit.
 fn print_timing_table(
     model: &harness::golden::speed::TimingNoise,
+    wanted: &[&str],
     scores: &[(harness::golden::speed::measure::TimingMeasurement, f64, f64)],
 ) {
     let too_noisy = scores
@@ -301,7 +302,11 @@ fn print_timing_table(
         "{:<8} {:<12} {:<22} {:>20} {:>20} {:>10} {:>10}",
         "scene", "backend", "pass", "host noise", "driver noise", "limit", "elsewhere"
     );
-    for (scene, backends) in &model.scenes {
+    let named = model
+        .scenes
+        .iter()
+        .filter(|(scene, _)| wanted.contains(&scene.as_str()));
+    for (scene, backends) in named {
         for (backend, passes) in backends {
             for (pass, noise) in passes {
                 let here = model.limit(noise.noise(Tier::SameHost).0);

@@ -167,3 +167,24 @@ fn timing_noise_is_written_only_on_the_host_that_blessed() {
     );
     assert_eq!(std::fs::read(&model).unwrap(), before);
 }
+
+/// `noise --timing --scene S` prints the model's rows of that scene only (it printed every
+/// scene's), here from a recorded host's figures alone, which it reads without probing.
+#[test]
+fn timing_noise_of_one_scene_prints_that_scene_only() {
+    let output = common::harness_command()
+        .args([
+            "noise", "--timing", "--source", "host-c", "--scene", "arrow",
+        ])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}{output:?}");
+    let rows: Vec<&str> = stdout
+        .lines()
+        .skip(1)
+        .take_while(|l| !l.contains(" measurements, "))
+        .collect();
+    assert!(rows.len() >= 6, "{stdout}");
+    assert!(rows.iter().all(|r| r.starts_with("arrow ")), "{stdout}");
+}
