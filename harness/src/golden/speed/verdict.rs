@@ -321,6 +321,8 @@ pub struct SpeedCoverage {
     /// run below their goldens (on a host that did not bless, ratios lie x0.4 to x1.75 from
     /// the blessing host's) a limit of x1.6 can mean x3.5 from here.
     pub fails_beyond: Option<[f64; 3]>,
+    /// At [`Tier::RecordedHost`], the recording the limits come from (`host-d's recording`).
+    pub recording: Option<String>,
 }
 
 impl SpeedCoverage {
@@ -328,9 +330,12 @@ impl SpeedCoverage {
     /// each fails), and how many were untimed.
     pub fn describe(&self) -> String {
         let how = match self.tier {
-            Tier::SameHost => "on the host that blessed",
-            Tier::RecordedHost => "against this host's recording",
-            Tier::OtherHost => "on a host that did not bless",
+            Tier::SameHost => "on the host that blessed".to_owned(),
+            Tier::RecordedHost => format!(
+                "against {}",
+                self.recording.as_deref().unwrap_or("this host's recording")
+            ),
+            Tier::OtherHost => "on a host that did not bless".to_owned(),
         };
         let limits = match self.limits {
             Some([low, _, high]) if format!("{low:.2}") == format!("{high:.2}") => {
@@ -388,6 +393,7 @@ pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
         limits: Vec<f64>,
         untimed: usize,
         fails_beyond: Vec<f64>,
+        recording: Option<String>,
     }
     let mut groups: Vec<Group> = Vec::new();
     for c in checks {
@@ -403,11 +409,15 @@ pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
                     limits: Vec::new(),
                     untimed: 0,
                     fails_beyond: Vec::new(),
+                    recording: None,
                 });
                 groups.len() - 1
             }
         };
         let group = &mut groups[index];
+        if c.tier == Tier::RecordedHost && group.recording.is_none() {
+            group.recording = c.noise.as_ref().map(|(_, at)| at.clone());
+        }
         match (&c.outcome, c.limit) {
             (SpeedOutcome::Untimed(_), _) => group.untimed += 1,
             (SpeedOutcome::MissingGolden | SpeedOutcome::TargetsChanged(_), _) | (_, None) => {}
@@ -433,6 +443,7 @@ pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
             untimed: g.untimed,
             limits: spread(g.limits),
             fails_beyond: spread(g.fails_beyond),
+            recording: g.recording,
         })
         .collect()
 }

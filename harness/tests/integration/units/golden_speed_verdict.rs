@@ -374,6 +374,13 @@ fn coverage_counts_the_timed_and_untimed_passes_per_backend_and_tier() {
         "3 passes timed on the host that blessed, limits x1.44 to x1.80 (median x1.60); \
          1 untimed"
     );
+    // A recording's limits are named by the recording.
+    let mut recorded = covered(Gl, Tier::RecordedHost, SpeedOutcome::Passed, Some(1.69));
+    recorded.noise = Some((1.3, "host-d's recording".to_owned()));
+    assert_eq!(
+        coverage(&[recorded])[0].describe(),
+        "1 passes timed against host-d's recording, limits x1.69; 0 untimed"
+    );
     let none_timed = coverage(&[covered(Gl, Tier::OtherHost, untimed(), None)]);
     assert_eq!(
         none_timed[0].describe(),
