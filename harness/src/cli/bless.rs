@@ -232,14 +232,17 @@ fn bless_speed(
     if !moved.is_empty() {
         // The model's same-host figures are the previous blessing host's noise, and a check
         // here reads them at the limits for any host until they are measured here.
+        let names: Vec<&str> = moved.into_iter().collect();
+        let scenes: String = names.iter().map(|n| format!(" --scene {n}")).collect();
         println!(
             "note: {} timing goldens are this host's now, but golden/timing-noise.toml's \
-             same-host figures for them were measured where they were blessed before: measure \
-             this host's with `harness noise --timing --write --scene S` (without the second \
-             Mesa: `--source runs --source busy-neighbour --write --scene S`); until then its \
-             checks read them at the limits for any host. The recordings in golden/evidence/ were \
-             taken against the goldens replaced, and no longer apply to them",
-            moved.into_iter().collect::<Vec<_>>().join(", ")
+             same-host figures for them were measured on another host (or before the model \
+             kept where), so until this host's are measured its checks read them at the limits \
+             for any host. Measure them: `harness noise --timing --write{scenes}` (without the \
+             second Mesa: `harness noise --timing --write{scenes} --source runs --source \
+             busy-neighbour`). The recordings in golden/evidence/ were taken against the \
+             goldens replaced, and no longer apply to them",
+            names.join(", ")
         );
     }
     Ok(lines

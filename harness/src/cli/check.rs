@@ -472,7 +472,7 @@ fn print_load_warnings_of(run: &CheckRun, scene: &str) {
 /// The speed section of the table: a line per scene, pass and backend (the value against the
 /// limit, or why it is untimed), the probes that failed, and the passes that got faster.
 fn print_speed(run: &CheckRun) {
-    use harness::golden::speed::{SpeedOutcome, Tier};
+    use harness::golden::speed::SpeedOutcome;
     if run.speed.checks.is_empty() && run.speed.errors.is_empty() {
         return;
     }
@@ -504,9 +504,7 @@ fn print_speed(run: &CheckRun) {
         run.speed
             .checks
             .iter()
-            .filter(|c| {
-                c.outcome == SpeedOutcome::Faster && (c.tier == Tier::SameHost) == same_host
-            })
+            .filter(|c| c.outcome == SpeedOutcome::Faster && c.tier.blessed_here() == same_host)
             .map(|c| format!("{}/{} on {}", c.scene, c.pass, c.backend))
             .collect()
     };

@@ -143,7 +143,10 @@ pub(super) fn timing(
         refuse_if_busy(writing.busy_ok, false, "after the probes, nothing written")?;
         let measured = measure::model_from(&measurements, &sources, margin);
         let model = match TimingNoise::load(store.root()) {
-            Ok(old) if !only.is_empty() => measure::merged(old, measured),
+            Ok(old) if !only.is_empty() => {
+                let moved = moved_here(&old, store.root(), &scenes, &hosts, &probed)?;
+                measure::merged_replacing(old, measured, &moved)
+            }
             // Scenes not measured in this run keep their figures.
             Ok(old) => {
                 let mut model = measured;
@@ -200,6 +203,36 @@ fn stamp_this_host(
         model.stamp_where_blessed(scene, &goldens, hosts, &cpu);
     }
     Ok(())
+}
+
+/// The scenes and backends whose same-host figures `probed` measures here (a same-host source
+/// among them, goldens this host blessed) where `model` has them from another host: replaced by
+/// this host's, not merged with them.
+fn moved_here(
+    model: &harness::golden::speed::TimingNoise,
+    root: &std::path::Path,
+    scenes: &[(String, String)],
+    hosts: &[(BackendKind, String)],
+    probed: &[harness::golden::speed::measure::TimingSource],
+) -> anyhow::Result<Vec<(String, BackendKind)>> {
+    let mut moved = Vec::new();
+    if !probed.iter().any(|s| s.tier == Tier::SameHost) {
+        return Ok(moved);
+    }
+    let cpu = harness::golden::speed::cpu_signature();
+    for (scene, _) in scenes {
+        let goldens = harness::golden::speed::TimingGoldens::load(root, scene)?;
+        for (kind, host) in hosts {
+            let blessed_here = goldens
+                .backends
+                .get(kind)
+                .is_some_and(|g| g.blessed_on(host, &cpu));
+            if blessed_here && !model.measured_on_host(scene, *kind, host, &cpu) {
+                moved.push((scene.clone(), *kind));
+            }
+        }
+    }
+    Ok(moved)
 }
 
 /// Every available backend with this host's fingerprint for it (as the speed checks name it).

@@ -412,7 +412,7 @@ pub fn accept_timings(
         };
         // Judged on the blessing host by the check (the CPU it ran on), and still that host's
         // section now (not re-blessed elsewhere since).
-        let blessed_here = c.tier == crate::golden::speed::Tier::SameHost
+        let blessed_here = c.tier.blessed_here()
             && check
                 .hosts
                 .get(&c.backend)

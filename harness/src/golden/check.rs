@@ -146,7 +146,7 @@ impl CheckRun {
         }
         for c in self.speed.checks.iter().filter(|c| c.failed()) {
             let argument = self.scene_argument(&c.scene);
-            let same_host = c.tier == crate::golden::speed::Tier::SameHost;
+            let same_host = c.tier.blessed_here();
             let command = crate::golden::command_line::speed_bless_command(argument, same_host);
             if !commands.contains(&command) && !commands.contains(&bless_command(argument)) {
                 commands.push(command);

@@ -134,11 +134,7 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
     }
     // A timing bless writes on the host that blessed the goldens only; elsewhere the command
     // that moves them here is the one to offer.
-    let elsewhere = run
-        .speed
-        .checks
-        .iter()
-        .any(|c| c.tier != crate::golden::speed::Tier::SameHost);
+    let elsewhere = run.speed.checks.iter().any(|c| !c.tier.blessed_here());
     let bless = if elsewhere {
         "this host did not bless the timing goldens: if intended, <code>harness bless --scene \
          S --speed-only --every-pass</code> moves them here, every pass (or bless with \

@@ -188,3 +188,60 @@ fn timing_noise_of_one_scene_prints_that_scene_only() {
     assert!(rows.len() >= 6, "{stdout}");
     assert!(rows.iter().all(|r| r.starts_with("arrow ")), "{stdout}");
 }
+
+/// Timing goldens blessed on this host, with the model's same-host figures from another (as
+/// after `bless --speed-only --every-pass`): `check` reads them at the limits for any host as
+/// `moved-here`, says so once with the command that measures this host, and does not take the
+/// host for one to record.
+#[test]
+fn goldens_moved_here_are_read_at_any_hosts_limits_until_measured_here() {
+    use engine::backend::BackendKind;
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    common::bless_timings_here(root.path(), "arrow", BackendKind::Gl, &[], 1.0);
+    // The fixture stamps the model as measured here; the previous host measured it instead.
+    let golden = root.path().join("golden");
+    let mut model = harness::golden::speed::TimingNoise::load(&golden).unwrap();
+    model.measured_on.clear();
+    model.save(&golden).unwrap();
+    let summary = root.path().join("summary.md");
+    let output = common::harness_command()
+        .args([
+            "check",
+            "--scene",
+            "arrow",
+            "--backend",
+            "gl",
+            "--json",
+            "--summary",
+        ])
+        .arg(&summary)
+        .arg("--out")
+        .arg(root.path().join("out"))
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let run: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let checks = run["speed"]["checks"].as_array().unwrap();
+    assert!(!checks.is_empty());
+    assert!(
+        checks.iter().all(|c| c["tier"] == "moved-here"),
+        "{checks:?}"
+    );
+    let notes = run["speed"]["host_notes"].as_array().unwrap();
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    let note = notes[0].as_str().unwrap();
+    assert!(
+        note.contains("arrow's timing goldens on gl were blessed on this host")
+            && note.contains("`harness noise --timing --write --scene arrow`"),
+        "{note}"
+    );
+    let summary = std::fs::read_to_string(&summary).unwrap();
+    assert!(
+        summary.contains("on the host that blessed, at the limits for any host")
+            && !summary.contains("neither the one that blessed"),
+        "{summary}"
+    );
+}

@@ -267,7 +267,9 @@ pub fn model_from(
             });
         let (value, at) = match m.tier {
             Tier::SameHost => (&mut entry.host, &mut entry.host_at),
-            Tier::OtherHost | Tier::RecordedHost => (&mut entry.drivers, &mut entry.drivers_at),
+            Tier::OtherHost | Tier::RecordedHost | Tier::MovedHere => {
+                (&mut entry.drivers, &mut entry.drivers_at)
+            }
         };
         if m.factor > *value {
             *value = ceil4(m.factor);
@@ -309,6 +311,31 @@ pub fn merged(mut model: TimingNoise, measured: TimingNoise) -> TimingNoise {
         }
     }
     model
+}
+
+/// As [`merged`], except that the same-host figures of `moved` (scenes and backends whose
+/// figures in `model` were measured on another host: goldens moved here) are replaced by
+/// `measured`'s instead of raised: the other host's noise is not this one's.
+pub fn merged_replacing(
+    mut model: TimingNoise,
+    measured: TimingNoise,
+    moved: &[(String, BackendKind)],
+) -> TimingNoise {
+    for (scene, kind) in moved {
+        let (Some(new), Some(old)) = (
+            measured.scenes.get(scene).and_then(|b| b.get(kind)),
+            model.scenes.get_mut(scene).and_then(|b| b.get_mut(kind)),
+        ) else {
+            continue;
+        };
+        for (pass, figures) in new {
+            if let Some(old) = old.get_mut(pass) {
+                old.host = figures.host;
+                old.host_at = figures.host_at.clone();
+            }
+        }
+    }
+    merged(model, measured)
 }
 
 /// `x` rounded up to 4 decimals (the file stays readable, and no measurement lies above its

@@ -385,10 +385,6 @@ pub fn check_scenes(
                 }
             }
         }
-        // Goldens blessed here, read at the limits for any host: say why and what to run.
-        if let Some(note) = unmeasured_here(&goldens, &noise, &probe.scene, kind, &host) {
-            run.host_notes.push(note);
-        }
         // Read at the limits for any host: say what keeps a recording of this CPU from applying.
         if checks.iter().any(|c| c.tier == Tier::OtherHost) {
             if let Some(note) = near_recordings(&recordings, kind, &host, &cpu_signature()) {
@@ -399,30 +395,36 @@ pub fn check_scenes(
         }
         run.checks.extend(checks);
     }
+    run.host_notes.extend(moved_here_notes(&run.checks));
     run
 }
 
-/// Where `scene`'s timing goldens on `kind` were blessed on this host (`host`) but the model's
-/// same-host figures for them were not measured here (moved with `bless --speed-only
-/// --every-pass`): a note saying the check read them at the limits for any host, and how to
-/// measure this host's noise.
-pub fn unmeasured_here(
-    goldens: &TimingGoldens,
-    noise: &TimingNoise,
-    scene: &str,
-    kind: BackendKind,
-    host: &str,
-) -> Option<String> {
-    let cpu = cpu_signature();
-    let blessed_here = goldens
-        .backends
-        .get(&kind)
-        .is_some_and(|g| g.blessed_on(host, &cpu));
-    (blessed_here && !noise.measured_on_host(scene, kind, host, &cpu)).then(|| {
-        format!(
-            "{scene}'s timing goldens on {kind} were blessed on this host, but              golden/timing-noise.toml's same-host figures for them were measured on another              (or before the model kept where): they were read at the limits for any host.              Measure this host's with `harness noise --timing --write --scene {scene}`              (without the second Mesa: `--source runs --source busy-neighbour`)"
-        )
-    })
+/// Per scene with checks at [`Tier::MovedHere`] (timing goldens blessed on this host, the
+/// model's same-host figures for them measured on another): a note saying they were read at
+/// the limits for any host, on which backends, and the command that measures this host's noise.
+pub fn moved_here_notes(checks: &[SpeedCheck]) -> Vec<String> {
+    let mut scenes: Vec<(&str, Vec<BackendKind>)> = Vec::new();
+    for c in checks.iter().filter(|c| c.tier == Tier::MovedHere) {
+        match scenes.iter_mut().find(|(scene, _)| *scene == c.scene) {
+            Some((_, kinds)) if kinds.contains(&c.backend) => {}
+            Some((_, kinds)) => kinds.push(c.backend),
+            None => scenes.push((&c.scene, vec![c.backend])),
+        }
+    }
+    scenes
+        .into_iter()
+        .map(|(scene, kinds)| {
+            format!(
+                "{scene}'s timing goldens on {} were blessed on this host, but \
+                 golden/timing-noise.toml's same-host figures for them were measured on another \
+                 host (or before the model kept where), so they were read at the limits for any \
+                 host. Measure this host's: `harness noise --timing --write --scene {scene}` \
+                 (without the second Mesa: `harness noise --timing --write --scene {scene} \
+                 --source runs --source busy-neighbour`)",
+                crate::names(&kinds)
+            )
+        })
+        .collect()
 }
 
 /// Appends a check's ratios to the speed history in `out` ([`history`]).

@@ -35,6 +35,18 @@ pub enum Tier {
     /// A host recorded in golden/evidence/ (same fingerprint): checked against its own
     /// recorded ratios and their spread ([`super::recorded`]).
     RecordedHost,
+    /// The host that blessed, where the model's same-host figures were measured on another
+    /// (goldens moved here with `bless --speed-only --every-pass`): its goldens, at the limits
+    /// for any host, until `noise --timing --write` measures this host's noise.
+    MovedHere,
+}
+
+impl Tier {
+    /// Whether the goldens checked are this host's own (it blessed them): a timing bless or
+    /// accept here writes them, and a speed-up is this host's to bless.
+    pub fn blessed_here(self) -> bool {
+        matches!(self, Tier::SameHost | Tier::MovedHere)
+    }
 }
 
 /// One pass's measured timing noise.
@@ -56,7 +68,9 @@ impl PassNoise {
     /// The noise a check in `tier` allows for, and where it was measured.
     pub fn noise(&self, tier: Tier) -> (f64, &str) {
         match tier {
-            Tier::OtherHost if self.drivers > self.host => (self.drivers, &self.drivers_at),
+            Tier::OtherHost | Tier::MovedHere if self.drivers > self.host => {
+                (self.drivers, &self.drivers_at)
+            }
             _ => (self.host, &self.host_at),
         }
     }

@@ -186,11 +186,12 @@ pub fn check_speed_with(
     let cpu = super::cpu_signature();
     // The same-host figures are the blessing host's noise only where it measured them.
     let host_tier = match golden_backend {
-        Some(g)
-            if g.blessed_on(host, &cpu)
-                && noise.measured_on_host(&probe.scene, probe.backend, host, &cpu) =>
-        {
-            Tier::SameHost
+        Some(g) if g.blessed_on(host, &cpu) => {
+            if noise.measured_on_host(&probe.scene, probe.backend, host, &cpu) {
+                Tier::SameHost
+            } else {
+                Tier::MovedHere
+            }
         }
         _ => Tier::OtherHost,
     };
@@ -267,6 +268,10 @@ pub fn check_speed_with(
                             Tier::SameHost => "here",
                             Tier::OtherHost => "on a host that did not bless",
                             Tier::RecordedHost => "on this recorded host",
+                            Tier::MovedHere => {
+                                "here at the limits for any host (this host's timing noise \
+                                 not measured yet)"
+                            }
                         }
                     ))
                 } else if ratio / golden > limit {
@@ -336,6 +341,9 @@ impl SpeedCoverage {
                 self.recording.as_deref().unwrap_or("this host's recording")
             ),
             Tier::OtherHost => "on a host that did not bless".to_owned(),
+            Tier::MovedHere => "on the host that blessed, at the limits for any host (its \
+                                timing noise not measured here)"
+                .to_owned(),
         };
         let limits = match self.limits {
             Some([low, _, high]) if format!("{low:.2}") == format!("{high:.2}") => {

@@ -58,3 +58,32 @@ fn limits_are_noise_to_the_margin_and_another_host_counts_the_drivers() {
     let merged = harness::golden::speed::measure::merged(TimingNoise::default(), model.clone());
     assert_eq!(merged.measured_on, model.measured_on);
 }
+
+/// Measuring this host's noise for goldens moved here replaces the previous host's same-host
+/// figures of those scenes and backends (a merge only raises them); other figures merge as
+/// before.
+#[test]
+fn figures_measured_for_goldens_moved_here_replace_the_previous_hosts() {
+    let model_with = |host: f64, drivers: f64| {
+        let mut model = TimingNoise::default();
+        for scene in ["a", "b"] {
+            model.scenes.entry(scene.to_owned()).or_default().insert(
+                BackendKind::Gl,
+                BTreeMap::from([(PassId::ToneMap, noise(host, drivers))]),
+            );
+        }
+        model
+    };
+    let figure = |model: &TimingNoise, scene: &str| {
+        let n = &model.scenes[scene][&BackendKind::Gl][&PassId::ToneMap];
+        (n.host, n.drivers)
+    };
+    let old = model_with(1.5, 1.3);
+    let measured = model_with(1.1, 1.4);
+    let raised = harness::golden::speed::measure::merged(old.clone(), measured.clone());
+    assert_eq!(figure(&raised, "a"), (1.5, 1.4));
+    let moved = [("a".to_owned(), BackendKind::Gl)];
+    let replaced = harness::golden::speed::measure::merged_replacing(old, measured, &moved);
+    assert_eq!(figure(&replaced, "a"), (1.1, 1.4));
+    assert_eq!(figure(&replaced, "b"), (1.5, 1.4));
+}
