@@ -89,21 +89,16 @@ pub(super) fn timing(
         .cloned()
         .collect();
     if !probed.is_empty() {
-        if let Some(why) = blessed_elsewhere(store.root(), &scenes, &hosts)? {
+        if let Some((why, instead)) = blessed_elsewhere(store.root(), &scenes, &hosts)? {
             if write {
                 anyhow::bail!(
-                    "{why}: this host's probes are another host's figures, and --write would \
-                     take them for the blessing host's own noise. Record them with `harness \
-                     noise --timing --record-host NAME` and count them with `harness noise \
-                     --timing --source NAME --write`; or make this host the blessing one with \
-                     `harness bless --scene S --speed-only --every-pass` for every scene \
-                     first"
+                    "{why}. This host's probes of them are another host's figures, and --write \
+                     would take them for the blessing host's own noise: {instead}"
                 );
             }
             eprintln!(
-                "note: {why}: this host's sources are read against another host's goldens, \
-                 so their factors are that host's offset as much as noise (`--record-host NAME` \
-                 records this host's own)"
+                "note: {why}. This host's sources are read against another host's goldens, \
+                 so their factors are that host's offset as much as noise: {instead}"
             );
         }
     }
@@ -251,24 +246,88 @@ fn this_hosts() -> Vec<(BackendKind, String)> {
         .collect()
 }
 
-/// Where one of `scenes`' timing goldens on one of `hosts`' backends was not blessed on this
-/// host: which, and where it was (None where this host blessed them all).
+/// Where some of `scenes`' timing goldens on `hosts`' backends were not blessed on this host:
+/// which scenes and why for the first (another host, or goldens that keep no CPU signature),
+/// and what to do instead: measure the scenes this host blessed, move the others here, or
+/// record this host (naming its recording where it has one). None where this host blessed
+/// them all.
 fn blessed_elsewhere(
     root: &std::path::Path,
     scenes: &[(String, String)],
     hosts: &[(BackendKind, String)],
-) -> anyhow::Result<Option<String>> {
+) -> anyhow::Result<Option<(String, String)>> {
     let cpu = harness::golden::speed::cpu_signature();
+    let mut elsewhere: Vec<&str> = Vec::new();
+    let mut here: Vec<&str> = Vec::new();
+    let mut first = None;
     for (scene, _) in scenes {
         let goldens = harness::golden::speed::TimingGoldens::load(root, scene)?;
-        if let Some((kind, g)) = goldens.blessed_elsewhere(hosts, &cpu) {
-            return Ok(Some(format!(
-                "{scene}'s timing goldens on {kind} were blessed on {}, not here ({cpu})",
-                g.blessed_by()
-            )));
+        match goldens.blessed_elsewhere(hosts, &cpu) {
+            Some((kind, g)) => {
+                elsewhere.push(scene);
+                first.get_or_insert_with(|| {
+                    let known = harness::golden::speed::cpu_known(&g.cpu);
+                    (
+                        format!("{scene}'s timing goldens on {kind}"),
+                        known,
+                        g.blessed_by(),
+                    )
+                });
+            }
+            None => here.push(scene),
         }
     }
-    Ok(None)
+    let Some((first, cpu_known, blessed_by)) = first else {
+        return Ok(None);
+    };
+    let scene_args =
+        |names: &[&str]| -> String { names.iter().map(|n| format!(" --scene {n}")).collect() };
+    let others = match &elsewhere[1..] {
+        [] => String::new(),
+        [one] => format!(" (and {one}'s)"),
+        [many @ .., last] => format!(" (and {}'s and {last}'s)", many.join("'s, ")),
+    };
+    let why = if cpu_known {
+        format!("{first}{others} were blessed on {blessed_by}, not on this host ({cpu})")
+    } else {
+        format!(
+            "{first}{others} keep no CPU signature (blessed before it was kept), so no host, \
+             this one included, is taken for the one that blessed them"
+        )
+    };
+    let measure_here = if here.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "measure only the scenes this host blessed (`harness noise --timing --write{}`); ",
+            scene_args(&here)
+        )
+    };
+    let recorded = harness::golden::speed::recorded::load_all(root)?
+        .into_iter()
+        .find(|(_, r)| {
+            hosts
+                .iter()
+                .any(|(kind, host)| r.records(*kind, host, &cpu))
+        })
+        .map(|(name, _)| name);
+    let record = match recorded {
+        Some(name) => format!(
+            "this host is recorded as {name} already (`harness noise --timing --record-host \
+             {name}` records it again)"
+        ),
+        None => {
+            "or record this host's figures (`harness noise --timing --record-host NAME`)".to_owned()
+        }
+    };
+    Ok(Some((
+        why,
+        format!(
+            "{measure_here}make this host the blessing one first (`harness bless --speed-only \
+             --every-pass{}`); {record}",
+            scene_args(&elsewhere)
+        ),
+    )))
 }
 
 /// Says where this host (`backends`' fingerprints, `cpu`) is recorded already under another
@@ -332,7 +391,7 @@ fn print_timing_table(
         .filter(|(_, _, s)| *s > MAX_NOISE_RATIO)
         .count();
     println!(
-        "{:<8} {:<12} {:<22} {:>20} {:>20} {:>10} {:>10}",
+        "{:<8} {:<12} {:<22} {:>20} {:>20} {:>16} {:>16}",
         "scene", "backend", "pass", "host noise", "driver noise", "limit", "elsewhere"
     );
     let named = model
@@ -344,20 +403,19 @@ fn print_timing_table(
             for (pass, noise) in passes {
                 let here = model.limit(noise.noise(Tier::SameHost).0);
                 let elsewhere = model.limit(noise.noise(Tier::OtherHost).0);
-                let untimed = |limit: f64| {
+                let cell = |limit: f64| {
                     if limit >= harness::golden::speed::MUST_CATCH {
-                        "(untimed)"
+                        format!("x{limit:.2} (untimed)")
                     } else {
-                        ""
+                        format!("x{limit:.2}")
                     }
                 };
                 println!(
-                    "{scene:<8} {backend:<12} {pass:<22} {:>20} {:>20} {:>10} {:>10} {}",
+                    "{scene:<8} {backend:<12} {pass:<22} {:>20} {:>20} {:>16} {:>16}",
                     format!("x{:.2} {}", noise.host, short(&noise.host_at)),
                     format!("x{:.2} {}", noise.drivers, short(&noise.drivers_at)),
-                    format!("x{here:.2}{}", untimed(here)),
-                    format!("x{elsewhere:.2}"),
-                    untimed(elsewhere)
+                    cell(here),
+                    cell(elsewhere),
                 );
             }
         }
