@@ -9,6 +9,7 @@ pub(super) mod check;
 pub(super) mod hard;
 pub(super) mod info;
 pub(super) mod noise;
+pub(super) mod noise_record;
 pub(super) mod noise_timing;
 pub(super) mod render;
 pub(super) mod review;

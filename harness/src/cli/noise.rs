@@ -68,7 +68,7 @@ pub(crate) struct NoiseArgs {
 /// the image noise model, each with its default margin unless one is given.
 pub(crate) fn entry(args: NoiseArgs) -> anyhow::Result<ExitCode> {
     if let Some(name) = &args.record_host {
-        return super::noise_timing::record_host(
+        return super::noise_record::record_host(
             name,
             &args.scenes,
             args.history.as_deref(),

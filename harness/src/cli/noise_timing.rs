@@ -1,6 +1,6 @@
 //! `harness noise --timing`: the timing-noise model (golden/timing-noise.toml) measured from
-//! this host's sources and the hosts recorded in golden/evidence/, and `--record-host`, which
-//! records this host's speed ratios there.
+//! this host's sources and the hosts recorded in golden/evidence/ (`--record-host`, which
+//! records this host's speed ratios there, is [`super::noise_record`]).
 
 use std::process::ExitCode;
 
@@ -137,9 +137,15 @@ pub(super) fn timing(
         }
         refuse_if_busy(writing.busy_ok, false, "after the probes, nothing written")?;
         let measured = measure::model_from(&measurements, &sources, margin);
+        let here = measured_here_now(store.root(), &scenes, &hosts, &probed)?;
+        let cpu = harness::golden::speed::cpu_signature();
         let model = match TimingNoise::load(store.root()) {
             Ok(old) if !only.is_empty() => {
-                let moved = moved_here(&old, store.root(), &scenes, &hosts, &probed)?;
+                let moved: Vec<(String, BackendKind)> = here
+                    .iter()
+                    .filter(|(scene, kind, host)| !old.measured_on_host(scene, *kind, host, &cpu))
+                    .map(|(scene, kind, _)| (scene.clone(), *kind))
+                    .collect();
                 measure::merged_replacing(old, measured, &moved)
             }
             // Scenes not measured in this run keep their figures.
@@ -155,7 +161,9 @@ pub(super) fn timing(
             Err(_) => measured,
         };
         let mut model = model;
-        stamp_this_host(&mut model, store.root(), &scenes, &hosts, &probed)?;
+        for (scene, kind, host) in &here {
+            model.stamp_measured_on(scene, *kind, host, &cpu);
+        }
         model.save(store.root())?;
         eprintln!("wrote {}", TimingNoise::path(store.root()).display());
         model
@@ -179,59 +187,39 @@ pub(super) fn timing(
     })
 }
 
-/// Stamps the model's same-host figures of `scenes` on `hosts`' backends as this host's where
-/// `probed` measured them here (a same-host source among them) against goldens this host
-/// blessed: only there does a check read them as its own noise ([`Tier::SameHost`]).
-fn stamp_this_host(
-    model: &mut harness::golden::speed::TimingNoise,
+/// The scenes and backends (with this host's fingerprint for each) whose same-host figures
+/// this run measures as this host's own: a same-host source among `probed`, and timing goldens
+/// this host blessed. Only there does a check read them as its own noise
+/// ([`Tier::SameHost`]); where the model has them from another host they are replaced, not
+/// merged with this host's.
+fn measured_here_now(
     root: &std::path::Path,
     scenes: &[(String, String)],
     hosts: &[(BackendKind, String)],
     probed: &[harness::golden::speed::measure::TimingSource],
-) -> anyhow::Result<()> {
+) -> anyhow::Result<Vec<(String, BackendKind, String)>> {
+    let mut here = Vec::new();
     if !probed.iter().any(|s| s.tier == Tier::SameHost) {
-        return Ok(());
-    }
-    let cpu = harness::golden::speed::cpu_signature();
-    for (scene, _) in scenes {
-        let goldens = harness::golden::speed::TimingGoldens::load(root, scene)?;
-        model.stamp_where_blessed(scene, &goldens, hosts, &cpu);
-    }
-    Ok(())
-}
-
-/// The scenes and backends whose same-host figures `probed` measures here (a same-host source
-/// among them, goldens this host blessed) where `model` has them from another host: replaced by
-/// this host's, not merged with them.
-fn moved_here(
-    model: &harness::golden::speed::TimingNoise,
-    root: &std::path::Path,
-    scenes: &[(String, String)],
-    hosts: &[(BackendKind, String)],
-    probed: &[harness::golden::speed::measure::TimingSource],
-) -> anyhow::Result<Vec<(String, BackendKind)>> {
-    let mut moved = Vec::new();
-    if !probed.iter().any(|s| s.tier == Tier::SameHost) {
-        return Ok(moved);
+        return Ok(here);
     }
     let cpu = harness::golden::speed::cpu_signature();
     for (scene, _) in scenes {
         let goldens = harness::golden::speed::TimingGoldens::load(root, scene)?;
         for (kind, host) in hosts {
-            let blessed_here = goldens
+            if goldens
                 .backends
                 .get(kind)
-                .is_some_and(|g| g.blessed_on(host, &cpu));
-            if blessed_here && !model.measured_on_host(scene, *kind, host, &cpu) {
-                moved.push((scene.clone(), *kind));
+                .is_some_and(|g| g.blessed_on(host, &cpu))
+            {
+                here.push((scene.clone(), *kind, host.clone()));
             }
         }
     }
-    Ok(moved)
+    Ok(here)
 }
 
 /// Every available backend with this host's fingerprint for it (as the speed checks name it).
-fn this_hosts() -> Vec<(BackendKind, String)> {
+pub(super) fn this_hosts() -> Vec<(BackendKind, String)> {
     BackendKind::ALL
         .into_iter()
         .filter_map(|kind| {
@@ -330,31 +318,6 @@ fn blessed_elsewhere(
     )))
 }
 
-/// Says where this host (`backends`' fingerprints, `cpu`) is recorded already under another
-/// name than `name`: checks read a host against the first recording that matches it, so a
-/// second name for the same host would never be read.
-fn note_recorded_as_another(
-    root: &std::path::Path,
-    name: &str,
-    backends: &[(BackendKind, String)],
-    cpu: &str,
-) -> anyhow::Result<()> {
-    for (other, recording) in harness::golden::speed::recorded::load_all(root)? {
-        let same_host = other != name
-            && backends
-                .iter()
-                .all(|(kind, host)| recording.records(*kind, host, cpu));
-        if same_host {
-            eprintln!(
-                "note: this host is recorded already, as {other} (golden/evidence/{other}/: the \
-                 same driver fingerprints and CPU); checks read it against that recording, not \
-                 a second one: `--record-host {other}` adds to it"
-            );
-        }
-    }
-    Ok(())
-}
-
 /// `harness noise --timing --json`: every measurement with its limit and score, and the errors.
 fn print_timing_json(
     scores: &[(harness::golden::speed::measure::TimingMeasurement, f64, f64)],
@@ -437,7 +400,7 @@ fn print_timing_table(
 }
 
 /// Each of `cases` as its name and the argument a probe child takes (a name or a scene file).
-fn named(cases: &[harness::golden::suite::Case]) -> Vec<(String, String)> {
+pub(super) fn named(cases: &[harness::golden::suite::Case]) -> Vec<(String, String)> {
     cases
         .iter()
         .map(|c| (c.name().to_owned(), c.argument()))
@@ -445,205 +408,6 @@ fn named(cases: &[harness::golden::suite::Case]) -> Vec<(String, String)> {
 }
 
 /// A source name short enough for the table (`busy-neighbour` whole).
-fn short(source: &str) -> &str {
+pub(super) fn short(source: &str) -> &str {
     source.get(..source.len().min(14)).unwrap_or(source)
-}
-
-/// `harness noise --timing --record-host NAME`: on a host that did not bless the timing goldens,
-/// probes the scenes named (every canonical one by default) on every available backend under
-/// each timing source this machine has (at most
-/// [`RECORD_PROBES`](harness::golden::speed::recorded::RECORD_PROBES) per source), each a fresh
-/// process, and writes golden/evidence/NAME/timing.toml. Refuses on the host that blessed (its
-/// figures are this host's noise, not another's) and writes nothing when a probe failed.
-pub(super) fn record_host(
-    name: &str,
-    scenes: &[String],
-    history: Option<&std::path::Path>,
-    busy_ok: bool,
-) -> anyhow::Result<ExitCode> {
-    use harness::golden::speed::{measure, recorded, TimingGoldens};
-    if name.is_empty()
-        || !name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
-    {
-        anyhow::bail!("--record-host {name:?}: a host's name is letters, digits, '-' and '_'");
-    }
-    let store = GoldenStore::workspace();
-    let cases = load_cases(scenes)?;
-    let input_digests = harness::golden::scene_inputs::digests(cases.iter().map(|c| &c.inputs));
-    let scenes = named(&cases);
-    let backends = this_hosts();
-    if backends.is_empty() {
-        anyhow::bail!("no backend is available here (`harness backends` says why)");
-    }
-    // A scene whose goldens this host blessed (on some backend) is its own noise there, not
-    // another host's figures: left out, and refused only when that leaves nothing.
-    let cpu = harness::golden::speed::cpu_signature();
-    let mut kept = Vec::new();
-    for (scene, argument) in scenes {
-        let goldens = TimingGoldens::load(store.root(), &scene)?;
-        let blessed_here = backends.iter().find(|(kind, host)| {
-            goldens
-                .backends
-                .get(kind)
-                .is_some_and(|g| g.blessed_on(host, &cpu))
-        });
-        match blessed_here {
-            Some((kind, host)) => eprintln!(
-                "note: {scene} left out: this host blessed its timing goldens on {kind} \
-                 ({host}), so its figures there are this host's own noise (`harness noise \
-                 --timing --scene {scene}`), not another host's"
-            ),
-            None => kept.push((scene, argument)),
-        }
-    }
-    if kept.is_empty() {
-        anyhow::bail!(
-            "this host blessed the timing goldens of every scene asked for: its figures are its \
-             own noise (`harness noise --timing`), not another host's"
-        );
-    }
-    let scenes = kept;
-    refuse_if_busy(busy_ok, false, "before measuring")?;
-    note_recorded_as_another(store.root(), name, &backends, &cpu)?;
-    let path = recorded::RecordedTimings::path(store.root(), name);
-    let earlier = recorded::RecordedTimings::load(&path)?;
-    if let Some(earlier) = &earlier {
-        let hosts: std::collections::BTreeMap<BackendKind, String> =
-            backends.iter().cloned().collect();
-        if earlier.hosts != hosts
-            || !(earlier.cpu.is_empty() || earlier.cpu == harness::golden::speed::cpu_signature())
-        {
-            anyhow::bail!(
-                "{} was recorded on another host ({}); record this one under another name",
-                path.display(),
-                earlier.hosts.values().next().map_or("-", String::as_str)
-            );
-        }
-    }
-    let (sources, missing) = measure::timing_sources();
-    for (source, why) in &missing {
-        eprintln!("note: timing source {source} not recorded: {why}");
-    }
-    let history = match history {
-        Some(out) => {
-            let (entries, skipped) = harness::golden::speed::history::read(out);
-            if entries.is_empty() {
-                anyhow::bail!(
-                    "--history {}: no speed history there ({} lines unreadable)",
-                    out.join(harness::golden::speed::history::HISTORY_FILE)
-                        .display(),
-                    skipped
-                );
-            }
-            // Only an unchanged build's checks: this executable, each scene loaded from the
-            // bytes it is now (a check of an edited scene, or of a rebuilt harness, under the
-            // same commit measured something else).
-            let (kept, left_out) =
-                harness::golden::speed::history::of_this_build(&entries, &input_digests);
-            if left_out > 0 {
-                eprintln!(
-                    "note: {left_out} check(s) of the history left out: another build of the \
-                     harness, or their scenes edited since (only this executable's checks of \
-                     the scenes as they are now count)"
-                );
-            }
-            kept
-        }
-        None => Vec::new(),
-    };
-    let exe = std::env::current_exe()?;
-    let (mut recorded, errors) = recorded::record(
-        &exe,
-        store.root(),
-        &scenes,
-        &backends,
-        &sources,
-        recorded::RECORD_PROBES,
-        &history,
-        |what| eprintln!("recording {name}: {what} ..."),
-    );
-    if !errors.is_empty() {
-        for e in &errors {
-            eprintln!("error: {e}");
-        }
-        anyhow::bail!("{} probe(s) failed; nothing written", errors.len());
-    }
-    if let Some(earlier) = earlier {
-        let probes: usize = earlier.probes.values().sum();
-        let dropped = recorded.absorb(earlier);
-        eprintln!(
-            "adding to the {probes} earlier probe(s) and check(s) per backend in {}",
-            path.display()
-        );
-        if !dropped.is_empty() {
-            eprintln!(
-                "note: their goldens changed since, so the earlier ratios of {} are dropped",
-                dropped.join(", ")
-            );
-        }
-    }
-    refuse_if_busy(busy_ok, false, "after the probes, nothing written")?;
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)?;
-    }
-    recorded.save(&path)?;
-    start_readme(&path, name, &recorded)?;
-    println!(
-        "{:<8} {:<12} {:<22} {:>24} {:>8}",
-        "scene", "backend", "pass", "largest of golden", "lowest"
-    );
-    for (scene, backends) in &recorded.scenes {
-        for (backend, passes) in backends {
-            for (pass, r) in passes {
-                let (factor, at) = r.factor();
-                println!(
-                    "{scene:<8} {backend:<12} {pass:<22} {:>24} {:>8}",
-                    format!("x{factor:.3} {}", short(at)),
-                    format!("x{:.3}", r.lowest())
-                );
-            }
-        }
-    }
-    eprintln!(
-        "wrote {}; `harness noise --timing --source {name} --write` counts it in the model",
-        path.display()
-    );
-    Ok(ExitCode::SUCCESS)
-}
-
-/// Writes the README.md beside the recording at `path` of host `name`, where there is none: what
-/// the tool knows of the host (its drivers as the checks fingerprint them, its CPU signature,
-/// when and at which commit), and what the person committing it must add.
-fn start_readme(
-    path: &std::path::Path,
-    name: &str,
-    recorded: &harness::golden::speed::recorded::RecordedTimings,
-) -> anyhow::Result<()> {
-    let readme = path.with_file_name("README.md");
-    if !readme.exists() {
-        let hosts: Vec<String> = recorded
-            .hosts
-            .iter()
-            .map(|(kind, host)| format!("- {kind}: `{host}`"))
-            .collect();
-        let text = format!(
-            "# {name}\n\nSpeed ratios recorded with `harness noise --timing --record-host {name}` \
-             on {} (commit {}), CPU signature {}.\n\nDrivers as the checks fingerprint them:\n\n{}\n\n\
-             TODO before committing: say what this host is (the machine or CI runner class, its \
-             CPU, cores and memory, the OS and Mesa release), why it was recorded, and anything \
-             that was running beside it.\n",
-            recorded.recorded,
-            recorded.commit.as_deref().unwrap_or("not a git tree"),
-            recorded.cpu,
-            hosts.join("\n")
-        );
-        std::fs::write(&readme, text)?;
-        eprintln!(
-            "wrote {}: a start; say there what this host is before committing",
-            readme.display()
-        );
-    }
-    Ok(())
 }

@@ -193,6 +193,6 @@ pub fn bless_timings_here(
     // The model's same-host figures count as this host's, as after `noise --timing --write`
     // here (the committed figures, not measured again).
     let mut model = harness::golden::speed::TimingNoise::load(&golden).unwrap();
-    model.stamp_where_blessed(scene, &goldens, &[(kind, host)], &cpu);
+    model.stamp_measured_on(scene, kind, &host, &cpu);
     model.save(&golden).unwrap();
 }

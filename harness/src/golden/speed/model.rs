@@ -173,38 +173,20 @@ impl TimingNoise {
             .is_some_and(|m| m.host == host && super::cpu_known(&m.cpu) && m.cpu == cpu)
     }
 
-    /// Stamps `scene`'s same-host figures as measured on this host (`hosts`: each backend
-    /// with this host's fingerprint for it; `cpu`) on every backend whose timing goldens this
-    /// host blessed ([`super::BackendTimings::blessed_on`]), what `noise --timing --write`
-    /// does after probing this host's sources. Returns the backends stamped.
-    pub fn stamp_where_blessed(
-        &mut self,
-        scene: &str,
-        goldens: &super::TimingGoldens,
-        hosts: &[(BackendKind, String)],
-        cpu: &str,
-    ) -> Vec<BackendKind> {
-        let mut stamped = Vec::new();
-        for (kind, host) in hosts {
-            if goldens
-                .backends
-                .get(kind)
-                .is_some_and(|g| g.blessed_on(host, cpu))
-            {
-                self.measured_on
-                    .entry(scene.to_owned())
-                    .or_default()
-                    .insert(
-                        *kind,
-                        MeasuredOn {
-                            host: host.clone(),
-                            cpu: cpu.to_owned(),
-                        },
-                    );
-                stamped.push(*kind);
-            }
-        }
-        stamped
+    /// Records that `scene`'s same-host figures on `backend` were measured on `host`, `cpu`
+    /// (what `noise --timing --write` does for the goldens this host blessed, after probing
+    /// this host's sources).
+    pub fn stamp_measured_on(&mut self, scene: &str, backend: BackendKind, host: &str, cpu: &str) {
+        self.measured_on
+            .entry(scene.to_owned())
+            .or_default()
+            .insert(
+                backend,
+                MeasuredOn {
+                    host: host.to_owned(),
+                    cpu: cpu.to_owned(),
+                },
+            );
     }
 
     /// The figures of one pass: its own, or where the scene has none (a scene outside the

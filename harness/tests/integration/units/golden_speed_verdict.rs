@@ -41,13 +41,7 @@ fn model() -> TimingNoise {
 /// The model, its same-host figures measured on `host` (this CPU).
 fn model_measured_on(host: &str) -> TimingNoise {
     let mut model = TimingNoise::default();
-    let mut goldens = TimingGoldens::default();
-    goldens.record(&probe(3.0, 4.0), &[], &stamp(host, &cpu_signature()));
-    let hosts = [(BackendKind::Gl, host.to_owned())];
-    assert_eq!(
-        model.stamp_where_blessed("s", &goldens, &hosts, &cpu_signature()),
-        [BackendKind::Gl]
-    );
+    model.stamp_measured_on("s", BackendKind::Gl, host, &cpu_signature());
     let figures = |host: f64, drivers: f64| PassNoise {
         host,
         host_at: "busy".to_owned(),
@@ -317,17 +311,10 @@ fn same_host_figures_count_only_on_the_host_that_measured_them() {
     let there = check_speed(&probe(3.0, 4.0), &goldens, &before, "there");
     assert_eq!(there[0].tier, Tier::OtherHost);
     assert!(harness::golden::speed::moved_here_notes(&there).is_empty());
-    // Only backends whose goldens this host blessed are stamped.
-    let mut stamped = TimingNoise::default();
-    let hosts = [
-        (BackendKind::Gl, "here".to_owned()),
-        (BackendKind::WgpuVulkan, "here".to_owned()),
-    ];
-    assert_eq!(
-        stamped.stamp_where_blessed("s", &goldens, &hosts, &cpu_signature()),
-        [BackendKind::Gl]
-    );
+    // A stamp names one scene, backend, host and CPU.
+    let stamped = model();
     assert!(stamped.measured_on_host("s", BackendKind::Gl, "here", &cpu_signature()));
+    assert!(!stamped.measured_on_host("s", BackendKind::Gl, "there", &cpu_signature()));
     assert!(!stamped.measured_on_host("s", BackendKind::WgpuVulkan, "here", &cpu_signature()));
     assert!(!stamped.measured_on_host("t", BackendKind::Gl, "here", &cpu_signature()));
 }
