@@ -203,6 +203,7 @@ pub fn bless_scenes(
                 &[*kind],
                 CHECK_ROUNDS,
                 Default::default(),
+                crate::measure::speed::ProbePurpose::Measure,
                 &[],
             );
             if let Some(error) = errors.first() {

@@ -291,6 +291,7 @@ pub fn start_check(
             kinds,
             CHECK_ROUNDS,
             variations,
+            crate::measure::speed::ProbePurpose::Check,
             env,
         ),
         exe: exe.to_owned(),
@@ -371,6 +372,7 @@ pub fn check_scenes(
                 &[kind],
                 CHECK_ROUNDS,
                 variations,
+                crate::measure::speed::ProbePurpose::Check,
                 &env,
             );
             run.errors.extend(errors);
