@@ -189,8 +189,7 @@ fn save_bench_json(dir: &Path, name: &str, text: &str) -> anyhow::Result<()> {
 /// `harness speed --in-process`: the probe in this process, as JSON (or a table); exits 1 when
 /// a backend asked for is missing or a scene fails. Every probe is prepared first (started,
 /// recorded, warmed up), then each takes its timed rounds in turn; with `wait_for_go`, only
-/// once a line (or the end) comes on stdin. With `untimed_once`, the passes a check here
-/// reports untimed whatever they measure take one round ([`untimed_once_passes`]).
+/// once a line (or the end) comes on stdin.
 pub(crate) fn speed_in_process(
     scenes: &[String],
     backends: &[BackendKind],
@@ -198,7 +197,6 @@ pub(crate) fn speed_in_process(
     variations: engine::renderer::Variations,
     json: bool,
     wait_for_go: bool,
-    untimed_once: bool,
 ) -> anyhow::Result<ExitCode> {
     let loaded = load_scenes(scenes)?;
     let (prepared, mut failed) = each_scene_and_backend(&loaded, backends, |scene, kind| {
@@ -220,12 +218,7 @@ pub(crate) fn speed_in_process(
             probe.scene(),
             probe.backend()
         );
-        let once = if untimed_once {
-            untimed_once_passes(&probe)?
-        } else {
-            Vec::new()
-        };
-        match probe.sample_with(rounds, &once) {
+        match probe.sample(rounds) {
             Ok(result) => {
                 if !json {
                     print_speed(&result);
@@ -246,29 +239,6 @@ pub(crate) fn speed_in_process(
     } else {
         ExitCode::SUCCESS
     })
-}
-
-/// The passes of `probe`'s scene and backend that a check on this host reports untimed whatever
-/// they measure ([`harness::golden::speed::verdict::untimed_here`]), from the workspace's timing
-/// goldens, model and recordings.
-fn untimed_once_passes(
-    probe: &harness::measure::speed::PreparedProbe,
-) -> anyhow::Result<Vec<engine::plan::PassId>> {
-    use harness::golden::speed::{recorded, TimingGoldens, TimingNoise};
-    let store = harness::golden::GoldenStore::workspace();
-    let goldens = TimingGoldens::load(store.root(), probe.scene())?;
-    let noise = TimingNoise::load(store.root())?;
-    let recordings = recorded::load_all(store.root())?;
-    let host =
-        harness::golden::speed::host_fingerprint(&harness::golden::fingerprint(probe.driver()));
-    Ok(harness::golden::speed::verdict::untimed_here(
-        probe.scene(),
-        probe.backend(),
-        &goldens,
-        &noise,
-        &host,
-        &recordings,
-    ))
 }
 
 /// `harness speed`: the speed probe of each scene asked for (every canonical one by default) on
@@ -298,15 +268,8 @@ pub(crate) fn speed(
             "probing {} scene(s) on {kind} ({rounds} rounds, one rasterizer thread) ...",
             names.len()
         );
-        let (probed, errors) = harness::measure::speed::probe_in_child(
-            &exe,
-            &names,
-            &[kind],
-            rounds,
-            variations,
-            harness::measure::speed::ProbePurpose::Measure,
-            &[],
-        );
+        let (probed, errors) =
+            harness::measure::speed::probe_in_child(&exe, &names, &[kind], rounds, variations, &[]);
         for e in &errors {
             eprintln!("error: {e}");
         }
@@ -376,10 +339,6 @@ pub(crate) struct SpeedArgs {
     /// rounds (how `check` lets its probe child prepare while it renders the images).
     #[arg(long, hide = true, requires = "in_process")]
     pub wait_for_go: bool,
-    /// With --in-process: sample the passes that a check here reports untimed whatever they
-    /// measure in one round only (what a check's probe child does: `ProbePurpose::Check`).
-    #[arg(long, hide = true, requires = "in_process")]
-    pub untimed_once: bool,
 }
 
 /// `harness speed`: parses the slowdown asked for and probes, in child processes (or in this
@@ -412,7 +371,6 @@ pub(crate) fn speed_command(args: SpeedArgs) -> anyhow::Result<ExitCode> {
             variations,
             args.json,
             args.wait_for_go,
-            args.untimed_once,
         )
     } else {
         speed(

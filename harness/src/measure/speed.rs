@@ -211,21 +211,9 @@ impl PreparedProbe {
         Ok(())
     }
 
-    /// The driver the probe runs on.
-    pub fn driver(&self) -> &engine::backend::DriverInfo {
-        self.backend.info()
-    }
-
     /// The timed rounds ([`sample`]), at most `rounds` (at least one); frees the probe's
     /// resources.
-    pub fn sample(self, rounds: usize) -> Result<SceneSpeed, BenchError> {
-        self.sample_with(rounds, &[])
-    }
-
-    /// As [`PreparedProbe::sample`], with the passes in `once` sampled in one round only (a
-    /// check's passes that are untimed on its host whatever they measure: their ratio is
-    /// reported, not judged).
-    pub fn sample_with(mut self, rounds: usize, once: &[PassId]) -> Result<SceneSpeed, BenchError> {
+    pub fn sample(mut self, rounds: usize) -> Result<SceneSpeed, BenchError> {
         let rounds = rounds.max(1);
         match sample(
             self.backend.as_mut(),
@@ -233,7 +221,6 @@ impl PreparedProbe {
             &self.floors,
             &self.passes,
             rounds,
-            once,
         ) {
             Ok(mut passes) => {
                 for pass in &mut passes {
@@ -289,18 +276,6 @@ impl PreparedProbe {
 /// thread (see [`crate::golden::speed`]).
 pub const PROBE_ENV: [(&str, &str); 1] = [crate::golden::speed::PROBE_THREADS];
 
-/// What a probe child's ratios are for, which decides how long it samples each pass.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ProbePurpose {
-    /// Timing goldens, the noise model, a recording, `harness speed`: every pass sampled until
-    /// it settles.
-    Measure,
-    /// A check: the passes untimed on this host whatever they measure (too noisy at its tier
-    /// to catch a doubling, [`crate::golden::speed::verdict::untimed_here`]) take one round,
-    /// the others as for [`ProbePurpose::Measure`].
-    Check,
-}
-
 /// Runs the probe of `scenes` (names or scene files) on `backends` (one after the other) in one
 /// child process of `exe` ([`ProbeChild`]) and waits for it: the scenes that were probed, and an
 /// error per scene or backend that failed.
@@ -310,10 +285,9 @@ pub fn probe_in_child(
     backends: &[BackendKind],
     rounds: usize,
     variations: Variations,
-    purpose: ProbePurpose,
     env: &[(String, String)],
 ) -> (Vec<SceneSpeed>, Vec<String>) {
-    ProbeChild::start(exe, scenes, backends, rounds, variations, purpose, env).finish()
+    ProbeChild::start(exe, scenes, backends, rounds, variations, env).finish()
 }
 
 /// The probe of some scenes on some backends in a child process, `exe speed --in-process --json
@@ -333,15 +307,13 @@ pub struct ProbeChild {
 impl ProbeChild {
     /// Starts the child for `scenes` on `backends` (every available one when empty), at most
     /// `rounds` rounds each. `variations` may hold a slowed pass and the unspecialised lighting
-    /// (the ones `harness speed` takes); the others are not passed on. `purpose` says how
-    /// long each pass is sampled.
+    /// (the ones `harness speed` takes); the others are not passed on.
     pub fn start(
         exe: &std::path::Path,
         scenes: &[String],
         backends: &[BackendKind],
         rounds: usize,
         variations: Variations,
-        purpose: ProbePurpose,
         env: &[(String, String)],
     ) -> Self {
         let mut command = std::process::Command::new(exe);
@@ -361,9 +333,6 @@ impl ProbeChild {
         }
         if variations.unspecialised_lighting {
             command.arg("--debug-unspecialised-lighting");
-        }
-        if purpose == ProbePurpose::Check {
-            command.arg("--untimed-once");
         }
         command.envs(PROBE_ENV.iter().map(|(k, v)| (*k, *v)));
         command.envs(env.iter().map(|(k, v)| (k, v)));
@@ -459,15 +428,13 @@ enum SampleError {
 
 /// The timed part of a probe warmed up by [`PreparedProbe::new`]: every floor once more, sizing
 /// its repeats, then round after round each pass that has not settled alone and its floor,
-/// until every pass has settled ([`settled`]) or `rounds` rounds were taken; a pass in `once`
-/// takes the first round only.
+/// until every pass has settled ([`settled`]) or `rounds` rounds were taken.
 fn sample(
     backend: &mut dyn backend::Backend,
     recorded: &RecordedFrame,
     floors: &Floors,
     ids: &[PassId],
     rounds: usize,
-    once: &[PassId],
 ) -> Result<Vec<PassSpeed>, SampleError> {
     let mut passes: Vec<PassSpeed> = Vec::new();
     let mut copies = Vec::new();
@@ -488,7 +455,7 @@ fn sample(
     for _ in 0..rounds {
         let mut sampled = false;
         for (speed, &n) in passes.iter_mut().zip(&copies) {
-            if settled(speed) || (once.contains(&speed.pass) && !speed.pass_ms.is_empty()) {
+            if settled(speed) {
                 continue;
             }
             // A slowed pass gives every other turn to itself without its copies, in the same

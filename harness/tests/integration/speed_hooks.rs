@@ -133,33 +133,3 @@ fn a_probe_of_a_slowed_pass_says_what_slowdown_its_copies_delivered() {
     }
     assert!(plain.passes.iter().all(|p| p.delivered().is_none()));
 }
-
-/// A check's probe samples the passes that are untimed on its host anyway in one round
-/// (`PreparedProbe::sample_with`), and the others until they settle, at least
-/// `MIN_ROUNDS`.
-#[test]
-fn a_pass_sampled_once_takes_one_round_and_the_others_settle() {
-    let scene = test_scenes::five_models(64);
-    let Some(&kind) = common::available_backends().first() else {
-        return;
-    };
-    let prepared =
-        harness::measure::speed::PreparedProbe::new(&scene, kind, Default::default()).unwrap();
-    let probe = prepared.sample_with(8, &[PassId::ToneMap]).unwrap();
-    let Some(tonemap) = probe.pass(PassId::ToneMap) else {
-        return; // no timestamps on this backend
-    };
-    assert_eq!(
-        (tonemap.pass_ms.len(), tonemap.floor_ms.len()),
-        (1, 1),
-        "{tonemap:?}"
-    );
-    for pass in probe.passes.iter().filter(|p| p.pass != PassId::ToneMap) {
-        assert!(
-            pass.pass_ms.len() >= harness::measure::speed::MIN_ROUNDS,
-            "{}: {:?}",
-            pass.pass,
-            pass.pass_ms
-        );
-    }
-}

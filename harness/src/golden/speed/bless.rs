@@ -203,7 +203,6 @@ pub fn bless_scenes(
                 &[*kind],
                 CHECK_ROUNDS,
                 Default::default(),
-                crate::measure::speed::ProbePurpose::Measure,
                 &[],
             );
             if let Some(error) = errors.first() {

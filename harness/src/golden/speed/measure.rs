@@ -191,7 +191,6 @@ pub fn measure_timing(
                     &[kind],
                     CHECK_ROUNDS,
                     Default::default(),
-                    crate::measure::speed::ProbePurpose::Measure,
                     &source.env,
                 );
                 errors.extend(failed.into_iter().map(|e| format!("{}: {e}", source.name)));

@@ -291,7 +291,6 @@ pub fn start_check(
             kinds,
             CHECK_ROUNDS,
             variations,
-            crate::measure::speed::ProbePurpose::Check,
             env,
         ),
         exe: exe.to_owned(),
@@ -372,7 +371,6 @@ pub fn check_scenes(
                 &[kind],
                 CHECK_ROUNDS,
                 variations,
-                crate::measure::speed::ProbePurpose::Check,
                 &env,
             );
             run.errors.extend(errors);

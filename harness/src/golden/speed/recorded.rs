@@ -353,7 +353,6 @@ pub fn record(
                     &[*kind],
                     CHECK_ROUNDS,
                     Default::default(),
-                    crate::measure::speed::ProbePurpose::Measure,
                     &source.env,
                 );
                 errors.extend(failed.into_iter().map(|e| format!("{}: {e}", source.name)));

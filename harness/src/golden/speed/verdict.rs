@@ -182,33 +182,72 @@ pub fn check_speed_with(
     host: &str,
     recordings: &[(String, RecordedTimings)],
 ) -> Vec<SpeedCheck> {
-    let judge = Judge::new(
-        &probe.scene,
-        probe.backend,
-        goldens,
-        noise,
-        host,
-        recordings,
-    );
+    let golden_backend = goldens.backends.get(&probe.backend);
+    let cpu = super::cpu_signature();
+    // The same-host figures are the blessing host's noise only where it measured them.
+    let host_tier = match golden_backend {
+        Some(g) if g.blessed_on(host, &cpu) => {
+            if noise.measured_on_host(&probe.scene, probe.backend, host, &cpu) {
+                Tier::SameHost
+            } else {
+                Tier::MovedHere
+            }
+        }
+        _ => Tier::OtherHost,
+    };
+    let recording = (host_tier == Tier::OtherHost && !recordings.is_empty())
+        .then(|| {
+            recordings
+                .iter()
+                .find(|(_, r)| r.records(probe.backend, host, &cpu))
+        })
+        .flatten();
     let mut checks = Vec::new();
     for pass in &probe.passes {
         let (Some(ratio), Some(ms)) = (pass.ratio(), pass.min_ms()) else {
             continue;
         };
-        let blessed_pass = judge.blessed_pass(pass.pass);
+        let blessed_pass = golden_backend.and_then(|g| g.passes.get(&pass.pass));
+        let blessed = blessed_pass.map(|g| g.ratio);
         let targets_changed = match (blessed_pass.and_then(|g| g.targets.as_ref()), &pass.targets) {
             (Some(then), Some(now)) if then != now => Some(format!(
                 "it writes {now}, where it wrote {then} when blessed"
             )),
             _ => None,
         };
-        let Reference {
-            tier,
-            golden,
-            noise: noise_figure,
-            borrowed,
-            floor,
-        } = judge.reference(pass.pass);
+        let own = recording.and_then(|(name, r)| {
+            let recorded = r
+                .scenes
+                .get(&probe.scene)?
+                .get(&probe.backend)?
+                .get(&pass.pass)?;
+            let (reference, spread) = recorded.reference(blessed?)?;
+            Some((name, reference, spread))
+        });
+        let (tier, golden, noise_figure, borrowed) = match own {
+            Some((name, reference, spread)) => (
+                Tier::RecordedHost,
+                Some(reference),
+                Some((spread, format!("{name}'s recording"))),
+                false,
+            ),
+            None => {
+                let figures = noise.figures(&probe.scene, probe.backend, pass.pass);
+                let (figure, borrowed) = match &figures {
+                    Some((n, borrowed)) => {
+                        let (value, at) = n.noise(host_tier);
+                        (Some((value, at.to_owned())), *borrowed)
+                    }
+                    None => (None, false),
+                };
+                (host_tier, blessed, figure, borrowed)
+            }
+        };
+        let floor = if tier == Tier::RecordedHost {
+            MIN_NOISE_RECORDED
+        } else {
+            1.0
+        };
         let limit = noise_figure
             .as_ref()
             .map(|(n, _)| noise.limit_for(n.max(floor), ms));
@@ -266,141 +305,6 @@ pub fn check_speed_with(
         });
     }
     checks
-}
-
-/// What a pass is judged against on one scene and backend, from the goldens, the model and the
-/// recordings: the tier, the reference ratio and the noise figure with its floor.
-struct Reference {
-    tier: Tier,
-    /// The reference ratio: the golden, or this host's recorded median.
-    golden: Option<f64>,
-    /// The noise figure and where it was measured.
-    noise: Option<(f64, String)>,
-    /// Whether the figure is borrowed from other scenes.
-    borrowed: bool,
-    /// The smallest noise the tier allows (a recording's own floor; 1 where the model's
-    /// minimum applies).
-    floor: f64,
-}
-
-/// The tier of one scene on one backend here, and each pass's [`Reference`] in it.
-struct Judge<'a> {
-    scene: &'a str,
-    backend: BackendKind,
-    golden_backend: Option<&'a super::BackendTimings>,
-    noise: &'a TimingNoise,
-    host_tier: Tier,
-    recording: Option<&'a (String, RecordedTimings)>,
-}
-
-impl<'a> Judge<'a> {
-    fn new(
-        scene: &'a str,
-        backend: BackendKind,
-        goldens: &'a TimingGoldens,
-        noise: &'a TimingNoise,
-        host: &str,
-        recordings: &'a [(String, RecordedTimings)],
-    ) -> Self {
-        let golden_backend = goldens.backends.get(&backend);
-        let cpu = super::cpu_signature();
-        // The same-host figures are the blessing host's noise only where it measured them.
-        let host_tier = match golden_backend {
-            Some(g) if g.blessed_on(host, &cpu) => {
-                if noise.measured_on_host(scene, backend, host, &cpu) {
-                    Tier::SameHost
-                } else {
-                    Tier::MovedHere
-                }
-            }
-            _ => Tier::OtherHost,
-        };
-        let recording = (host_tier == Tier::OtherHost)
-            .then(|| {
-                recordings
-                    .iter()
-                    .find(|(_, r)| r.records(backend, host, &cpu))
-            })
-            .flatten();
-        Self {
-            scene,
-            backend,
-            golden_backend,
-            noise,
-            host_tier,
-            recording,
-        }
-    }
-
-    fn blessed_pass(&self, pass: PassId) -> Option<&'a super::PassTiming> {
-        self.golden_backend.and_then(|g| g.passes.get(&pass))
-    }
-
-    fn reference(&self, pass: PassId) -> Reference {
-        let blessed = self.blessed_pass(pass).map(|g| g.ratio);
-        let own = self.recording.and_then(|(name, r)| {
-            let recorded = r.scenes.get(self.scene)?.get(&self.backend)?.get(&pass)?;
-            let (reference, spread) = recorded.reference(blessed?)?;
-            Some((name, reference, spread))
-        });
-        match own {
-            Some((name, reference, spread)) => Reference {
-                tier: Tier::RecordedHost,
-                golden: Some(reference),
-                noise: Some((spread, format!("{name}'s recording"))),
-                borrowed: false,
-                floor: MIN_NOISE_RECORDED,
-            },
-            None => {
-                let figures = self.noise.figures(self.scene, self.backend, pass);
-                let (figure, borrowed) = match &figures {
-                    Some((n, borrowed)) => {
-                        let (value, at) = n.noise(self.host_tier);
-                        (Some((value, at.to_owned())), *borrowed)
-                    }
-                    None => (None, false),
-                };
-                Reference {
-                    tier: self.host_tier,
-                    golden: blessed,
-                    noise: figure,
-                    borrowed,
-                    floor: 1.0,
-                }
-            }
-        }
-    }
-}
-
-/// The passes of `scene`'s timing goldens on `backend` that a check here reports untimed
-/// whatever it measures: their limit at this host's tier ([`check_speed_with`]) would not
-/// catch a doubling even for a long pass. A check's probe gives them one round
-/// ([`crate::measure::speed::PreparedProbe::sample_with`]) instead of sampling them until
-/// they settle.
-pub fn untimed_here(
-    scene: &str,
-    backend: BackendKind,
-    goldens: &TimingGoldens,
-    noise: &TimingNoise,
-    host: &str,
-    recordings: &[(String, RecordedTimings)],
-) -> Vec<PassId> {
-    let judge = Judge::new(scene, backend, goldens, noise, host, recordings);
-    let Some(golden_backend) = judge.golden_backend else {
-        return Vec::new();
-    };
-    golden_backend
-        .passes
-        .keys()
-        .copied()
-        .filter(|&pass| {
-            let reference = judge.reference(pass);
-            reference.golden.is_some()
-                && reference.noise.as_ref().is_some_and(|(n, _)| {
-                    noise.limit_for(n.max(reference.floor), f64::INFINITY) >= MUST_CATCH
-                })
-        })
-        .collect()
 }
 
 /// What one backend's speed checks at one tier can catch: how many passes were timed, the

@@ -319,33 +319,6 @@ fn same_host_figures_count_only_on_the_host_that_measured_them() {
     assert!(!stamped.measured_on_host("t", BackendKind::Gl, "here", &cpu_signature()));
 }
 
-/// The passes a check here reports untimed whatever it measures (their limit at this host's
-/// tier would not catch a doubling): a check's probe samples them once.
-#[test]
-fn untimed_here_lists_the_passes_too_noisy_at_this_hosts_tier() {
-    use harness::golden::speed::verdict::untimed_here;
-    let mut goldens = TimingGoldens::default();
-    goldens.record(&probe(3.0, 4.0), &[], &stamp("here", &cpu_signature()));
-    let noise = model();
-    // Here (the blessing host, figures measured here): both passes timed (limit 1.44).
-    assert!(untimed_here("s", BackendKind::Gl, &goldens, &noise, "here", &[]).is_empty());
-    // Elsewhere: geometry's drivers figure 1.5 gives x2.25, tone mapping's 1.2 x1.44.
-    assert_eq!(
-        untimed_here("s", BackendKind::Gl, &goldens, &noise, "there", &[]),
-        [PassId::Geometry]
-    );
-    // As the verdict says of the probe's own ratios.
-    let there = check_speed(&probe(3.0, 4.0), &goldens, &noise, "there");
-    let untimed: Vec<PassId> = there
-        .iter()
-        .filter(|c| matches!(c.outcome, SpeedOutcome::Untimed(_)))
-        .map(|c| c.pass)
-        .collect();
-    assert_eq!(untimed, [PassId::Geometry]);
-    // No goldens on a backend: nothing to leave out.
-    assert!(untimed_here("s", BackendKind::WgpuVulkan, &goldens, &noise, "there", &[]).is_empty());
-}
-
 fn covered(
     backend: BackendKind,
     tier: Tier,
