@@ -328,7 +328,9 @@ pub fn merged_replacing(
         ) else {
             continue;
         };
-        for (pass, figures) in new {
+        // A placeholder (`-`: no same-host source measured the pass in this run) replaces
+        // nothing.
+        for (pass, figures) in new.iter().filter(|(_, f)| f.host_at != "-") {
             if let Some(old) = old.get_mut(pass) {
                 old.host = figures.host;
                 old.host_at = figures.host_at.clone();

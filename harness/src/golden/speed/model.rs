@@ -173,6 +173,33 @@ impl TimingNoise {
             .is_some_and(|m| m.host == host && super::cpu_known(&m.cpu) && m.cpu == cpu)
     }
 
+    /// Whether the same-host figures a check of `scene` on `backend` reads were measured on
+    /// this host: its own ([`TimingNoise::measured_on_host`]), or, for a scene the model has
+    /// no figures of (one outside the canonical set, which borrows every scene's largest:
+    /// [`TimingNoise::figures`]), those of every scene it borrows from.
+    pub fn figures_measured_on_host(
+        &self,
+        scene: &str,
+        backend: BackendKind,
+        host: &str,
+        cpu: &str,
+    ) -> bool {
+        if self
+            .scenes
+            .get(scene)
+            .is_some_and(|b| b.contains_key(&backend))
+        {
+            return self.measured_on_host(scene, backend, host, cpu);
+        }
+        let mut lenders = self
+            .scenes
+            .iter()
+            .filter(|(_, b)| b.contains_key(&backend))
+            .map(|(s, _)| s)
+            .peekable();
+        lenders.peek().is_some() && lenders.all(|s| self.measured_on_host(s, backend, host, cpu))
+    }
+
     /// Records that `scene`'s same-host figures on `backend` were measured on `host`, `cpu`
     /// (what `noise --timing --write` does for the goldens this host blessed, after probing
     /// this host's sources).

@@ -160,7 +160,8 @@ impl SpeedCheck {
 /// the tier's figures. The goldens' host for this backend equal to `host`, on this CPU, is the
 /// same host ([`BackendTimings::blessed_on`](super::BackendTimings::blessed_on): goldens that
 /// keep no CPU signature name none) where the model's same-host figures were measured there too
-/// ([`TimingNoise::measured_on_host`]); any other is another host.
+/// ([`TimingNoise::figures_measured_on_host`]), and [`Tier::MovedHere`] where they were not
+/// (read at the limits for any host); any other is another host.
 pub fn check_speed(
     probe: &SceneSpeed,
     goldens: &TimingGoldens,
@@ -187,7 +188,7 @@ pub fn check_speed_with(
     // The same-host figures are the blessing host's noise only where it measured them.
     let host_tier = match golden_backend {
         Some(g) if g.blessed_on(host, &cpu) => {
-            if noise.measured_on_host(&probe.scene, probe.backend, host, &cpu) {
+            if noise.figures_measured_on_host(&probe.scene, probe.backend, host, &cpu) {
                 Tier::SameHost
             } else {
                 Tier::MovedHere
@@ -313,7 +314,8 @@ pub fn check_speed_with(
 pub struct SpeedCoverage {
     /// Backend.
     pub backend: BackendKind,
-    /// Which figures the limits count: the blessing host's, a recording's, or any host's.
+    /// Which figures the limits count: the blessing host's, a recording's, or any host's (on
+    /// another host, or on the blessing one before it measured its own: [`Tier::MovedHere`]).
     pub tier: Tier,
     /// Passes with a verdict against a limit.
     pub timed: usize,

@@ -86,4 +86,22 @@ fn figures_measured_for_goldens_moved_here_replace_the_previous_hosts() {
     let replaced = harness::golden::speed::measure::merged_replacing(old, measured, &moved);
     assert_eq!(figure(&replaced, "a"), (1.1, 1.4));
     assert_eq!(figure(&replaced, "b"), (1.5, 1.4));
+    // A pass no same-host source measured in this run (a placeholder) replaces nothing.
+    let mut placeholder = model_with(1.1, 1.4);
+    let entry = placeholder
+        .scenes
+        .get_mut("a")
+        .unwrap()
+        .get_mut(&BackendKind::Gl)
+        .unwrap()
+        .get_mut(&PassId::ToneMap)
+        .unwrap();
+    entry.host = 0.0;
+    entry.host_at = "-".to_owned();
+    let kept = harness::golden::speed::measure::merged_replacing(
+        model_with(1.5, 1.3),
+        placeholder,
+        &moved,
+    );
+    assert_eq!(figure(&kept, "a"), (1.5, 1.4));
 }

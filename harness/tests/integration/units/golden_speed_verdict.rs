@@ -474,3 +474,26 @@ fn a_pass_whose_targets_changed_is_not_compared_with_its_golden() {
     let slower = tonemap(&with_targets(9.0, "256x256 depth32f"), &old);
     assert_eq!(slower.outcome, SpeedOutcome::Slower);
 }
+
+/// A scene outside the canonical set has no figures of its own and borrows every scene's: on
+/// the blessing host its figures count as measured here when every scene it borrows from was
+/// measured here (it was `moved-here` for ever before, whatever the model said).
+#[test]
+fn a_scene_that_borrows_figures_is_read_as_the_hosts_that_measured_them() {
+    let mut goldens = TimingGoldens::default();
+    let mut other = probe(3.0, 4.0);
+    other.scene = "elsewhere.toml".to_owned();
+    goldens.record(&other, &[], &stamp("here", &cpu_signature()));
+    let tier = |noise: &TimingNoise| {
+        let checks = check_speed(&other, &goldens, noise, "here");
+        (checks[0].tier, checks[0].borrowed)
+    };
+    assert_eq!(tier(&model()), (Tier::SameHost, true));
+    assert_eq!(
+        tier(&model_measured_on("the previous blessing host")),
+        (Tier::MovedHere, true)
+    );
+    let mut unstamped = model();
+    unstamped.measured_on.clear();
+    assert_eq!(tier(&unstamped), (Tier::MovedHere, true));
+}
