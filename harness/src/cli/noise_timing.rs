@@ -245,37 +245,44 @@ fn blessed_elsewhere(
     hosts: &[(BackendKind, String)],
 ) -> anyhow::Result<Option<(String, String)>> {
     let cpu = harness::golden::speed::cpu_signature();
-    let mut elsewhere: Vec<&str> = Vec::new();
+    // Each scene blessed elsewhere: the first backend found so, where it was blessed, and
+    // whether that names a CPU.
+    let mut elsewhere: Vec<(&str, BackendKind, String, bool)> = Vec::new();
     let mut here: Vec<&str> = Vec::new();
-    let mut first = None;
     for (scene, _) in scenes {
         let goldens = harness::golden::speed::TimingGoldens::load(root, scene)?;
         match goldens.blessed_elsewhere(hosts, &cpu) {
-            Some((kind, g)) => {
-                elsewhere.push(scene);
-                first.get_or_insert_with(|| {
-                    let known = harness::golden::speed::cpu_known(&g.cpu);
-                    (
-                        format!("{scene}'s timing goldens on {kind}"),
-                        known,
-                        g.blessed_by(),
-                    )
-                });
-            }
+            Some((kind, g)) => elsewhere.push((
+                scene,
+                kind,
+                g.blessed_by(),
+                harness::golden::speed::cpu_known(&g.cpu),
+            )),
             None => here.push(scene),
         }
     }
-    let Some((first, cpu_known, blessed_by)) = first else {
+    let Some((first, kind, blessed_by, cpu_known)) = elsewhere.first().cloned() else {
         return Ok(None);
     };
     let scene_args =
         |names: &[&str]| -> String { names.iter().map(|n| format!(" --scene {n}")).collect() };
-    let others = match &elsewhere[1..] {
+    // The scenes blessed where the first was are said with it; any others after it.
+    let (alike, unlike): (Vec<&str>, Vec<&str>) = {
+        let (alike, unlike): (Vec<_>, Vec<_>) = elsewhere[1..]
+            .iter()
+            .partition(|(_, _, by, _)| *by == blessed_by);
+        (
+            alike.iter().map(|(scene, ..)| *scene).collect(),
+            unlike.iter().map(|(scene, ..)| *scene).collect(),
+        )
+    };
+    let others = match alike.as_slice() {
         [] => String::new(),
         [one] => format!(" (and {one}'s)"),
         [many @ .., last] => format!(" (and {}'s and {last}'s)", many.join("'s, ")),
     };
-    let why = if cpu_known {
+    let first = format!("{first}'s timing goldens on {kind}");
+    let mut why = if cpu_known {
         format!("{first}{others} were blessed on {blessed_by}, not on this host ({cpu})")
     } else {
         format!(
@@ -283,6 +290,13 @@ fn blessed_elsewhere(
              this one included, is taken for the one that blessed them"
         )
     };
+    if !unlike.is_empty() {
+        why += &format!(
+            "; {}'s were blessed on other hosts, not here, too",
+            unlike.join("'s, ")
+        );
+    }
+    let elsewhere: Vec<&str> = elsewhere.iter().map(|(scene, ..)| *scene).collect();
     let measure_here = if here.is_empty() {
         String::new()
     } else {
@@ -296,7 +310,7 @@ fn blessed_elsewhere(
         .find(|(_, r)| {
             hosts
                 .iter()
-                .any(|(kind, host)| r.records(*kind, host, &cpu))
+                .all(|(kind, host)| r.records(*kind, host, &cpu))
         })
         .map(|(name, _)| name);
     let record = match recorded {
