@@ -80,7 +80,7 @@ impl BackendTimings {
     /// blessing EPYC's fingerprint, and its ratios lay up to x1.39 from the goldens, next to
     /// the blessing host's limits of x1.44.
     pub fn blessed_on(&self, host: &str, cpu: &str) -> bool {
-        self.host == host && super::cpu_known(&self.cpu) && self.cpu == cpu
+        super::same_host(&self.host, &self.cpu, host, cpu)
     }
 
     /// Where these goldens were blessed, as a refusal names it: the host's fingerprint and

@@ -169,6 +169,14 @@ pub fn cpu_known(signature: &str) -> bool {
     !signature.is_empty() && !signature.contains('?')
 }
 
+/// Whether a host written down as `their_host` (its driver fingerprint for a backend) and
+/// `their_cpu` is this one (`host`, `cpu`): the same fingerprint and a known, equal CPU
+/// signature. The one rule for the blessing host, a recorded host and the host that measured
+/// the model's same-host figures.
+pub fn same_host(their_host: &str, their_cpu: &str, host: &str, cpu: &str) -> bool {
+    their_host == host && cpu_known(their_cpu) && their_cpu == cpu
+}
+
 /// The first CPU's `name` field in `/proc/cpuinfo`, trimmed. The file is read once per process
 /// (a check asks for the CPU per scene and backend, and the CPU does not change under it).
 fn cpuinfo_field(name: &str) -> Option<String> {

@@ -170,7 +170,7 @@ impl TimingNoise {
         self.measured_on
             .get(scene)
             .and_then(|b| b.get(&backend))
-            .is_some_and(|m| m.host == host && super::cpu_known(&m.cpu) && m.cpu == cpu)
+            .is_some_and(|m| super::same_host(&m.host, &m.cpu, host, cpu))
     }
 
     /// Whether the same-host figures a check of `scene` on `backend` reads were measured on

@@ -135,7 +135,9 @@ impl RecordedTimings {
     /// Whether this is the recording of the host whose `kind` backend has fingerprint `host`,
     /// on CPU signature `cpu` (a known one: see [`super::cpu_known`]).
     pub fn records(&self, kind: BackendKind, host: &str, cpu: &str) -> bool {
-        super::cpu_known(cpu) && self.cpu == cpu && self.hosts.get(&kind).is_some_and(|h| h == host)
+        self.hosts
+            .get(&kind)
+            .is_some_and(|h| super::same_host(h, &self.cpu, host, cpu))
     }
 
     /// The file of the host `name` under the golden root.
