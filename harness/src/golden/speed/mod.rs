@@ -74,8 +74,8 @@ pub const MIN_NOISE_SHORT: f64 = 1.3;
 /// On host-c, fresh checks came out up to x1.45 above the median of a recording of 57 ratios
 /// whose largest was x1.21 above it (ibl's lighting on wgpu-vulkan, 2026-11-26).
 pub const MIN_NOISE_RECORDED: f64 = MIN_NOISE_SHORT;
-/// A limit that would not catch a pass taking this many times as long is no check: such a pass
-/// is untimed, with the reason.
+/// A limit that would not catch a pass taking this many times as long is no check of ordinary
+/// slowdowns: such a pass is untimed, with the reason, and fails only beyond its limit.
 pub const MUST_CATCH: f64 = 2.0;
 /// Passes faster than this (their fastest sample, ms) are too short to time: timer resolution
 /// and fixed costs dominate.

@@ -104,6 +104,13 @@ fn a_slower_pass_fails_a_faster_one_is_a_note_and_noise_decides_what_is_timed() 
         "{noisy:?}"
     );
     assert!(!noisy.failed());
+    // Untimed for a doubling, it still fails beyond its wide limit: x3 is no noise measured.
+    let far = verdict(&probe(3.0, 12.0), "there", PassId::Geometry);
+    assert_eq!(
+        (far.outcome.clone(), far.tier),
+        (SpeedOutcome::Slower, Tier::OtherHost)
+    );
+    assert!(far.failed() && far.score().unwrap() > 1.0, "{far:?}");
     assert_eq!(
         verdict(&probe(3.0, 8.0), "here", PassId::Geometry).outcome,
         SpeedOutcome::Slower
