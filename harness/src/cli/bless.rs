@@ -8,6 +8,7 @@ use engine::plan::TargetId;
 use engine::renderer::Readback;
 use harness::golden::bless::{bless_pass, BlessOutcome, BlessRequest};
 
+use super::bless_speed::{bless_speed, timed_passes};
 use super::load_cases;
 
 /// The command line of `harness bless`.
@@ -16,14 +17,17 @@ pub(crate) struct BlessArgs {
     /// Only this scene: a name in scenes/ or a path to a scene file (repeatable).
     #[arg(long = "scene")]
     scenes: Vec<String>,
-    /// Only this pass (repeatable); a pass named here is rewritten even within tolerance.
+    /// Only this pass (repeatable); a pass named here is rewritten even within tolerance. With
+    /// --speed-only, a timed pass as `check`'s speed table names it (lighting_pbr, mask, ...).
     #[arg(long = "pass")]
     passes: Vec<String>,
     /// Rewrite every pass considered, also those within tolerance (after a driver change).
     #[arg(long)]
     every_pass: bool,
     /// Backend to render the goldens with (default gl); with --from-last-check, whose outputs
-    /// to accept (default: the reference among those the check checked, gl when it did).
+    /// to accept (default: the reference among those the check checked, gl when it did); with
+    /// --speed-only, the one backend whose timing goldens to bless (default: every available
+    /// one).
     #[arg(long)]
     backend: Option<BackendKind>,
     /// Bless every canonical scene: the passes that moved beyond their limits or have no golden
@@ -90,6 +94,7 @@ pub(crate) fn command(args: BlessArgs) -> anyhow::Result<ExitCode> {
                 dry_run: args.dry_run,
                 images: !args.speed_only,
                 speed: !args.no_speed,
+                speed_backend: None,
                 unverified: args.unverified,
                 reason: args.reason.clone(),
             },
@@ -105,6 +110,7 @@ pub(crate) fn command(args: BlessArgs) -> anyhow::Result<ExitCode> {
             dry_run: args.dry_run,
             images: !args.speed_only,
             speed: !args.no_speed,
+            speed_backend: args.backend.filter(|_| args.speed_only),
             unverified: args.unverified,
             reason: args.reason,
         },
@@ -121,6 +127,8 @@ pub(crate) struct Options {
     pub images: bool,
     /// Bless the timing goldens (on every available backend).
     pub speed: bool,
+    /// With the timings alone, the one backend asked for (`--backend`); else every available.
+    pub speed_backend: Option<BackendKind>,
     /// Write new image goldens without verifying that they reproduce.
     pub unverified: bool,
     /// Why the pictures or timings changed, recorded beside each golden written.
@@ -165,7 +173,14 @@ pub(crate) fn run(
         refused = bless_images(&cases, &store, &locks, passes, kind, &options)?;
     }
     if options.speed {
-        let refused_timings = bless_speed(&cases, &store, &options)?;
+        // `--pass` names timed passes when the timings alone are blessed; with the images it
+        // names image passes, and the timings are rewritten where they moved.
+        let timed = if options.images {
+            Vec::new()
+        } else {
+            timed_passes(&cases, &store, passes)?
+        };
+        let refused_timings = bless_speed(&cases, &store, &timed, &options)?;
         // Timings alone were asked for: a backend whose goldens another host blessed, kept,
         // is a refusal (with images, keeping them is what a bless elsewhere does).
         if refused_timings > 0 && !options.images {
@@ -181,74 +196,6 @@ pub(crate) fn run(
     } else {
         ExitCode::FAILURE
     })
-}
-
-/// Probes every available backend and rewrites the timing goldens that moved; returns how
-/// many scenes' backends it kept whole as another host's.
-fn bless_speed(
-    cases: &[harness::golden::suite::Case],
-    store: &harness::golden::GoldenStore,
-    options: &Options,
-) -> anyhow::Result<usize> {
-    let backends: Vec<(BackendKind, String)> = BackendKind::ALL
-        .into_iter()
-        .filter_map(|kind| {
-            let status = engine::backend::probe(kind);
-            match (status.available, status.info) {
-                (true, Some(info)) => Some((kind, harness::golden::fingerprint(&info))),
-                _ => {
-                    eprintln!("note: no timing goldens for {kind}: it is unavailable here");
-                    None
-                }
-            }
-        })
-        .collect();
-    let scenes: Vec<(String, String)> = cases
-        .iter()
-        .map(|c| (c.name().to_owned(), c.argument()))
-        .collect();
-    let lines = harness::golden::speed::bless_scenes(
-        &std::env::current_exe()?,
-        store.root(),
-        &scenes,
-        &backends,
-        harness::golden::speed::TimingBless {
-            every_pass: options.every_pass,
-            // Another host's timing goldens move here only when timings alone were asked for.
-            move_here: options.every_pass && !options.images,
-            dry_run: options.dry_run,
-            reason: options.reason.as_deref(),
-        },
-        |what| eprintln!("{what} ..."),
-    )?;
-    for line in &lines {
-        println!("{line}");
-    }
-    let moved: std::collections::BTreeSet<&str> = lines
-        .iter()
-        .filter(|l| l.moved_here && l.fate == harness::golden::speed::bless::Fate::Rewritten)
-        .map(|l| l.scene.as_str())
-        .collect();
-    if !moved.is_empty() {
-        // The model's same-host figures are the previous blessing host's noise, and a check
-        // here reads them at the limits for any host until they are measured here.
-        let names: Vec<&str> = moved.into_iter().collect();
-        let scenes: String = names.iter().map(|n| format!(" --scene {n}")).collect();
-        println!(
-            "note: {} timing goldens are this host's now, but golden/timing-noise.toml's \
-             same-host figures for them were measured on another host (or before the model \
-             kept where), so until this host's are measured its checks read them at the limits \
-             for any host. Measure them: `harness noise --timing --write{scenes}` (without the \
-             second Mesa: `harness noise --timing --write{scenes} --source runs --source \
-             busy-neighbour`). The recordings in golden/evidence/ were taken against the \
-             goldens replaced, and no longer apply to them",
-            names.join(", ")
-        );
-    }
-    Ok(lines
-        .iter()
-        .filter(|l| l.pass.is_none() && l.fate == harness::golden::speed::bless::Fate::Kept)
-        .count())
 }
 
 /// Whether `candidates`, the new goldens of `case`, reproduce under every verification source

@@ -368,12 +368,30 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
         report.display()
     );
     if failed > 0 {
-        println!("failure images: {failures}");
+        if run.results.iter().any(|r| !r.outcome.passed()) {
+            println!("failure images: {failures}");
+        }
         let commands = run.bless_commands();
-        let kept = if run.verifications.is_empty() {
-            ""
-        } else {
-            "; or accept what this check kept, as above"
+        // Slower passes whose timing goldens a bless from here writes: the check's own figures
+        // can be accepted as they are, as its kept images can.
+        let acceptable_timings = run.speed.checks.iter().any(|c| {
+            c.outcome == harness::golden::speed::SpeedOutcome::Slower && c.tier.bless_writes_here()
+        });
+        let kept = match (run.verifications.is_empty(), acceptable_timings) {
+            (true, false) => String::new(),
+            (false, false) => "; or accept what this check kept, as above".to_owned(),
+            (verified, true) => format!(
+                "; or {} the timings this check measured, probing nothing again: `{} \
+                 --speed-only`",
+                if verified {
+                    "accept"
+                } else {
+                    "accept what it kept, as above, and"
+                },
+                harness::golden::command_line::accept_command(
+                    report.parent().filter(|dir| *dir != default_out_dir())
+                )
+            ),
         };
         println!(
             "after reviewing the report, bless what changed on purpose (one command per \
@@ -504,7 +522,9 @@ fn print_speed(run: &CheckRun) {
         run.speed
             .checks
             .iter()
-            .filter(|c| c.outcome == SpeedOutcome::Faster && c.tier.blessed_here() == same_host)
+            .filter(|c| {
+                c.outcome == SpeedOutcome::Faster && c.tier.bless_writes_here() == same_host
+            })
             .map(|c| format!("{}/{} on {}", c.scene, c.pass, c.backend))
             .collect()
     };
@@ -518,9 +538,10 @@ fn print_speed(run: &CheckRun) {
     }
     if !elsewhere.is_empty() {
         println!(
-            "note: faster beyond the limit, on a host that did not bless the timing goldens \
-             (ratios differ between hosts: record this host, or record it again, with `harness \
-             noise --timing --record-host NAME`, or move the timing goldens here whole with \
+            "note: faster beyond the limit, on a host that neither blessed the timing goldens \
+             nor is recorded against them (ratios differ between hosts: record this host, or \
+             record it again, with `harness noise --timing --record-host NAME`, then bless \
+             with `--speed-only`; or move the timing goldens here whole with \
              `harness bless --scene S --speed-only --every-pass`): {}",
             elsewhere.join(", ")
         );

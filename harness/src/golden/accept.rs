@@ -16,6 +16,7 @@ use super::bless::{bless_pass, BlessRequest, BlessedPass};
 use super::check::CheckRun;
 use super::suite::{Case, PassCheck};
 use super::{GoldenStore, SceneLock};
+pub use crate::golden::speed::accept::{accept_timings, KeptTiming, TimingAcceptance};
 
 /// The file `check` keeps its results in, under its output folder.
 pub const LAST_CHECK: &str = "last-check.json";
@@ -336,136 +337,6 @@ impl CheckContext {
     pub fn scene_argument<'a>(&'a self, scene: &'a str) -> &'a str {
         self.arguments.get(scene).map_or(scene, String::as_str)
     }
-}
-
-/// What accepting a scene's speed checks did ([`accept_timings`]).
-#[derive(Debug, Default)]
-pub struct TimingAcceptance {
-    /// A line per timing golden written (or, in a dry run, that would be).
-    pub written: Vec<String>,
-    /// The speed checks not accepted.
-    pub kept: Vec<KeptTiming>,
-}
-
-/// A speed check not accepted as its timing golden, and why.
-#[derive(Debug)]
-pub struct KeptTiming {
-    /// The plan pass.
-    pub pass: engine::plan::PassId,
-    /// The backend.
-    pub backend: BackendKind,
-    /// One line: the check and why it was not accepted.
-    pub why: String,
-}
-
-/// Records `checks` (those of the locked scene) as its timing goldens: each pass's ratio as the
-/// check measured it (its fastest time and its floor's), with `reason` beside each; nothing with
-/// `dry_run`. A check is kept out, with why, where it ran on a host that did not bless the
-/// backend's timing goldens (it measured another host's ratio, and one backend's goldens are one
-/// host's, see [`crate::golden::speed::kept_as_another_hosts`]) and where the backend has no
-/// timing goldens yet (a first golden is a bless's three probes, not one check). The check must
-/// have judged it on the blessing host (its tier, decided where it ran), and that host
-/// (`check`, [`speed_candidates`]) must still have blessed the section as the file is now, so a
-/// section re-blessed elsewhere since the check is not written into.
-pub fn accept_timings(
-    store: &GoldenStore,
-    lock: &SceneLock,
-    checks: &[crate::golden::speed::SpeedCheck],
-    check: &CheckContext,
-    dry_run: bool,
-    reason: Option<&str>,
-) -> Result<TimingAcceptance, String> {
-    use crate::golden::speed::{cpu_signature, Stamp, TimingGoldens};
-    use crate::measure::speed::{PassSpeed, SceneSpeed};
-    let scene = lock.scene();
-    // Timings of the scene as it was are not the scene's as it is, as for its images.
-    if let Some(then) = check.inputs.iter().find(|i| i.scene == scene) {
-        let changed = then.changed_on_disk(&crate::workspace_root());
-        if let Some(why) = then.refusal(&changed, check.scene_argument(scene), Some(&check.out)) {
-            return Err(why);
-        }
-    }
-    let cpu = cpu_signature();
-    let mut goldens = TimingGoldens::load(store.root(), scene).map_err(|e| e.to_string())?;
-    let blessed = humantime::format_rfc3339_seconds(SystemTime::now()).to_string();
-    let bless = |on_blessing_host| {
-        crate::golden::command_line::speed_bless_command(
-            check.scene_argument(scene),
-            on_blessing_host,
-        )
-    };
-    let mut done = TimingAcceptance::default();
-    for c in checks.iter().filter(|c| c.scene == scene) {
-        let name = format!("{scene}/{} on {} (speed)", c.pass, c.backend);
-        let kept = |why: String| KeptTiming {
-            pass: c.pass,
-            backend: c.backend,
-            why: format!("{name}: not accepted: {why}"),
-        };
-        let Some(section) = goldens.backends.get(&c.backend) else {
-            done.kept.push(kept(format!(
-                "no timing goldens there yet, and one check's probe is not one; bless them \
-                 with `{}`",
-                bless(true)
-            )));
-            continue;
-        };
-        // Judged on the blessing host by the check (the CPU it ran on), and still that host's
-        // section now (not re-blessed elsewhere since).
-        let blessed_here = c.tier.blessed_here()
-            && check
-                .hosts
-                .get(&c.backend)
-                .is_some_and(|host| section.blessed_on(host, &cpu));
-        if !blessed_here {
-            done.kept.push(kept(format!(
-                "the check ran on a host that did not bless {}'s timing goldens (blessed on \
-                 {}), and a backend's timing goldens are one host's ratios. To move them all \
-                 to this host: `{}`",
-                c.backend,
-                section.blessed_by(),
-                bless(false)
-            )));
-            continue;
-        }
-        // The check's host blessed the section: its stamp stays.
-        let (section_host, section_cpu) = (section.host.clone(), section.cpu.clone());
-        // The check's figures as a probe of one sample: its fastest time over its floor's.
-        let probe = SceneSpeed {
-            scene: scene.to_owned(),
-            backend: c.backend,
-            rounds: 1,
-            passes: vec![PassSpeed {
-                pass: c.pass,
-                pass_ms: vec![c.ms],
-                floor_ms: vec![c.ms / c.ratio],
-                targets: c.targets.clone(),
-                unslowed_ms: Vec::new(),
-            }],
-        };
-        let stamp = Stamp {
-            host: &section_host,
-            cpu: &section_cpu,
-            blessed: &blessed,
-            reason,
-        };
-        goldens.record(&probe, &[c.pass], &stamp);
-        done.written.push(format!(
-            "{name}: ratio {:.3} as the check measured it; {}",
-            c.ratio,
-            if dry_run {
-                "would be written"
-            } else {
-                "written"
-            }
-        ));
-    }
-    if !dry_run && !done.written.is_empty() {
-        goldens
-            .save(store.root(), scene)
-            .map_err(|e| e.to_string())?;
-    }
-    Ok(done)
 }
 
 /// What accepting one scene's candidates did ([`accept_scene`]).

@@ -29,11 +29,13 @@ pub fn check_command(scene: &str, out: Option<&std::path::Path>) -> String {
     )
 }
 
-/// The command that blesses a deliberate change of `scene`'s timings: `--speed-only` on the
-/// host that blessed its timing goldens; elsewhere, where a bless keeps another host's timing
-/// goldens, with `--every-pass`, which moves a backend's to this host whole.
-pub fn speed_bless_command(scene: &str, on_blessing_host: bool) -> String {
-    let flags = if on_blessing_host {
+/// The command that blesses a deliberate change of `scene`'s timings: `--speed-only` where a
+/// bless writes them from here (`writes_here`: the host that blessed its timing goldens, or
+/// one recorded against them, [`Tier::bless_writes_here`](crate::golden::speed::Tier));
+/// elsewhere, where a bless keeps another host's timing goldens, with `--every-pass`, which
+/// moves a backend's to this host whole.
+pub fn speed_bless_command(scene: &str, writes_here: bool) -> String {
+    let flags = if writes_here {
         "--speed-only"
     } else {
         MOVE_TIMINGS_HERE

@@ -132,13 +132,14 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
     if run.speed.checks.is_empty() && run.speed.errors.is_empty() {
         return;
     }
-    // A timing bless writes on the host that blessed the goldens only; elsewhere the command
-    // that moves them here is the one to offer.
-    let elsewhere = run.speed.checks.iter().any(|c| !c.tier.blessed_here());
+    // A timing bless writes on the host that blessed the goldens, or scaled from a recorded
+    // one; elsewhere the command that moves them here is the one to offer.
+    let elsewhere = run.speed.checks.iter().any(|c| !c.tier.bless_writes_here());
     let bless = if elsewhere {
-        "this host did not bless the timing goldens: if intended, <code>harness bless --scene \
-         S --speed-only --every-pass</code> moves them here, every pass (or bless with \
-         <code>--speed-only</code> on the host that did, where the goldens name one)"
+        "this host neither blessed the timing goldens nor is recorded against them: if \
+         intended, record it (<code>harness noise --timing --record-host NAME</code>) and bless \
+         with <code>harness bless --scene S --speed-only</code>, or move them here, every pass, \
+         with <code>--speed-only --every-pass</code>"
     } else {
         "bless it with <code>harness bless --scene S --speed-only</code> if intended"
     };
@@ -200,7 +201,7 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
         out.push_str("</ul>");
     }
     if let Some(advice) = crate::golden::speed::verdict::record_advice(&coverage) {
-        let _ = write!(out, "<p class=\"note\">Note: {}.</p>", escape(advice));
+        let _ = write!(out, "<p class=\"note\">Note: {}.</p>", escape(&advice));
     }
     for note in &run.speed.host_notes {
         let _ = write!(out, "<p class=\"note\">Note: {}.</p>", escape(note));

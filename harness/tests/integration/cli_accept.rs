@@ -377,12 +377,21 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
     assert_eq!(check(), (Some(0), vec![]));
 }
 
-/// `bless --speed-only` where another host blessed every backend's timing goldens writes
-/// nothing and says so: each backend kept with why and the command that moves them, and exit
-/// 1 (a script must not take it for a bless). Nothing is probed.
+/// `bless --speed-only` where another host blessed every backend's timing goldens, on a host
+/// not recorded against them, writes nothing and says so: each backend kept with why and the
+/// commands that record this host or move the goldens, and exit 1 (a script must not take it
+/// for a bless). Nothing is probed.
 #[test]
 fn a_speed_only_bless_that_keeps_another_hosts_goldens_fails() {
     let root = common::temp_workspace();
+    // No host recorded: this one may be among golden/evidence/'s (a recorded host blesses
+    // its slowdowns scaled into the blessing host's terms instead).
+    for entry in std::fs::read_dir(root.path().join("golden/evidence")).unwrap() {
+        let recording = entry.unwrap().path().join("timing.toml");
+        if recording.exists() {
+            std::fs::remove_file(recording).unwrap();
+        }
+    }
     let timing = root.path().join("golden/arrow/timing.toml");
     let text = std::fs::read_to_string(&timing).unwrap();
     let elsewhere: String = text
@@ -409,7 +418,9 @@ fn a_speed_only_bless_that_keeps_another_hosts_goldens_fails() {
     }
     assert_eq!(output.status.code(), Some(1), "{stdout}{stderr}");
     assert!(
-        stdout.contains("(speed): kept: ") && stdout.contains("--every-pass"),
+        stdout.contains("(speed): kept: ")
+            && stdout.contains("--record-host NAME")
+            && stdout.contains("--every-pass"),
         "{stdout}"
     );
     assert!(

@@ -8,9 +8,10 @@ use std::collections::BTreeMap;
 use engine::backend::BackendKind;
 use engine::plan::PassId;
 
+use super::recorded::RecordedTimings;
 use super::{
-    check_speed, host_fingerprint, BackendTimings, SpeedError, SpeedOutcome, TimingGoldens,
-    TimingNoise, BLESS_PROBES, CHECK_ROUNDS,
+    check_speed_with, host_fingerprint, BackendTimings, PassTiming, SpeedCheck, SpeedError,
+    SpeedOutcome, Tier, TimingGoldens, TimingNoise, BLESS_PROBES, CHECK_ROUNDS,
 };
 use crate::measure::speed::{PassSpeed, SceneSpeed};
 
@@ -122,11 +123,87 @@ pub fn kept_as_another_hosts(
     }
     Some(format!(
         "blessed on another host ({}, {}); a backend's timing goldens are one host's ratios, \
-         so none is rewritten from here. To move every backend's to this host: {}",
+         so none is rewritten from here. A recorded host blesses a slowdown into them scaled \
+         by its own recording (`harness noise --timing --record-host NAME` records this one); \
+         to move every backend's to this host instead: {}",
         existing.blessed_by(),
         existing.blessed,
         crate::golden::command_line::speed_bless_command(argument, false)
     ))
+}
+
+/// Writes the timing golden of `check`'s pass, a check on a recorded host
+/// ([`Tier::RecordedHost`]), in the terms of the host that blessed the section: the golden now
+/// times the slowdown the check measured against this host's own recording of that golden
+/// ([`TimingGoldens::record_scaled`]), `reason` beside it, on `date`. Returns the new ratio,
+/// or why the check cannot be carried over (another tier, no golden or recorded reference).
+pub fn record_scaled_check(
+    goldens: &mut TimingGoldens,
+    check: &SpeedCheck,
+    date: &str,
+    reason: Option<&str>,
+) -> Result<f64, String> {
+    let (Tier::RecordedHost, Some(reference), Some(slowdown)) =
+        (check.tier, check.golden, check.slowdown())
+    else {
+        return Err(
+            "not read against a current recording of this host, so there is no slowdown to \
+             carry into the blessing host's terms"
+                .to_owned(),
+        );
+    };
+    let before = goldens
+        .backends
+        .get(&check.backend)
+        .and_then(|b| b.passes.get(&check.pass))
+        .map(|p| p.ratio)
+        .ok_or_else(|| "no timing golden to scale".to_owned())?;
+    let recording = check
+        .noise
+        .as_ref()
+        .map_or("this host's recording", |(_, at)| at.as_str());
+    let measured = PassTiming {
+        ratio: check.ratio,
+        ms: check.ms,
+        floor_ms: check.ms / check.ratio,
+        targets: check.targets.clone(),
+        reason: reason.map(str::to_owned),
+        scaled: None,
+    };
+    let how = format!(
+        "{date}: x{slowdown:.3} against {recording} (ratio {:.3} over its median {reference:.3}) \
+         times the golden before, {before:.4}",
+        check.ratio
+    );
+    goldens
+        .record_scaled(check.backend, check.pass, slowdown, &measured, how)
+        .ok_or_else(|| "no timing golden to scale".to_owned())
+}
+
+/// The name of the recording in `recordings` that holds this host (`host`, `cpu`) on `kind`.
+fn recorded_as<'a>(
+    recordings: &'a [(String, RecordedTimings)],
+    kind: BackendKind,
+    host: &str,
+    cpu: &str,
+) -> Option<&'a str> {
+    recordings
+        .iter()
+        .find(|(_, r)| r.records(kind, host, cpu))
+        .map(|(name, _)| name.as_str())
+}
+
+/// How a timing bless may write a scene's goldens on a backend.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Writing {
+    /// This host's own ratios (the section is this host's, new, or moving here whole).
+    Own {
+        /// Moving another host's section here: every pass, the old section replaced.
+        moving: bool,
+    },
+    /// Another host's section, this host recorded: slowdowns against the recording, scaled
+    /// into that host's terms ([`record_scaled_check`]).
+    Scaled,
 }
 
 /// Which timing goldens a bless rewrites, and what it records beside them.
@@ -142,6 +219,16 @@ pub struct TimingBless<'a> {
     pub dry_run: bool,
     /// Why the passes written changed (`--reason`), recorded beside each.
     pub reason: Option<&'a str>,
+    /// Only these passes (every one when empty), each rewritten even within its limit, as
+    /// `bless --speed-only --pass` names them.
+    pub passes: &'a [PassId],
+}
+
+impl TimingBless<'_> {
+    /// Whether `pass` is among those asked for.
+    fn names(&self, pass: PassId) -> bool {
+        self.passes.is_empty() || self.passes.contains(&pass)
+    }
 }
 
 /// Probes `scenes` (name, command-line argument) on each of `backends` (with its driver
@@ -164,15 +251,21 @@ pub fn bless_scenes(
     } else {
         Fate::Rewritten
     };
+    let recordings = super::recorded::load_all(root)?;
     let mut lines = Vec::new();
     for (kind, driver) in backends {
         let host = host_fingerprint(driver);
-        // Decided before probing: a backend whose goldens are all another host's is not probed.
+        let recorded = recorded_as(&recordings, *kind, &host, &cpu);
+        // Decided before probing: a backend whose goldens are all another host's is not probed,
+        // unless this host is recorded (then its slowdowns are carried over, scaled).
         let mut writable = Vec::new();
         for (scene, argument) in scenes {
             let goldens = TimingGoldens::load(root, scene)?;
             let existing = goldens.backends.get(kind);
             match kept_as_another_hosts(existing, &host, &cpu, options.move_here, argument) {
+                Some(_) if recorded.is_some() => {
+                    writable.push((scene.clone(), argument.clone(), Writing::Scaled));
+                }
                 Some(why) => lines.push(SpeedBlessed {
                     scene: scene.clone(),
                     backend: *kind,
@@ -182,9 +275,8 @@ pub fn bless_scenes(
                     moved_here: false,
                 }),
                 None => {
-                    // Moving another host's goldens here: every pass, the old section replaced.
                     let moving = existing.is_some_and(|e| !e.blessed_on(&host, &cpu));
-                    writable.push((scene.clone(), argument.clone(), moving));
+                    writable.push((scene.clone(), argument.clone(), Writing::Own { moving }));
                 }
             }
         }
@@ -212,53 +304,152 @@ pub fn bless_scenes(
                 probes.entry(result.scene.clone()).or_default().push(result);
             }
         }
-        for (scene, _, moving) in &writable {
-            let every_pass = options.every_pass || *moving;
+        for (scene, _, writing) in &writable {
             let Some(probe) = probes.get(scene).and_then(|p| median_probe(p)) else {
                 return Err(SpeedError::Probe(format!(
                     "{kind}: scene {scene} was not probed"
                 )));
             };
             let mut goldens = TimingGoldens::load(root, scene)?;
-            let checks = check_speed(&probe, &goldens, &noise, &host);
-            let mut rewrite = Vec::new();
-            for check in &checks {
-                let moved = matches!(
-                    check.outcome,
-                    SpeedOutcome::Slower
-                        | SpeedOutcome::Faster
-                        | SpeedOutcome::MissingGolden
-                        | SpeedOutcome::TargetsChanged(_)
-                );
-                let written = every_pass || moved;
-                if written {
-                    rewrite.push(check.pass);
+            // Judged as a check on this host judges it (against its recording where current).
+            let checks = check_speed_with(&probe, &goldens, &noise, &host, &recordings);
+            let written = match writing {
+                Writing::Scaled => bless_scaled(&mut goldens, &checks, options, &blessed, fate),
+                Writing::Own { moving } => {
+                    let stamp = super::Stamp {
+                        host: &host,
+                        cpu: &cpu,
+                        blessed: &blessed,
+                        reason: options.reason,
+                    };
+                    bless_own(
+                        &mut goldens,
+                        &probe,
+                        &checks,
+                        *moving,
+                        options,
+                        &stamp,
+                        fate,
+                    )
                 }
-                lines.push(SpeedBlessed {
-                    scene: scene.clone(),
-                    backend: *kind,
-                    pass: Some(check.pass),
-                    previous: check.describe(),
-                    fate: if written { fate } else { Fate::Kept },
-                    moved_here: *moving,
-                });
-            }
-            if !rewrite.is_empty() && !options.dry_run {
-                if every_pass {
-                    // Every pass is this probe's: none of another host's (or of a pass gone
-                    // from the plan) stays beside them.
-                    goldens.backends.remove(kind);
-                }
-                let stamp = super::Stamp {
-                    host: &host,
-                    cpu: &cpu,
-                    blessed: &blessed,
-                    reason: options.reason,
-                };
-                goldens.record(&probe, &rewrite, &stamp);
+            };
+            if !options.dry_run && written.iter().any(|l| l.fate == Fate::Rewritten) {
                 goldens.save(root, scene)?;
             }
+            lines.extend(written);
         }
     }
     Ok(lines)
+}
+
+/// Whether a check's verdict is a move a bless writes: beyond its limit either way, no golden
+/// yet, or other targets than its golden's.
+fn moved(outcome: &SpeedOutcome) -> bool {
+    matches!(
+        outcome,
+        SpeedOutcome::Slower
+            | SpeedOutcome::Faster
+            | SpeedOutcome::MissingGolden
+            | SpeedOutcome::TargetsChanged(_)
+    )
+}
+
+/// The lines of a bless of this host's own section ([`Writing::Own`]; `moving`: another
+/// host's, moving here whole): the passes that moved, every pass (`options.every_pass`, or
+/// moving), or the ones named, recorded from `probe` with `stamp`; nothing with
+/// `options.dry_run`. A move asked of named passes only is kept, with why: it takes every pass.
+fn bless_own(
+    goldens: &mut TimingGoldens,
+    probe: &SceneSpeed,
+    checks: &[SpeedCheck],
+    moving: bool,
+    options: TimingBless<'_>,
+    stamp: &super::Stamp<'_>,
+    fate: Fate,
+) -> Vec<SpeedBlessed> {
+    if moving && !options.passes.is_empty() {
+        return vec![SpeedBlessed {
+            scene: probe.scene.clone(),
+            backend: probe.backend,
+            pass: None,
+            previous: "another host's timing goldens move to this host whole, every pass, so \
+                       not with --pass: bless without it"
+                .to_owned(),
+            fate: Fate::Kept,
+            moved_here: false,
+        }];
+    }
+    let every_pass = options.every_pass || moving || !options.passes.is_empty();
+    let mut rewrite = Vec::new();
+    let mut lines = Vec::new();
+    for check in checks.iter().filter(|c| options.names(c.pass)) {
+        let written = every_pass || moved(&check.outcome);
+        if written {
+            rewrite.push(check.pass);
+        }
+        lines.push(SpeedBlessed {
+            scene: check.scene.clone(),
+            backend: check.backend,
+            pass: Some(check.pass),
+            previous: check.describe(),
+            fate: if written { fate } else { Fate::Kept },
+            moved_here: moving,
+        });
+    }
+    if !rewrite.is_empty() && !options.dry_run {
+        if moving || options.every_pass {
+            // Every pass is this probe's: none of another host's (or of a pass gone from the
+            // plan) stays beside them.
+            goldens.backends.remove(&probe.backend);
+        }
+        goldens.record(probe, &rewrite, stamp);
+    }
+    lines
+}
+
+/// The lines of a bless of another host's section from a recorded host ([`Writing::Scaled`]):
+/// each pass that moved beyond its limit against this host's recording (every pass with
+/// `options.every_pass`) is written scaled into the blessing host's terms
+/// ([`record_scaled_check`]); what cannot be scaled is kept, with why.
+fn bless_scaled(
+    goldens: &mut TimingGoldens,
+    checks: &[SpeedCheck],
+    options: TimingBless<'_>,
+    date: &str,
+    fate: Fate,
+) -> Vec<SpeedBlessed> {
+    checks
+        .iter()
+        .filter(|c| options.names(c.pass))
+        .map(|check| {
+            let mut previous = check.describe();
+            let mut this_fate = Fate::Kept;
+            if options.every_pass || !options.passes.is_empty() || moved(&check.outcome) {
+                let mut scaled = goldens.clone();
+                match record_scaled_check(&mut scaled, check, date, options.reason) {
+                    Ok(ratio) => {
+                        previous += &format!(
+                            "; carried into the blessing host's terms as ratio {ratio:.4} (this \
+                             host's recording of it is then of the golden before: the pass is \
+                             read at the limits for any host here until this host is recorded \
+                             again)"
+                        );
+                        if !options.dry_run {
+                            *goldens = scaled;
+                        }
+                        this_fate = fate;
+                    }
+                    Err(why) => previous += &format!("; not written: {why}"),
+                }
+            }
+            SpeedBlessed {
+                scene: check.scene.clone(),
+                backend: check.backend,
+                pass: Some(check.pass),
+                previous,
+                fate: this_fate,
+                moved_here: false,
+            }
+        })
+        .collect()
 }

@@ -40,6 +40,12 @@ pub struct PassTiming {
     /// dropped when the pass is recorded again without one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
+    /// Where the ratio was not measured on the blessing host but scaled into its terms: the
+    /// recorded host whose slowdown (against its own recording of the golden before) was
+    /// applied to that golden, as [`TimingGoldens::record_scaled`] wrote it. Dropped when the
+    /// pass is measured again.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scaled: Option<String>,
 }
 
 /// Who, where and why a timing bless records ([`TimingGoldens::record`]).
@@ -154,7 +160,11 @@ impl TimingGoldens {
         entry.blessed = stamp.blessed.to_owned();
         entry.host = stamp.host.to_owned();
         entry.cpu = stamp.cpu.to_owned();
-        entry.rounds = probe.rounds;
+        // The rounds of the probe that wrote the section; a few passes written into it (an
+        // accepted check's one sample) leave the figure of the rest.
+        if only.is_empty() || entry.passes.is_empty() {
+            entry.rounds = probe.rounds;
+        }
         for pass in &probe.passes {
             if !only.is_empty() && !only.contains(&pass.pass) {
                 continue;
@@ -164,8 +174,6 @@ impl TimingGoldens {
             else {
                 continue;
             };
-            // Rounded so the file reads well; no limit depends on the fifth digit.
-            let round = |x: f64, digits: i32| (x * 10f64.powi(digits)).round() / 10f64.powi(digits);
             entry.passes.insert(
                 pass.pass,
                 PassTiming {
@@ -174,8 +182,40 @@ impl TimingGoldens {
                     floor_ms: round(floor_ms, 3),
                     targets: pass.targets.clone(),
                     reason: stamp.reason.map(str::to_owned),
+                    scaled: None,
                 },
             );
         }
     }
+
+    /// Writes `pass`'s golden on `backend` as `slowdown` times the golden there now: a slowdown
+    /// measured on a recorded host against its own recording of that golden (its ratio over
+    /// the median of its recorded ones), carried into the blessing host's terms. The section's
+    /// host, CPU and time stay the blessing host's, `ms` and `floor_ms` are the recorded host's
+    /// (information only), and `scaled` says where the figure came from. `None` (nothing
+    /// written) where the pass has no golden to scale.
+    pub fn record_scaled(
+        &mut self,
+        backend: BackendKind,
+        pass: PassId,
+        slowdown: f64,
+        measured: &PassTiming,
+        scaled: String,
+    ) -> Option<f64> {
+        let timing = self.backends.get_mut(&backend)?.passes.get_mut(&pass)?;
+        let ratio = round(timing.ratio * slowdown, 4);
+        *timing = PassTiming {
+            ratio,
+            ms: round(measured.ms, 3),
+            floor_ms: round(measured.floor_ms, 3),
+            scaled: Some(scaled),
+            ..measured.clone()
+        };
+        Some(ratio)
+    }
+}
+
+/// `x` to `digits` decimals, so the file reads well; no limit depends on the fifth digit.
+fn round(x: f64, digits: i32) -> f64 {
+    (x * 10f64.powi(digits)).round() / 10f64.powi(digits)
 }

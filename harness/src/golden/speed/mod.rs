@@ -31,6 +31,7 @@
 //! ratio then does not depend on the host's core count, and a busy neighbour on a two-core
 //! machine leaves the rasterizer a core of its own.
 
+pub mod accept;
 pub mod bless;
 pub mod goldens;
 pub mod history;
@@ -43,7 +44,8 @@ pub mod verdict;
 use engine::backend::BackendKind;
 
 pub use bless::{
-    bless_scenes, kept_as_another_hosts, median_probe, Fate, SpeedBlessed, TimingBless,
+    bless_scenes, kept_as_another_hosts, median_probe, record_scaled_check, Fate, SpeedBlessed,
+    TimingBless,
 };
 pub use goldens::{BackendTimings, PassTiming, Stamp, TimingGoldens, TIMING_FILE};
 pub use model::{MeasuredOn, PassNoise, Tier, TimingNoise, TIMING_NOISE_FILE};

@@ -47,6 +47,15 @@ impl Tier {
     pub fn blessed_here(self) -> bool {
         matches!(self, Tier::SameHost | Tier::MovedHere)
     }
+
+    /// Whether a timing bless or accept on this host writes the goldens checked: its own
+    /// ([`Tier::blessed_here`]), or another host's read against this host's current recording,
+    /// a slowdown then carried into that host's terms
+    /// ([`record_scaled_check`](super::record_scaled_check)). At [`Tier::OtherHost`] only a
+    /// move of the whole backend here (`--speed-only --every-pass`) writes.
+    pub fn bless_writes_here(self) -> bool {
+        self.blessed_here() || self == Tier::RecordedHost
+    }
 }
 
 /// One pass's measured timing noise.

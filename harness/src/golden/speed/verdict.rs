@@ -387,13 +387,34 @@ pub const RECORD_THIS_HOST: &str = "this host is neither the one that blessed th
     catch less. `harness noise --timing --record-host NAME` records it \
     (golden/evidence/NAME/timing.toml, to commit); its checks then read against its own ratios";
 
-/// [`RECORD_THIS_HOST`] where some of `coverage` ran at [`Tier::OtherHost`]: the advice every
-/// place that shows the coverage adds under it.
-pub fn record_advice(coverage: &[SpeedCoverage]) -> Option<&'static str> {
-    coverage
+/// Where some of `coverage` ran at [`Tier::OtherHost`], the advice every place that shows the
+/// coverage adds under it: [`RECORD_THIS_HOST`], or, on a recorded host (other passes of the
+/// backend read against its recording), that those passes' goldens were blessed since the
+/// recording and the command that takes it again.
+pub fn record_advice(coverage: &[SpeedCoverage]) -> Option<String> {
+    let other: Vec<&SpeedCoverage> = coverage
         .iter()
-        .any(|c| c.tier == Tier::OtherHost)
-        .then_some(RECORD_THIS_HOST)
+        .filter(|c| c.tier == Tier::OtherHost)
+        .collect();
+    if other.is_empty() {
+        return None;
+    }
+    let recording = coverage
+        .iter()
+        .filter(|c| c.tier == Tier::RecordedHost && other.iter().any(|o| o.backend == c.backend))
+        .find_map(|c| c.recording.clone());
+    Some(match recording {
+        Some(recording) => {
+            let name = recording.strip_suffix("'s recording").unwrap_or("NAME");
+            format!(
+                "this host is recorded ({recording}), but some passes' timing goldens were \
+                 blessed since it was taken, so those were read at the limits for any host. \
+                 `harness noise --timing --record-host {name}` records this host again (to \
+                 commit)"
+            )
+        }
+        None => RECORD_THIS_HOST.to_owned(),
+    })
 }
 
 /// Per backend and tier, in the order the checks came: what the speed checks of a run can

@@ -119,11 +119,138 @@ fn a_timing_golden_is_accepted_only_on_the_host_that_blessed_it() {
     );
     let after = TimingGoldens::load(dir.path(), "arrow").unwrap();
     let gl = &after.backends[&BackendKind::Gl];
-    assert_eq!((gl.host.as_str(), gl.cpu.as_str()), (stamp.host, stamp.cpu));
+    // One check's sample written among the section's passes leaves its probe's rounds.
+    assert_eq!(
+        (gl.host.as_str(), gl.cpu.as_str(), gl.rounds),
+        (stamp.host, stamp.cpu, 4)
+    );
     let geometry = &gl.passes[&PassId::Geometry];
     assert_eq!(
         (geometry.ratio, geometry.reason.as_deref()),
         (6.0, Some("why"))
     );
     assert!(!after.backends.contains_key(&BackendKind::WgpuVulkan));
+}
+
+/// On a host recorded against the blessing host's timing goldens, a check is read against its
+/// own recording (`Tier::RecordedHost`): accepting it writes the slowdown it measured there
+/// (its ratio over the recording's median) times the golden, in the blessing host's terms,
+/// leaving the section's host, CPU and rounds as they were and saying where the figure came
+/// from; while that recording is still of the golden there, and not after the golden moved.
+#[test]
+fn a_recorded_host_accepts_a_slowdown_scaled_into_the_blessing_hosts_terms() {
+    use harness::golden::speed::recorded::{RecordedPass, RecordedTimings};
+    use std::collections::BTreeMap;
+    let dir = tempfile::tempdir().unwrap();
+    let store = GoldenStore::new(dir.path());
+    std::fs::create_dir_all(dir.path().join("arrow")).unwrap();
+    let cpu = cpu_signature();
+    let probe = SceneSpeed {
+        scene: "arrow".to_owned(),
+        backend: BackendKind::Gl,
+        rounds: 4,
+        passes: vec![PassSpeed {
+            pass: PassId::Geometry,
+            pass_ms: vec![2.0],
+            floor_ms: vec![1.0],
+            targets: None,
+            unslowed_ms: Vec::new(),
+        }],
+    };
+    let stamp = Stamp {
+        host: "the EPYC",
+        cpu: "family 25 model 1 stepping 1",
+        blessed: "t0",
+        reason: None,
+    };
+    let mut goldens = TimingGoldens::default();
+    goldens.record(&probe, &[], &stamp);
+    goldens.save(dir.path(), "arrow").unwrap();
+    // host-d reads the geometry at x1.2 of the golden (2.0): its median 2.4.
+    let recording = RecordedTimings {
+        recorded: "t1".to_owned(),
+        commit: None,
+        probes: BTreeMap::from([("runs".to_owned(), 3)]),
+        hosts: BTreeMap::from([(BackendKind::Gl, "host-d".to_owned())]),
+        cpu: cpu.clone(),
+        scenes: BTreeMap::from([(
+            "arrow".to_owned(),
+            BTreeMap::from([(
+                BackendKind::Gl,
+                BTreeMap::from([(
+                    PassId::Geometry,
+                    RecordedPass {
+                        ratios: BTreeMap::from([("runs".to_owned(), vec![2.3, 2.4, 2.5])]),
+                        golden: 2.0,
+                    },
+                )]),
+            )]),
+        )]),
+    };
+    let evidence = RecordedTimings::path(dir.path(), "host-d");
+    std::fs::create_dir_all(evidence.parent().unwrap()).unwrap();
+    recording.save(&evidence).unwrap();
+    let lock = store.lock_scene("arrow", |_| {}).unwrap();
+    // The check: x3 against host-d's recording (7.2 over 2.4).
+    let check = SpeedCheck {
+        ratio: 7.2,
+        golden: Some(2.4),
+        limit: Some(1.69),
+        noise: Some((1.04, "host-d's recording".to_owned())),
+        tier: Tier::RecordedHost,
+        ..slower(BackendKind::Gl)
+    };
+    let done = accept_timings(
+        &store,
+        &lock,
+        std::slice::from_ref(&check),
+        &on("host-d"),
+        false,
+        Some("why"),
+    )
+    .unwrap();
+    assert!(done.kept.is_empty(), "{done:?}");
+    let [written] = &done.written[..] else {
+        panic!("{done:?}")
+    };
+    assert!(
+        written.starts_with("arrow/geometry on gl (speed): x3.000 against host-d's recording")
+            && written.contains("as ratio 6.0000; written")
+            && written.contains("--record-host host-d"),
+        "{written}"
+    );
+    let after = TimingGoldens::load(dir.path(), "arrow").unwrap();
+    let gl = &after.backends[&BackendKind::Gl];
+    assert_eq!(
+        (
+            gl.host.as_str(),
+            gl.cpu.as_str(),
+            gl.rounds,
+            gl.blessed.as_str()
+        ),
+        (stamp.host, stamp.cpu, 4, "t0")
+    );
+    let geometry = &gl.passes[&PassId::Geometry];
+    assert_eq!(
+        (geometry.ratio, geometry.reason.as_deref()),
+        (6.0, Some("why"))
+    );
+    let scaled = geometry.scaled.as_deref().unwrap_or_default();
+    assert!(
+        scaled.contains("x3.000 against host-d's recording (ratio 7.200 over its median 2.400)")
+            && scaled.contains("the golden before, 2.0000"),
+        "{scaled}"
+    );
+    // The golden is 6.0 now, and host-d's recording of it is of 2.0: the same check (read
+    // against the recording then) is not carried over again.
+    let done = accept_timings(&store, &lock, &[check], &on("host-d"), false, None).unwrap();
+    assert!(
+        done.written.is_empty() && done.kept[0].why.contains("changed since: check again"),
+        "{done:?}"
+    );
+    assert_eq!(
+        TimingGoldens::load(dir.path(), "arrow").unwrap(),
+        after,
+        "nothing written"
+    );
 }

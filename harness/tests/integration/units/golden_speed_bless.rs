@@ -76,7 +76,96 @@ fn a_bless_keeps_another_hosts_timing_goldens_unless_every_pass_moves() {
         ..section.clone()
     };
     let why = kept_as_another_hosts(Some(&unsigned), "the EPYC", here.1, false, "arrow").unwrap();
-    assert!(why.contains("a CPU they do not record"), "{why}");
+    assert!(
+        why.contains("a CPU they do not record") && why.contains("--record-host NAME"),
+        "{why}"
+    );
+}
+
+/// A check read against this host's recording carries its slowdown into the blessing host's
+/// terms (golden x slowdown), with where it came from; a check at any other tier, or of a pass
+/// with no golden, writes nothing and says why.
+#[test]
+fn a_recorded_hosts_slowdown_is_written_as_the_golden_times_it() {
+    use harness::golden::speed::{SpeedCheck, SpeedOutcome, Stamp, Tier, TimingGoldens};
+    let mut goldens = TimingGoldens::default();
+    let probe = SceneSpeed {
+        scene: "s".to_owned(),
+        backend: BackendKind::Gl,
+        rounds: 12,
+        passes: vec![PassSpeed {
+            pass: PassId::ToneMap,
+            pass_ms: vec![3.0],
+            floor_ms: vec![1.0],
+            targets: None,
+            unslowed_ms: Vec::new(),
+        }],
+    };
+    let stamp = Stamp {
+        host: "the EPYC",
+        cpu: "family 23 model 49 stepping 0",
+        blessed: "t0",
+        reason: None,
+    };
+    goldens.record(&probe, &[], &stamp);
+    let check = SpeedCheck {
+        scene: "s".to_owned(),
+        backend: BackendKind::Gl,
+        pass: PassId::ToneMap,
+        ratio: 5.0,
+        ms: 5.0,
+        targets: None,
+        delivered: None,
+        golden: Some(2.5),
+        limit: Some(1.69),
+        noise: Some((1.1, "host-d's recording".to_owned())),
+        borrowed: false,
+        tier: Tier::RecordedHost,
+        outcome: SpeedOutcome::Slower,
+    };
+    let mut written = goldens.clone();
+    assert_eq!(
+        record_scaled_check(&mut written, &check, "t1", Some("on purpose")),
+        Ok(6.0)
+    );
+    let pass = &written.backends[&BackendKind::Gl].passes[&PassId::ToneMap];
+    assert_eq!(
+        (pass.ratio, pass.ms, pass.floor_ms, pass.reason.as_deref()),
+        (6.0, 5.0, 1.0, Some("on purpose"))
+    );
+    assert_eq!(
+        pass.scaled.as_deref(),
+        Some(
+            "t1: x2.000 against host-d's recording (ratio 5.000 over its median 2.500) times \
+             the golden before, 3.0000"
+        )
+    );
+    assert_eq!(
+        written.backends[&BackendKind::Gl].host,
+        "the EPYC",
+        "the section stays the blessing host's"
+    );
+    for tier in [Tier::OtherHost, Tier::SameHost, Tier::MovedHere] {
+        let mut untouched = goldens.clone();
+        let other = SpeedCheck {
+            tier,
+            ..check.clone()
+        };
+        let why = record_scaled_check(&mut untouched, &other, "t1", None).unwrap_err();
+        assert!(
+            why.contains("not read against a current recording"),
+            "{why}"
+        );
+        assert_eq!(untouched, goldens);
+    }
+    let geometry = SpeedCheck {
+        pass: PassId::Geometry,
+        ..check
+    };
+    assert_eq!(
+        record_scaled_check(&mut goldens.clone(), &geometry, "t1", None),
+        Err("no timing golden to scale".to_owned())
+    );
 }
 
 /// A dry run's lines say what would be written, not that it was.

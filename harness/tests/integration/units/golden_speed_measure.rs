@@ -75,6 +75,7 @@ fn a_probe_of_other_targets_is_not_a_noise_measurement() {
         floor_ms: 1.0,
         targets: targets.map(str::to_owned),
         reason: None,
+        scaled: None,
     };
     let gl = engine::backend::BackendKind::Gl;
     let why = targets_changed(

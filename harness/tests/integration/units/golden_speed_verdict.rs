@@ -414,6 +414,35 @@ fn coverage_counts_the_timed_and_untimed_passes_per_backend_and_tier() {
     assert_eq!(found[0].fails_beyond, Some([3.0, 3.0, 3.0]));
 }
 
+/// The advice under the coverage: none where every pass was read at this host's own limits;
+/// record this host where some were read at any host's; and on a recorded host whose
+/// recording predates some goldens (blessed since), record it again, by its name.
+#[test]
+fn the_advice_under_the_coverage_says_whether_to_record_this_host_or_record_it_again() {
+    use harness::golden::speed::verdict::RECORD_THIS_HOST;
+    use BackendKind::{Gl, WgpuVulkan};
+    let mut recorded = covered(Gl, Tier::RecordedHost, SpeedOutcome::Passed, Some(1.69));
+    recorded.noise = Some((1.3, "host-d's recording".to_owned()));
+    let stale = covered(Gl, Tier::OtherHost, SpeedOutcome::Passed, Some(1.8));
+    let elsewhere = covered(WgpuVulkan, Tier::OtherHost, SpeedOutcome::Passed, Some(1.8));
+    assert_eq!(
+        record_advice(&coverage(std::slice::from_ref(&recorded))),
+        None
+    );
+    assert_eq!(
+        record_advice(&coverage(&[recorded.clone(), elsewhere])).as_deref(),
+        Some(RECORD_THIS_HOST)
+    );
+    let again = record_advice(&coverage(&[recorded, stale])).unwrap();
+    assert!(
+        again.contains(
+            "this host is recorded (host-d's recording), but some passes' timing \
+             goldens were blessed since"
+        ) && again.contains("`harness noise --timing --record-host host-d`"),
+        "{again}"
+    );
+}
+
 /// A timing bless's stamp at time "t", without a reason.
 fn stamp<'a>(host: &'a str, cpu: &'a str) -> harness::golden::speed::Stamp<'a> {
     harness::golden::speed::Stamp {

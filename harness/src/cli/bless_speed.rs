@@ -1,0 +1,109 @@
+//! `harness bless`'s timing part: probing the backends and rewriting the timing goldens that
+//! moved (or the passes `--pass` names), through [`harness::golden::speed::bless_scenes`].
+
+use engine::backend::BackendKind;
+use engine::plan::PassId;
+
+use super::bless::Options;
+
+/// Probes every available backend and rewrites the timing goldens that moved; returns how
+/// many scenes' backends it kept whole as another host's.
+pub(super) fn bless_speed(
+    cases: &[harness::golden::suite::Case],
+    store: &harness::golden::GoldenStore,
+    passes: &[PassId],
+    options: &Options,
+) -> anyhow::Result<usize> {
+    let backends: Vec<(BackendKind, String)> = BackendKind::ALL
+        .into_iter()
+        .filter(|kind| options.speed_backend.is_none_or(|only| only == *kind))
+        .filter_map(|kind| {
+            let status = engine::backend::probe(kind);
+            match (status.available, status.info) {
+                (true, Some(info)) => Some((kind, harness::golden::fingerprint(&info))),
+                _ => {
+                    eprintln!("note: no timing goldens for {kind}: it is unavailable here");
+                    None
+                }
+            }
+        })
+        .collect();
+    let scenes: Vec<(String, String)> = cases
+        .iter()
+        .map(|c| (c.name().to_owned(), c.argument()))
+        .collect();
+    let lines = harness::golden::speed::bless_scenes(
+        &std::env::current_exe()?,
+        store.root(),
+        &scenes,
+        &backends,
+        harness::golden::speed::TimingBless {
+            every_pass: options.every_pass,
+            // Another host's timing goldens move here only when timings alone were asked for.
+            move_here: options.every_pass && !options.images,
+            dry_run: options.dry_run,
+            reason: options.reason.as_deref(),
+            passes,
+        },
+        |what| eprintln!("{what} ..."),
+    )?;
+    for line in &lines {
+        println!("{line}");
+    }
+    let moved: std::collections::BTreeSet<&str> = lines
+        .iter()
+        .filter(|l| l.moved_here && l.fate == harness::golden::speed::bless::Fate::Rewritten)
+        .map(|l| l.scene.as_str())
+        .collect();
+    if !moved.is_empty() {
+        // The model's same-host figures are the previous blessing host's noise, and a check
+        // here reads them at the limits for any host until they are measured here.
+        let names: Vec<&str> = moved.into_iter().collect();
+        let scenes: String = names.iter().map(|n| format!(" --scene {n}")).collect();
+        println!(
+            "note: {} timing goldens are this host's now, but golden/timing-noise.toml's \
+             same-host figures for them were measured on another host (or before the model \
+             kept where), so until this host's are measured its checks read them at the limits \
+             for any host. Measure them: `harness noise --timing --write{scenes}` (without the \
+             second Mesa: `harness noise --timing --write{scenes} --source runs --source \
+             busy-neighbour`). The recordings in golden/evidence/ were taken against the \
+             goldens replaced, and no longer apply to them",
+            names.join(", ")
+        );
+    }
+    Ok(lines
+        .iter()
+        .filter(|l| l.pass.is_none() && l.fate == harness::golden::speed::bless::Fate::Kept)
+        .count())
+}
+
+/// The passes `--pass` names for a timing bless: each must have a timing golden (on some
+/// backend) in every scene asked for, as `check`'s speed table names it.
+pub(super) fn timed_passes(
+    cases: &[harness::golden::suite::Case],
+    store: &harness::golden::GoldenStore,
+    names: &[String],
+) -> anyhow::Result<Vec<PassId>> {
+    let mut named = Vec::new();
+    for case in cases {
+        let goldens = harness::golden::speed::TimingGoldens::load(store.root(), case.name())?;
+        let timed: std::collections::BTreeSet<PassId> = goldens
+            .backends
+            .values()
+            .flat_map(|b| b.passes.keys().copied())
+            .collect();
+        for name in names {
+            match name.parse::<PassId>().ok().filter(|p| timed.contains(p)) {
+                Some(pass) if named.contains(&pass) => {}
+                Some(pass) => named.push(pass),
+                None => anyhow::bail!(
+                    "scene {} has no timing golden of pass `{name}` (it has: {}; image passes, \
+                     such as light and final, are timed as the passes that draw them)",
+                    case.name(),
+                    harness::names(&timed.iter().collect::<Vec<_>>())
+                ),
+            }
+        }
+    }
+    Ok(named)
+}
