@@ -70,8 +70,9 @@ enum Command {
         summary: Option<PathBuf>,
         /// Debug: give the lighting passes the generic, unspecialised shader variant, in the
         /// renders and the speed probes (a real slowdown, reproduced: the lighting passes'
-        /// speed checks fail and nothing else does).
-        #[arg(long)]
+        /// speed checks fail and nothing else does). Not with --no-speed: the picture is the
+        /// same, only the speed checks show it.
+        #[arg(long, conflicts_with = "no_speed")]
         debug_unspecialised_lighting: bool,
     },
     /// Measure the noise model behind the golden tolerances: how far unchanged renders move

@@ -138,13 +138,14 @@ impl Suite {
         }
     }
 
-    /// The command that blesses a deliberate change of a speed check's timing: on the host that
-    /// blessed, the timings that moved; elsewhere (where a bless keeps another host's timing
-    /// goldens) every pass, moving the backend's timing goldens to this host.
+    /// The command that blesses a deliberate change of a speed check's timing: where a bless
+    /// from here writes it (the host that blessed, or one recorded against it), the timings
+    /// that moved; elsewhere (where a bless keeps another host's timing goldens) every pass,
+    /// moving the backend's timing goldens to this host.
     fn speed_bless(&self, case: usize, check: &harness::golden::speed::SpeedCheck) -> String {
         harness::golden::command_line::speed_bless_command(
             &self.cases[case].argument(),
-            check.tier == harness::golden::speed::Tier::SameHost,
+            check.bless_writes_here(),
         )
     }
 

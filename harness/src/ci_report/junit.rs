@@ -62,7 +62,7 @@ pub fn junit(run: &CheckRun) -> Result<String, quick_junit::SerializeError> {
                 format!(
                     "{}\nif the slowdown is intended, bless the timing goldens with:\n  {}",
                     c.describe(),
-                    speed_bless_command(run.scene_argument(&c.scene), c.tier.bless_writes_here(),)
+                    speed_bless_command(run.scene_argument(&c.scene), c.bless_writes_here())
                 )
             });
             suite.add_test_case(case(

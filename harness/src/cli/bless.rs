@@ -182,11 +182,12 @@ pub(crate) fn run(
         };
         let refused_timings = bless_speed(&cases, &store, &timed, &options)?;
         // Timings alone were asked for: a backend whose goldens another host blessed, kept,
-        // is a refusal (with images, keeping them is what a bless elsewhere does).
+        // or a pass asked for that could not be written, is a refusal (with images, keeping
+        // them is what a bless elsewhere does).
         if refused_timings > 0 && !options.images {
             eprintln!(
-                "error: {refused_timings} scene and backend timing golden(s) were kept as \
-                 another host's, not blessed (each line above says why and what to run)"
+                "error: {refused_timings} timing golden(s) asked for (a scene and backend, or a \
+                 pass) were kept, not blessed (each line above says why and what to run)"
             );
             refused += refused_timings;
         }

@@ -6,8 +6,9 @@ use engine::plan::PassId;
 
 use super::bless::Options;
 
-/// Probes every available backend and rewrites the timing goldens that moved; returns how
-/// many scenes' backends it kept whole as another host's.
+/// Probes every available backend (or the one asked for) and rewrites the timing goldens that
+/// moved, or the `passes` named; returns how many it refused: scenes' backends kept whole as
+/// another host's, and passes asked for that could not be written.
 pub(super) fn bless_speed(
     cases: &[harness::golden::suite::Case],
     store: &harness::golden::GoldenStore,
@@ -71,10 +72,7 @@ pub(super) fn bless_speed(
             names.join(", ")
         );
     }
-    Ok(lines
-        .iter()
-        .filter(|l| l.pass.is_none() && l.fate == harness::golden::speed::bless::Fate::Kept)
-        .count())
+    Ok(lines.iter().filter(|l| l.refused).count())
 }
 
 /// The passes `--pass` names for a timing bless: each must have a timing golden (on some

@@ -51,6 +51,10 @@ pub(crate) fn run(
         ..Default::default()
     };
     if options.unspecialised_lighting {
+        eprintln!(
+            "debug: the lighting passes run unspecialised (--debug-unspecialised-lighting), in \
+             the renders and the speed probes"
+        );
         for case in &mut cases {
             case.frame = case.frame.clone().with_variations(variations);
         }

@@ -146,10 +146,8 @@ impl CheckRun {
         }
         for c in self.speed.checks.iter().filter(|c| c.failed()) {
             let argument = self.scene_argument(&c.scene);
-            let command = crate::golden::command_line::speed_bless_command(
-                argument,
-                c.tier.bless_writes_here(),
-            );
+            let command =
+                crate::golden::command_line::speed_bless_command(argument, c.bless_writes_here());
             if !commands.contains(&command) && !commands.contains(&bless_command(argument)) {
                 commands.push(command);
             }

@@ -134,12 +134,13 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
     }
     // A timing bless writes on the host that blessed the goldens, or scaled from a recorded
     // one; elsewhere the command that moves them here is the one to offer.
-    let elsewhere = run.speed.checks.iter().any(|c| !c.tier.bless_writes_here());
+    let elsewhere = run.speed.checks.iter().any(|c| !c.bless_writes_here());
     let bless = if elsewhere {
-        "this host neither blessed the timing goldens nor is recorded against them: if \
-         intended, record it (<code>harness noise --timing --record-host NAME</code>) and bless \
-         with <code>harness bless --scene S --speed-only</code>, or move them here, every pass, \
-         with <code>--speed-only --every-pass</code>"
+        "bless it with <code>harness bless --scene S --speed-only</code> if intended; where a \
+         pass was read at the limits for any host, this host neither blessed its timing golden \
+         nor holds a current recording of it: record it (<code>harness noise --timing \
+         --record-host NAME</code>) first, or move the goldens here, every pass, with \
+         <code>--speed-only --every-pass</code>"
     } else {
         "bless it with <code>harness bless --scene S --speed-only</code> if intended"
     };

@@ -424,7 +424,7 @@ fn a_speed_only_bless_that_keeps_another_hosts_goldens_fails() {
         "{stdout}"
     );
     assert!(
-        stderr.contains("timing golden(s) were kept as another host's, not blessed"),
+        stderr.contains("timing golden(s) asked for (a scene and backend, or a pass) were kept"),
         "{stderr}"
     );
     assert!(!stderr.contains("probe 1 of"), "{stderr}");

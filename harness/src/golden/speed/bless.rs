@@ -62,6 +62,9 @@ pub struct SpeedBlessed {
     /// Whether the line's goldens were another host's (or named none) and are moving to this
     /// host whole: the model's same-host figures for them are then that other host's noise.
     pub moved_here: bool,
+    /// Whether a golden asked for (a pass named, or one that moved) was not written: a timing
+    /// bless that writes nothing it was asked to is a refusal, not a bless.
+    pub refused: bool,
 }
 
 /// What a timing bless did, or in a dry run would do, with a golden.
@@ -143,6 +146,14 @@ pub fn record_scaled_check(
     date: &str,
     reason: Option<&str>,
 ) -> Result<f64, String> {
+    if let SpeedOutcome::TargetsChanged(what) = &check.outcome {
+        return Err(format!(
+            "{what}: a ratio at other targets does not compare with the golden, so there is no \
+             slowdown to carry into the blessing host's terms; move the backend's timing goldens \
+             here whole (`--speed-only --every-pass`), or bless them on the host that blessed \
+             them"
+        ));
+    }
     let (Tier::RecordedHost, Some(reference), Some(slowdown)) =
         (check.tier, check.golden, check.slowdown())
     else {
@@ -273,6 +284,7 @@ pub fn bless_scenes(
                     previous: why,
                     fate: Fate::Kept,
                     moved_here: false,
+                    refused: true,
                 }),
                 None => {
                     let moving = existing.is_some_and(|e| !e.blessed_on(&host, &cpu));
@@ -354,11 +366,12 @@ fn moved(outcome: &SpeedOutcome) -> bool {
     )
 }
 
-/// The lines of a bless of this host's own section ([`Writing::Own`]; `moving`: another
-/// host's, moving here whole): the passes that moved, every pass (`options.every_pass`, or
-/// moving), or the ones named, recorded from `probe` with `stamp`; nothing with
-/// `options.dry_run`. A move asked of named passes only is kept, with why: it takes every pass.
-fn bless_own(
+/// The lines of a bless of this host's own section (`moving`: another host's, moving here
+/// whole): the passes that moved, every pass (`options.every_pass`, or moving), or the ones
+/// named, recorded from `probe` with `stamp`; nothing with `options.dry_run`. The section is
+/// replaced whole only when every pass is written (not with named passes). A move asked of
+/// named passes only is kept, with why: it takes every pass.
+pub fn bless_own(
     goldens: &mut TimingGoldens,
     probe: &SceneSpeed,
     checks: &[SpeedCheck],
@@ -377,6 +390,7 @@ fn bless_own(
                 .to_owned(),
             fate: Fate::Kept,
             moved_here: false,
+            refused: true,
         }];
     }
     let every_pass = options.every_pass || moving || !options.passes.is_empty();
@@ -394,10 +408,11 @@ fn bless_own(
             previous: check.describe(),
             fate: if written { fate } else { Fate::Kept },
             moved_here: moving,
+            refused: false,
         });
     }
     if !rewrite.is_empty() && !options.dry_run {
-        if moving || options.every_pass {
+        if (moving || options.every_pass) && options.passes.is_empty() {
             // Every pass is this probe's: none of another host's (or of a pass gone from the
             // plan) stays beside them.
             goldens.backends.remove(&probe.backend);
@@ -407,11 +422,13 @@ fn bless_own(
     lines
 }
 
-/// The lines of a bless of another host's section from a recorded host ([`Writing::Scaled`]):
-/// each pass that moved beyond its limit against this host's recording (every pass with
-/// `options.every_pass`) is written scaled into the blessing host's terms
-/// ([`record_scaled_check`]); what cannot be scaled is kept, with why.
-fn bless_scaled(
+/// The lines of a bless of another host's section from a recorded host: each pass that moved
+/// beyond its limit against this host's recording, or is named, is written scaled into the
+/// blessing host's terms ([`record_scaled_check`]); nothing with `options.dry_run`. What cannot
+/// be scaled is kept, with why, and refused. `options.every_pass` writes no more: a pass within
+/// its limit has no slowdown to carry over, only this host's run-to-run noise (and each
+/// scaled pass makes every recording of it stale).
+pub fn bless_scaled(
     goldens: &mut TimingGoldens,
     checks: &[SpeedCheck],
     options: TimingBless<'_>,
@@ -424,7 +441,9 @@ fn bless_scaled(
         .map(|check| {
             let mut previous = check.describe();
             let mut this_fate = Fate::Kept;
-            if options.every_pass || !options.passes.is_empty() || moved(&check.outcome) {
+            let asked = !options.passes.is_empty() || moved(&check.outcome);
+            let mut refused = false;
+            if asked {
                 let mut scaled = goldens.clone();
                 match record_scaled_check(&mut scaled, check, date, options.reason) {
                     Ok(ratio) => {
@@ -439,7 +458,10 @@ fn bless_scaled(
                         }
                         this_fate = fate;
                     }
-                    Err(why) => previous += &format!("; not written: {why}"),
+                    Err(why) => {
+                        previous += &format!("; not written: {why}");
+                        refused = true;
+                    }
                 }
             }
             SpeedBlessed {
@@ -449,6 +471,7 @@ fn bless_scaled(
                 previous,
                 fate: this_fate,
                 moved_here: false,
+                refused,
             }
         })
         .collect()

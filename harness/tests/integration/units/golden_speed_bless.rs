@@ -179,6 +179,7 @@ fn a_timing_bless_line_says_what_became_of_the_golden() {
             previous: "x1.02 of golden".to_owned(),
             fate,
             moved_here: false,
+            refused: false,
         }
         .to_string()
     };
@@ -193,5 +194,169 @@ fn a_timing_bless_line_says_what_became_of_the_golden() {
     assert_eq!(
         line(None, Fate::Kept),
         "arrow on gl (speed): kept: x1.02 of golden"
+    );
+}
+
+/// A check of `pass` on gl at `tier` with `outcome`: ratio 5 against a reference of 2.5.
+fn check_of(
+    pass: PassId,
+    tier: harness::golden::speed::Tier,
+    outcome: harness::golden::speed::SpeedOutcome,
+) -> harness::golden::speed::SpeedCheck {
+    harness::golden::speed::SpeedCheck {
+        scene: "s".to_owned(),
+        backend: BackendKind::Gl,
+        pass,
+        ratio: 5.0,
+        ms: 5.0,
+        targets: None,
+        delivered: None,
+        golden: Some(2.5),
+        limit: Some(1.69),
+        noise: Some((1.1, "host-d's recording".to_owned())),
+        borrowed: false,
+        tier,
+        outcome,
+    }
+}
+
+/// Goldens of tone mapping (3.0) and geometry (2.0) on gl, blessed on the EPYC.
+fn two_goldens() -> harness::golden::speed::TimingGoldens {
+    let mut goldens = harness::golden::speed::TimingGoldens::default();
+    let pass = |pass, ms| PassSpeed {
+        pass,
+        pass_ms: vec![ms],
+        floor_ms: vec![1.0],
+        targets: None,
+        unslowed_ms: Vec::new(),
+    };
+    let probe = SceneSpeed {
+        scene: "s".to_owned(),
+        backend: BackendKind::Gl,
+        rounds: 12,
+        passes: vec![pass(PassId::ToneMap, 3.0), pass(PassId::Geometry, 2.0)],
+    };
+    let stamp = harness::golden::speed::Stamp {
+        host: "the EPYC",
+        cpu: "family 23 model 49 stepping 0",
+        blessed: "t0",
+        reason: None,
+    };
+    goldens.record(&probe, &[], &stamp);
+    goldens
+}
+
+/// `--every-pass` with `--pass` on the host that blessed rewrites the passes named and keeps
+/// the others (the section is replaced whole only when every pass is written).
+#[test]
+fn every_pass_with_named_passes_keeps_the_other_goldens() {
+    use harness::golden::speed::{SpeedOutcome, Stamp, Tier};
+    let mut goldens = two_goldens();
+    let probe = SceneSpeed {
+        scene: "s".to_owned(),
+        backend: BackendKind::Gl,
+        rounds: 12,
+        passes: vec![PassSpeed {
+            pass: PassId::ToneMap,
+            pass_ms: vec![4.0],
+            floor_ms: vec![1.0],
+            targets: None,
+            unslowed_ms: Vec::new(),
+        }],
+    };
+    let checks = [check_of(
+        PassId::ToneMap,
+        Tier::SameHost,
+        SpeedOutcome::Passed,
+    )];
+    let stamp = Stamp {
+        host: "the EPYC",
+        cpu: "family 23 model 49 stepping 0",
+        blessed: "t1",
+        reason: None,
+    };
+    let options = TimingBless {
+        every_pass: true,
+        passes: &[PassId::ToneMap],
+        ..TimingBless::default()
+    };
+    let lines = bless_own(
+        &mut goldens,
+        &probe,
+        &checks,
+        false,
+        options,
+        &stamp,
+        Fate::Rewritten,
+    );
+    assert_eq!(lines.len(), 1);
+    assert_eq!(lines[0].fate, Fate::Rewritten);
+    let gl = &goldens.backends[&BackendKind::Gl];
+    assert_eq!(gl.passes[&PassId::ToneMap].ratio, 4.0);
+    assert_eq!(gl.passes[&PassId::Geometry].ratio, 2.0, "kept");
+}
+
+/// From a recorded host, only what moved (or is named) is carried over: `--every-pass` adds
+/// nothing (a pass within its limit has only this host's noise to carry). A pass whose targets
+/// changed cannot be carried over: refused, saying why and what writes it. A dry run writes
+/// nothing.
+#[test]
+fn a_recorded_host_carries_over_only_what_moved() {
+    use harness::golden::speed::{SpeedOutcome, Tier};
+    let checks = [
+        check_of(PassId::ToneMap, Tier::RecordedHost, SpeedOutcome::Passed),
+        check_of(
+            PassId::Geometry,
+            Tier::RecordedHost,
+            SpeedOutcome::TargetsChanged("it writes depth 512x512".to_owned()),
+        ),
+    ];
+    let every_pass = TimingBless {
+        every_pass: true,
+        ..TimingBless::default()
+    };
+    let mut goldens = two_goldens();
+    let lines = bless_scaled(&mut goldens, &checks, every_pass, "t1", Fate::Rewritten);
+    assert_eq!(goldens, two_goldens(), "nothing within its limit written");
+    assert_eq!(
+        lines
+            .iter()
+            .map(|l| (l.fate, l.refused))
+            .collect::<Vec<_>>(),
+        [(Fate::Kept, false), (Fate::Kept, true)]
+    );
+    assert!(
+        lines[1]
+            .previous
+            .contains("not written: it writes depth 512x512")
+            && lines[1].previous.contains("--speed-only --every-pass"),
+        "{}",
+        lines[1].previous
+    );
+    assert!(!checks[1].bless_writes_here() && checks[0].bless_writes_here());
+    // Slower: written (x2 of 3.0), not in a dry run.
+    let slower = [check_of(
+        PassId::ToneMap,
+        Tier::RecordedHost,
+        SpeedOutcome::Slower,
+    )];
+    let dry = TimingBless {
+        dry_run: true,
+        ..TimingBless::default()
+    };
+    let lines = bless_scaled(&mut goldens, &slower, dry, "t1", Fate::WouldBeRewritten);
+    assert_eq!(lines[0].fate, Fate::WouldBeRewritten);
+    assert_eq!(goldens, two_goldens(), "a dry run writes nothing");
+    let lines = bless_scaled(
+        &mut goldens,
+        &slower,
+        TimingBless::default(),
+        "t1",
+        Fate::Rewritten,
+    );
+    assert_eq!((lines[0].fate, lines[0].refused), (Fate::Rewritten, false));
+    assert_eq!(
+        goldens.backends[&BackendKind::Gl].passes[&PassId::ToneMap].ratio,
+        6.0
     );
 }

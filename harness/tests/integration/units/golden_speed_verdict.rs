@@ -412,6 +412,10 @@ fn coverage_counts_the_timed_and_untimed_passes_per_backend_and_tier() {
     below.ratio = 1.0;
     let found = coverage(&[failing, below]);
     assert_eq!(found[0].fails_beyond, Some([3.0, 3.0, 3.0]));
+    // A pass too noisy to catch a doubling is untimed, also when it fails beyond its limit.
+    let beyond = covered(Gl, Tier::OtherHost, SpeedOutcome::Slower, Some(3.2));
+    let found = coverage(&[beyond]);
+    assert_eq!((found[0].timed, found[0].untimed), (0, 1));
 }
 
 /// The advice under the coverage: none where every pass was read at this host's own limits;
@@ -431,6 +435,16 @@ fn the_advice_under_the_coverage_says_whether_to_record_this_host_or_record_it_a
     );
     assert_eq!(
         record_advice(&coverage(&[recorded.clone(), elsewhere])).as_deref(),
+        Some(RECORD_THIS_HOST)
+    );
+    // Recorded on gl only: wgpu-vulkan read at any host's limits needs this host recorded.
+    assert_eq!(
+        record_advice(&coverage(&[
+            recorded.clone(),
+            stale.clone(),
+            covered(WgpuVulkan, Tier::OtherHost, SpeedOutcome::Passed, Some(1.8)),
+        ]))
+        .as_deref(),
         Some(RECORD_THIS_HOST)
     );
     let again = record_advice(&coverage(&[recorded, stale])).unwrap();
