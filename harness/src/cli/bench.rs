@@ -363,6 +363,10 @@ pub(crate) fn speed_command(args: SpeedArgs) -> anyhow::Result<ExitCode> {
         unspecialised_lighting: args.debug_unspecialised_lighting,
         ..Default::default()
     };
+    // A name that is no scene is one error here, not one per backend's probe child.
+    for name in &args.scenes {
+        engine::scene_file::resolve(name, &harness::scenes_dir())?;
+    }
     if args.in_process {
         speed_in_process(
             &args.scenes,

@@ -184,9 +184,17 @@ fn narrow_passes(cases: &mut Vec<Case>, passes: &[String]) -> anyhow::Result<()>
                 .collect();
             known.sort();
             known.dedup();
+            // A plan pass (`lighting_pbr`) names a speed check, which --pass does not narrow.
+            let timed = name.parse::<engine::plan::PassId>().is_ok();
             anyhow::bail!(
-                "no scene checked has a golden pass `{name}` (they have: {})",
-                known.join(", ")
+                "no scene checked has a golden pass `{name}` (they have: {}){}",
+                known.join(", "),
+                if timed {
+                    "; `--pass` narrows the image checks, and the speed checks, which name the \
+                     passes of the plan such as this one, are run whole (`--no-speed` skips them)"
+                } else {
+                    ""
+                }
             );
         }
     }

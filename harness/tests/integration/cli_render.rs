@@ -1,5 +1,6 @@
 //! `harness render`: load warnings printed once, unknown passes refused before rendering, and
-//! every pass of a scene file written.
+//! every pass of a scene file written; and what other commands refuse before any work (an
+//! unknown pass or scene, a flag that does nothing without another).
 
 use crate::common;
 use std::path::Path;
@@ -82,6 +83,10 @@ fn check_pass_checks_only_that_pass_and_rejects_an_unknown_one() {
         !out.path().join("last-check.json").exists(),
         "it ran the check"
     );
+    // A plan pass is a speed check's name: said so, since --pass does not narrow those.
+    let (code, _, stderr) = harness(&["check", "--scene", "arrow", "--pass", "lighting_pbr"]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("are run whole"), "{stderr}");
     let (code, stdout, stderr) = harness(&[
         "check",
         "--scene",
@@ -249,4 +254,29 @@ fn plan_and_render_know_the_extracted_sun() {
     ]);
     assert_eq!(code, 0, "{stdout}\n{stderr}");
     assert!(out.is_file());
+}
+
+/// A scene that is none is one error, before any probe child starts (`speed`) or once
+/// (`selftest --speed`); the debug slowdown of the lighting is refused without the speed
+/// checks that show it.
+#[test]
+fn speed_commands_name_an_unknown_scene_once() {
+    let (code, _, stderr) = harness(&["speed", "--scene", "nonexistent"]);
+    assert_ne!(code, 0, "{stderr}");
+    assert_eq!(
+        stderr.matches("no scene `nonexistent`").count(),
+        1,
+        "{stderr}"
+    );
+    assert!(!stderr.contains("probe died"), "{stderr}");
+    let (code, _, stderr) = harness(&["selftest", "--speed", "--scene", "nonexistent"]);
+    assert_ne!(code, 0, "{stderr}");
+    assert_eq!(
+        stderr.matches("no scene `nonexistent`").count(),
+        1,
+        "{stderr}"
+    );
+    let (code, _, stderr) = harness(&["check", "--no-speed", "--debug-unspecialised-lighting"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("cannot be used with"), "{stderr}");
 }
