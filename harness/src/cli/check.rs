@@ -242,6 +242,18 @@ pub(crate) fn finish(
         println!("{}", serde_json::to_string_pretty(run)?);
     } else {
         print_table(run, &report, failures);
+        if options.unspecialised_lighting && run.speed.checks.iter().any(|c| c.failed()) {
+            // A bless probes again, without the debug slowdown: only an accept takes it.
+            println!(
+                "note: this check ran with --debug-unspecialised-lighting, which `bless` does \
+                 not take: a `bless --speed-only` probes the lighting as it is and finds it \
+                 unchanged. To record the slowdown this check measured, accept it: `{} \
+                 --speed-only`",
+                harness::golden::command_line::accept_command(
+                    Some(out).filter(|dir| *dir != crate::default_out_dir())
+                )
+            );
+        }
     }
     Ok(if run.passed() {
         ExitCode::SUCCESS

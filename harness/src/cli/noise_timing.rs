@@ -373,6 +373,13 @@ fn print_timing_table(
         "{:<8} {:<12} {:<22} {:>20} {:>20} {:>16} {:>16}",
         "scene", "backend", "pass", "host noise", "driver noise", "limit", "elsewhere"
     );
+    for scene in wanted.iter().filter(|s| !model.scenes.contains_key(**s)) {
+        println!(
+            "{scene:<8} no figures of its own in golden/timing-noise.toml yet: its checks borrow \
+             every scene's (`--write` records this run's, the other hosts' kept at least as \
+             borrowed)"
+        );
+    }
     let named = model
         .scenes
         .iter()
@@ -406,6 +413,18 @@ fn print_timing_table(
             }
         }
     }
+    let borrowed = model
+        .scenes
+        .iter()
+        .filter(|(scene, _)| wanted.contains(&scene.as_str()))
+        .flat_map(|(_, backends)| backends.values().flat_map(|p| p.values()))
+        .any(|n| n.host_at.ends_with(", borrowed") || n.drivers_at.ends_with(", borrowed"));
+    if borrowed {
+        println!(
+            "* borrowed from the other scenes (their largest): no host has recorded this scene \
+             yet"
+        );
+    }
     let worst = scores
         .iter()
         .max_by(|a, b| a.2.total_cmp(&b.2))
@@ -432,6 +451,11 @@ pub(super) fn named(cases: &[harness::golden::suite::Case]) -> Vec<(String, Stri
 }
 
 /// A source name short enough for the table (`busy-neighbour` whole).
-pub(super) fn short(source: &str) -> &str {
-    source.get(..source.len().min(14)).unwrap_or(source)
+pub(super) fn short(source: &str) -> String {
+    // A figure borrowed from other scenes keeps its mark, `*`, whatever is cut.
+    let (name, mark) = match source.strip_suffix(", borrowed") {
+        Some(name) => (name, "*"),
+        None => (source, ""),
+    };
+    format!("{}{mark}", name.get(..name.len().min(14)).unwrap_or(name))
 }

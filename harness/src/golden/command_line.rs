@@ -43,6 +43,12 @@ pub fn speed_bless_command(scene: &str, writes_here: bool) -> String {
     format!("{} {flags}", bless_command(scene))
 }
 
+/// `harness ARGS` as [`bless_command`] names the harness and the workspace: the command to
+/// paste here.
+pub fn harness_command(args: &str) -> String {
+    format!("{}{} {args}", workspace(), harness())
+}
+
 /// The flags of a timing bless that moves another host's timing goldens to this one.
 const MOVE_TIMINGS_HERE: &str = "--speed-only --every-pass";
 

@@ -171,7 +171,10 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
             _ => c
                 .noise
                 .as_ref()
-                .map(|(n, at)| format!("noise x{n:.2} at {at}"))
+                .map(|(n, at)| {
+                    let borrowed = if c.borrowed { ", borrowed" } else { "" };
+                    format!("noise x{n:.2} at {at}{borrowed}")
+                })
                 .unwrap_or_default(),
         };
         let _ = write!(

@@ -238,7 +238,8 @@ fn goldens_moved_here_are_read_at_any_hosts_limits_until_measured_here() {
     let note = notes[0].as_str().unwrap();
     assert!(
         note.contains("arrow's timing goldens on gl were blessed on this host")
-            && note.contains("`harness noise --timing --write --scene arrow`"),
+            && note.contains(" noise --timing --write --scene arrow`")
+            && note.contains(&format!("HARNESS_ROOT={}", root.path().display())),
         "{note}"
     );
     let summary = std::fs::read_to_string(&summary).unwrap();

@@ -291,6 +291,24 @@ pub fn merged(mut model: TimingNoise, measured: TimingNoise) -> TimingNoise {
     for (scene, backends) in measured.scenes {
         for (backend, passes) in backends {
             for (pass, new) in passes {
+                let known = model
+                    .scenes
+                    .get(&scene)
+                    .and_then(|b| b.get(&backend))
+                    .is_some_and(|p| p.contains_key(&pass));
+                if !known {
+                    let borrowed = model.figures(&scene, backend, pass).map(|(f, _)| f);
+                    if let Some(first) = first_figures(new, borrowed) {
+                        model
+                            .scenes
+                            .entry(scene.clone())
+                            .or_default()
+                            .entry(backend)
+                            .or_default()
+                            .insert(pass, first);
+                    }
+                    continue;
+                }
                 let old = model
                     .scenes
                     .entry(scene.clone())
@@ -311,6 +329,34 @@ pub fn merged(mut model: TimingNoise, measured: TimingNoise) -> TimingNoise {
         }
     }
     model
+}
+
+/// The figures a pass new to the model starts with, from `new` (what this run measured, a
+/// tier no source measured being a placeholder, `-`) and `borrowed` (what its checks read
+/// until now: every scene's largest, [`TimingNoise::figures`]). No other host has recorded the
+/// pass, so its figure for any host is at least the borrowed one; a tier this run did not
+/// measure keeps the borrowed figure. `None` (the pass left out, its checks borrowing as
+/// before) where a tier has neither: a placeholder is no figure, and a figure of 0 no limit.
+fn first_figures(new: PassNoise, borrowed: Option<PassNoise>) -> Option<PassNoise> {
+    let label = |at: &str| format!("{at}, borrowed");
+    let (host, host_at) = match (&borrowed, new.host_at != "-") {
+        (_, true) => (new.host, new.host_at),
+        (Some(b), false) => (b.host, label(&b.host_at)),
+        (None, false) => return None,
+    };
+    let measured = (new.drivers_at != "-").then_some((new.drivers, new.drivers_at));
+    let (drivers, drivers_at) = match (measured, &borrowed) {
+        (Some((d, at)), Some(b)) if d >= b.drivers => (d, at),
+        (_, Some(b)) => (b.drivers, label(&b.drivers_at)),
+        (Some((d, at)), None) => (d, at),
+        (None, None) => return None,
+    };
+    Some(PassNoise {
+        host,
+        host_at,
+        drivers,
+        drivers_at,
+    })
 }
 
 /// As [`merged`], except that the same-host figures of `moved` (scenes and backends whose

@@ -413,24 +413,35 @@ pub fn check_scenes(
 /// model's same-host figures for them measured on another): a note saying they were read at
 /// the limits for any host, on which backends, and the command that measures this host's noise.
 pub fn moved_here_notes(checks: &[SpeedCheck]) -> Vec<String> {
-    let mut scenes: Vec<(&str, Vec<BackendKind>)> = Vec::new();
+    let mut scenes: Vec<(&str, Vec<BackendKind>, bool)> = Vec::new();
     for c in checks.iter().filter(|c| c.tier == Tier::MovedHere) {
-        match scenes.iter_mut().find(|(scene, _)| *scene == c.scene) {
-            Some((_, kinds)) if kinds.contains(&c.backend) => {}
-            Some((_, kinds)) => kinds.push(c.backend),
-            None => scenes.push((&c.scene, vec![c.backend])),
+        match scenes.iter_mut().find(|(scene, ..)| *scene == c.scene) {
+            Some((_, kinds, borrowed)) => {
+                *borrowed &= c.borrowed;
+                if !kinds.contains(&c.backend) {
+                    kinds.push(c.backend);
+                }
+            }
+            None => scenes.push((&c.scene, vec![c.backend], c.borrowed)),
         }
     }
     scenes
         .into_iter()
-        .map(|(scene, kinds)| {
+        .map(|(scene, kinds, borrowed)| {
+            let whose = if borrowed {
+                "golden/timing-noise.toml has no figures of its own for it yet: it borrows every \
+                 scene's, measured on other hosts"
+            } else {
+                "golden/timing-noise.toml's same-host figures for them were measured on another \
+                 host (or by a model that did not yet record where)"
+            };
+            let measure = crate::golden::command_line::harness_command(&format!(
+                "noise --timing --write --scene {scene}"
+            ));
             format!(
-                "{scene}'s timing goldens on {} were blessed on this host, but \
-                 golden/timing-noise.toml's same-host figures for them were measured on another \
-                 host (or before the model kept where), so they were read at the limits for any \
-                 host. Measure this host's: `harness noise --timing --write --scene {scene}` \
-                 (without the second Mesa: `harness noise --timing --write --scene {scene} \
-                 --source runs --source busy-neighbour`)",
+                "{scene}'s timing goldens on {} were blessed on this host, but {whose}, so they \
+                 were read at the limits for any host. Measure this host's: `{measure}` (without \
+                 the second Mesa: `{measure} --source runs --source busy-neighbour`)",
                 crate::names(&kinds)
             )
         })

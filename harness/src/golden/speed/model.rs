@@ -161,8 +161,27 @@ impl TimingNoise {
         Ok(model)
     }
 
-    /// Writes the model atomically.
+    /// Writes the model atomically; refuses, writing nothing, a figure that is not a finite
+    /// positive number (what reading it back would refuse, leaving every speed check without
+    /// a model).
     pub fn save(&self, root: &Path) -> Result<(), SpeedError> {
+        for (scene, backends) in &self.scenes {
+            for (backend, passes) in backends {
+                for (pass, n) in passes {
+                    let figure = |x: f64| x.is_finite() && x > 0.0;
+                    if !(figure(n.host) && figure(n.drivers)) {
+                        return Err(SpeedError::File {
+                            path: Self::path(root),
+                            message: format!(
+                                "not written: {scene} {backend} {pass} has no figure for a tier \
+                                 (host x{}, drivers x{}); measure both tiers' sources",
+                                n.host, n.drivers
+                            ),
+                        });
+                    }
+                }
+            }
+        }
         super::write_toml(&Self::path(root), HEADER, self)
     }
 

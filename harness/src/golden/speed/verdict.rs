@@ -276,7 +276,7 @@ pub fn check_speed_with(
                     SpeedOutcome::Slower
                 } else if limit >= MUST_CATCH {
                     SpeedOutcome::Untimed(format!(
-                        "too noisy to time {}: its ratio moved up to x{n:.2} ({at}), so a \
+                        "too noisy to time {}: its ratio moved up to x{n:.2} ({at}{}), so a \
                          limit of x{limit:.2} would not catch a doubling (it fails only \
                          beyond it)",
                         match tier {
@@ -287,7 +287,8 @@ pub fn check_speed_with(
                                 "here at the limits for any host (this host's timing noise \
                                  not measured yet)"
                             }
-                        }
+                        },
+                        if borrowed { ", borrowed" } else { "" }
                     ))
                 } else if ratio / golden < 1.0 / limit {
                     SpeedOutcome::Faster

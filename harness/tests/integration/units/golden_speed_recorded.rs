@@ -127,6 +127,71 @@ fn merging_a_source_raises_figures_where_it_measures_more_and_keeps_the_rest() {
     assert!(model.sources.contains_key("host-c"));
 }
 
+/// A scene new to the model, measured here by its same-host sources only (what the check's
+/// note offers without the second Mesa), starts from what its checks borrowed: its own
+/// same-host figure, and for any host at least the borrowed figure (no other host recorded
+/// it). A tier with neither measured nor borrowed leaves the pass out, and a model with a
+/// figure of 0 is not written (reading it back would refuse it, and every speed check with it).
+#[test]
+fn a_new_scene_measured_here_keeps_the_borrowed_figure_for_other_hosts() {
+    let mut old = TimingNoise::default();
+    old.scenes
+        .entry("ibl".to_owned())
+        .or_default()
+        .entry(BackendKind::Gl)
+        .or_default()
+        .insert(
+            PassId::ToneMap,
+            PassNoise {
+                host: 1.1,
+                host_at: "busy-neighbour".to_owned(),
+                drivers: 1.5,
+                drivers_at: "host-c".to_owned(),
+            },
+        );
+    let m = |backend, factor| TimingMeasurement {
+        source: "runs".to_owned(),
+        tier: Tier::SameHost,
+        scene: "mine".to_owned(),
+        backend,
+        pass: PassId::ToneMap,
+        factor,
+    };
+    let measured = model_from(
+        &[m(BackendKind::Gl, 1.2), m(BackendKind::WgpuVulkan, 1.3)],
+        &[],
+        2.0,
+    );
+    let model = merged(old, measured.clone());
+    assert_eq!(
+        model.scenes["mine"][&BackendKind::Gl][&PassId::ToneMap],
+        PassNoise {
+            host: 1.2,
+            host_at: "runs".to_owned(),
+            drivers: 1.5,
+            drivers_at: "host-c, borrowed".to_owned(),
+        }
+    );
+    assert!(
+        !model.scenes["mine"].contains_key(&BackendKind::WgpuVulkan),
+        "nothing to borrow on wgpu-vulkan: left out"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    model.save(dir.path()).unwrap();
+    assert_eq!(TimingNoise::load(dir.path()).unwrap(), model);
+    // The placeholders of the measurement alone (no driver figure) are refused, not written.
+    let why = measured.save(dir.path()).unwrap_err().to_string();
+    assert!(
+        why.contains("not written: mine") && why.contains("drivers x0"),
+        "{why}"
+    );
+    assert_eq!(
+        TimingNoise::load(dir.path()).unwrap(),
+        model,
+        "the file as it was"
+    );
+}
+
 /// The timing sources of one recorded host, read back from a temporary golden root.
 fn recorded_hosts_of(
     recorded: RecordedTimings,

@@ -308,8 +308,19 @@ fn same_host_figures_count_only_on_the_host_that_measured_them() {
     assert!(
         notes[0].contains("s's timing goldens on gl were blessed on this host")
             && notes[0].contains("read at the limits for any host")
-            && notes[0].contains("`harness noise --timing --write --scene s`")
+            && notes[0].contains(" noise --timing --write --scene s`")
+            && notes[0].contains("were measured on another host")
             && !notes[0].contains("  "),
+        "{}",
+        notes[0]
+    );
+    // A scene with no figures of its own (a new one, borrowing every scene's) is told so.
+    for check in &mut moved {
+        check.borrowed = true;
+    }
+    let notes = harness::golden::speed::moved_here_notes(&moved);
+    assert!(
+        notes[0].contains("has no figures of its own for it yet: it borrows every scene's"),
         "{}",
         notes[0]
     );
