@@ -53,7 +53,7 @@ pub(super) fn bless_speed(
     }
     let moved: std::collections::BTreeSet<&str> = lines
         .iter()
-        .filter(|l| l.moved_here && l.fate == harness::golden::speed::bless::Fate::Rewritten)
+        .filter(|l| l.moved_here && l.fate.written())
         .map(|l| l.scene.as_str())
         .collect();
     if !moved.is_empty() {
@@ -70,6 +70,28 @@ pub(super) fn bless_speed(
              busy-neighbour`). The recordings in golden/evidence/ were taken against the \
              goldens replaced, and no longer apply to them",
             names.join(", ")
+        );
+    }
+    // A scene whose timing goldens are new and that the model has no figures of: its checks
+    // borrow every scene's until its own are measured.
+    let model = harness::golden::speed::TimingNoise::load(store.root())?;
+    let mut new: Vec<&str> = lines
+        .iter()
+        .filter(|l| l.fate == harness::golden::speed::bless::Fate::Written)
+        .map(|l| l.scene.as_str())
+        .filter(|scene| !model.scenes.contains_key(*scene))
+        .collect();
+    new.sort_unstable();
+    new.dedup();
+    for scene in new {
+        let measure = harness::golden::command_line::harness_command(&format!(
+            "noise --timing --write --scene {scene}"
+        ));
+        println!(
+            "note: {scene}'s timing goldens are new, and golden/timing-noise.toml has no figures \
+             of it: its checks borrow every scene's until `{measure}` measures this host's (the \
+             figures for other hosts stay at least the borrowed ones). Commit golden/{scene}/ \
+             with the scene"
         );
     }
     Ok(lines.iter().filter(|l| l.refused).count())

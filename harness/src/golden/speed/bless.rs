@@ -70,18 +70,28 @@ pub struct SpeedBlessed {
 /// What a timing bless did, or in a dry run would do, with a golden.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Fate {
-    /// Written.
+    /// Written over the golden there was.
     Rewritten,
+    /// Written where there was none.
+    Written,
     /// Would be written (a dry run).
     WouldBeRewritten,
     /// Left as it was.
     Kept,
 }
 
+impl Fate {
+    /// Whether the golden was written ([`Fate::Rewritten`] or [`Fate::Written`]).
+    pub fn written(self) -> bool {
+        matches!(self, Fate::Rewritten | Fate::Written)
+    }
+}
+
 impl std::fmt::Display for Fate {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
             Fate::Rewritten => "rewritten",
+            Fate::Written => "written (new)",
             Fate::WouldBeRewritten => "would be rewritten (dry run)",
             Fate::Kept => "kept",
         })
@@ -345,7 +355,7 @@ pub fn bless_scenes(
                     )
                 }
             };
-            if !options.dry_run && written.iter().any(|l| l.fate == Fate::Rewritten) {
+            if !options.dry_run && written.iter().any(|l| l.fate.written()) {
                 goldens.save(root, scene)?;
             }
             lines.extend(written);
@@ -406,7 +416,11 @@ pub fn bless_own(
             backend: check.backend,
             pass: Some(check.pass),
             previous: check.describe(),
-            fate: if written { fate } else { Fate::Kept },
+            fate: match (written, &check.outcome) {
+                (false, _) => Fate::Kept,
+                (true, SpeedOutcome::MissingGolden) if fate == Fate::Rewritten => Fate::Written,
+                (true, _) => fate,
+            },
             moved_here: moving,
             refused: false,
         });

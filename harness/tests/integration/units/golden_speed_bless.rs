@@ -360,3 +360,53 @@ fn a_recorded_host_carries_over_only_what_moved() {
         6.0
     );
 }
+
+/// A pass without a timing golden is written new, and its line says so ("written (new)", not
+/// "rewritten").
+#[test]
+fn a_pass_without_a_golden_is_written_new() {
+    use harness::golden::speed::{SpeedOutcome, Stamp, Tier};
+    let mut goldens = two_goldens();
+    let probe = SceneSpeed {
+        scene: "s".to_owned(),
+        backend: BackendKind::Gl,
+        rounds: 12,
+        passes: vec![PassSpeed {
+            pass: PassId::Skybox,
+            pass_ms: vec![2.5],
+            floor_ms: vec![1.0],
+            targets: None,
+            unslowed_ms: Vec::new(),
+        }],
+    };
+    let checks = [check_of(
+        PassId::Skybox,
+        Tier::SameHost,
+        SpeedOutcome::MissingGolden,
+    )];
+    let stamp = Stamp {
+        host: "the EPYC",
+        cpu: "family 23 model 49 stepping 0",
+        blessed: "t1",
+        reason: None,
+    };
+    let lines = bless_own(
+        &mut goldens,
+        &probe,
+        &checks,
+        false,
+        TimingBless::default(),
+        &stamp,
+        Fate::Rewritten,
+    );
+    assert_eq!(lines[0].fate, Fate::Written);
+    assert!(lines[0].fate.written());
+    assert!(
+        lines[0].to_string().ends_with("; written (new)"),
+        "{}",
+        lines[0]
+    );
+    let gl = &goldens.backends[&BackendKind::Gl];
+    assert_eq!(gl.passes[&PassId::Skybox].ratio, 2.5);
+    assert_eq!(gl.passes.len(), 3, "the others kept");
+}
