@@ -87,27 +87,9 @@ fn a_bless_keeps_another_hosts_timing_goldens_unless_every_pass_moves() {
 /// with no golden, writes nothing and says why.
 #[test]
 fn a_recorded_hosts_slowdown_is_written_as_the_golden_times_it() {
-    use harness::golden::speed::{SpeedCheck, SpeedOutcome, Stamp, Tier, TimingGoldens};
+    use harness::golden::speed::{SpeedCheck, SpeedOutcome, Tier, TimingGoldens};
     let mut goldens = TimingGoldens::default();
-    let probe = SceneSpeed {
-        scene: "s".to_owned(),
-        backend: BackendKind::Gl,
-        rounds: 12,
-        passes: vec![PassSpeed {
-            pass: PassId::ToneMap,
-            pass_ms: vec![3.0],
-            floor_ms: vec![1.0],
-            targets: None,
-            unslowed_ms: Vec::new(),
-        }],
-    };
-    let stamp = Stamp {
-        host: "the EPYC",
-        cpu: "family 23 model 49 stepping 0",
-        blessed: "t0",
-        reason: None,
-    };
-    goldens.record(&probe, &[], &stamp);
+    goldens.record(&probe_of(&[(PassId::ToneMap, 3.0)]), &[], &epyc("t0"));
     let check = SpeedCheck {
         scene: "s".to_owned(),
         backend: BackendKind::Gl,
@@ -223,58 +205,53 @@ fn check_of(
 /// Goldens of tone mapping (3.0) and geometry (2.0) on gl, blessed on the EPYC.
 fn two_goldens() -> harness::golden::speed::TimingGoldens {
     let mut goldens = harness::golden::speed::TimingGoldens::default();
-    let pass = |pass, ms| PassSpeed {
-        pass,
-        pass_ms: vec![ms],
-        floor_ms: vec![1.0],
-        targets: None,
-        unslowed_ms: Vec::new(),
-    };
-    let probe = SceneSpeed {
+    let probe = probe_of(&[(PassId::ToneMap, 3.0), (PassId::Geometry, 2.0)]);
+    goldens.record(&probe, &[], &epyc("t0"));
+    goldens
+}
+
+/// A probe of scene "s" on gl, 12 rounds: each pass at its ms over a floor of 1 ms.
+fn probe_of(passes: &[(PassId, f64)]) -> SceneSpeed {
+    SceneSpeed {
         scene: "s".to_owned(),
         backend: BackendKind::Gl,
         rounds: 12,
-        passes: vec![pass(PassId::ToneMap, 3.0), pass(PassId::Geometry, 2.0)],
-    };
-    let stamp = harness::golden::speed::Stamp {
+        passes: passes
+            .iter()
+            .map(|&(pass, ms)| PassSpeed {
+                pass,
+                pass_ms: vec![ms],
+                floor_ms: vec![1.0],
+                targets: None,
+                unslowed_ms: Vec::new(),
+            })
+            .collect(),
+    }
+}
+
+/// The blessing EPYC's stamp at time `blessed`, without a reason.
+fn epyc(blessed: &'static str) -> harness::golden::speed::Stamp<'static> {
+    harness::golden::speed::Stamp {
         host: "the EPYC",
         cpu: "family 23 model 49 stepping 0",
-        blessed: "t0",
+        blessed,
         reason: None,
-    };
-    goldens.record(&probe, &[], &stamp);
-    goldens
+    }
 }
 
 /// `--every-pass` with `--pass` on the host that blessed rewrites the passes named and keeps
 /// the others (the section is replaced whole only when every pass is written).
 #[test]
 fn every_pass_with_named_passes_keeps_the_other_goldens() {
-    use harness::golden::speed::{SpeedOutcome, Stamp, Tier};
+    use harness::golden::speed::{SpeedOutcome, Tier};
     let mut goldens = two_goldens();
-    let probe = SceneSpeed {
-        scene: "s".to_owned(),
-        backend: BackendKind::Gl,
-        rounds: 12,
-        passes: vec![PassSpeed {
-            pass: PassId::ToneMap,
-            pass_ms: vec![4.0],
-            floor_ms: vec![1.0],
-            targets: None,
-            unslowed_ms: Vec::new(),
-        }],
-    };
+    let probe = probe_of(&[(PassId::ToneMap, 4.0)]);
     let checks = [check_of(
         PassId::ToneMap,
         Tier::SameHost,
         SpeedOutcome::Passed,
     )];
-    let stamp = Stamp {
-        host: "the EPYC",
-        cpu: "family 23 model 49 stepping 0",
-        blessed: "t1",
-        reason: None,
-    };
+    let stamp = epyc("t1");
     let options = TimingBless {
         every_pass: true,
         passes: &[PassId::ToneMap],
@@ -365,31 +342,15 @@ fn a_recorded_host_carries_over_only_what_moved() {
 /// "rewritten").
 #[test]
 fn a_pass_without_a_golden_is_written_new() {
-    use harness::golden::speed::{SpeedOutcome, Stamp, Tier};
+    use harness::golden::speed::{SpeedOutcome, Tier};
     let mut goldens = two_goldens();
-    let probe = SceneSpeed {
-        scene: "s".to_owned(),
-        backend: BackendKind::Gl,
-        rounds: 12,
-        passes: vec![PassSpeed {
-            pass: PassId::Skybox,
-            pass_ms: vec![2.5],
-            floor_ms: vec![1.0],
-            targets: None,
-            unslowed_ms: Vec::new(),
-        }],
-    };
+    let probe = probe_of(&[(PassId::Skybox, 2.5)]);
     let checks = [check_of(
         PassId::Skybox,
         Tier::SameHost,
         SpeedOutcome::MissingGolden,
     )];
-    let stamp = Stamp {
-        host: "the EPYC",
-        cpu: "family 23 model 49 stepping 0",
-        blessed: "t1",
-        reason: None,
-    };
+    let stamp = epyc("t1");
     let lines = bless_own(
         &mut goldens,
         &probe,
