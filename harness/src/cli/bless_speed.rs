@@ -61,14 +61,17 @@ pub(super) fn bless_speed(
         // here reads them at the limits for any host until they are measured here.
         let names: Vec<&str> = moved.into_iter().collect();
         let scenes: String = names.iter().map(|n| format!(" --scene {n}")).collect();
+        let measure = harness::golden::command_line::harness_command(&format!(
+            "noise --timing --write{scenes}"
+        ));
         println!(
             "note: {} timing goldens are this host's now, but golden/timing-noise.toml's \
-             same-host figures for them were measured on another host (or before the model \
-             kept where), so until this host's are measured its checks read them at the limits \
-             for any host. Measure them: `harness noise --timing --write{scenes}` (without the \
-             second Mesa: `harness noise --timing --write{scenes} --source runs --source \
-             busy-neighbour`). The recordings in golden/evidence/ were taken against the \
-             goldens replaced, and no longer apply to them",
+             same-host figures for them were measured on another host (or by a model that did \
+             not yet record where), so until this host's are measured its checks read them at \
+             the limits for any host. Measure them: `{measure}` (without the second Mesa: \
+             `{measure} --source runs --source busy-neighbour`). The recordings in \
+             golden/evidence/ were taken against the goldens replaced, and no longer apply to \
+             them",
             names.join(", ")
         );
     }

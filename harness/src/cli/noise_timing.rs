@@ -120,12 +120,10 @@ pub(super) fn timing(
             eprintln!("timing noise: {what} ...")
         });
     let wanted: Vec<&str> = scenes.iter().map(|(name, _)| name.as_str()).collect();
-    measurements.extend(
-        recorded_measurements
-            .into_iter()
-            .flatten()
-            .filter(|m| chosen(&m.source) && wanted.contains(&m.scene.as_str())),
-    );
+    measurements.extend(recorded_measurements.into_iter().flatten().filter(|m| {
+        // Figures of a backend not probed here would stand alone, without this host's.
+        chosen(&m.source) && wanted.contains(&m.scene.as_str()) && backends.contains(&m.backend)
+    }));
     sources.retain(|s| chosen(&s.name));
     for e in &errors {
         eprintln!("error: {e}");
@@ -148,15 +146,8 @@ pub(super) fn timing(
                     .collect();
                 measure::merged_replacing(old, measured, &moved)
             }
-            // Scenes not measured in this run keep their figures.
-            Ok(old) => {
-                let mut model = measured;
-                for (scene, figures) in old.scenes {
-                    model.scenes.entry(scene).or_insert(figures);
-                }
-                model.measured_on = old.measured_on;
-                model
-            }
+            // Scenes, backends and passes not measured in this run keep their figures.
+            Ok(old) => measure::remeasured(measured, old),
             Err(e) if !only.is_empty() => return Err(e.into()),
             Err(_) => measured,
         };

@@ -156,6 +156,14 @@ pub fn record_scaled_check(
     date: &str,
     reason: Option<&str>,
 ) -> Result<f64, String> {
+    if check.outcome == SpeedOutcome::MissingGolden {
+        return Err(
+            "no timing golden to scale (a pass new to the plan): its first golden comes from \
+             the host that blessed the backend's, or with the move here (`--speed-only \
+             --every-pass`)"
+                .to_owned(),
+        );
+    }
     if let SpeedOutcome::TargetsChanged(what) = &check.outcome {
         return Err(format!(
             "{what}: a ratio at other targets does not compare with the golden, so there is no \

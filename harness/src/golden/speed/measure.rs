@@ -284,6 +284,8 @@ pub fn model_from(
 /// added. What `noise --timing --source S --write` writes: one source measured again or a host
 /// recorded, without probing the others.
 pub fn merged(mut model: TimingNoise, measured: TimingNoise) -> TimingNoise {
+    // What a new pass borrows is the model as it was, not a scene added by this merge.
+    let before = model.clone();
     model.sources.extend(measured.sources);
     for (scene, backends) in measured.measured_on {
         model.measured_on.entry(scene).or_default().extend(backends);
@@ -297,7 +299,7 @@ pub fn merged(mut model: TimingNoise, measured: TimingNoise) -> TimingNoise {
                     .and_then(|b| b.get(&backend))
                     .is_some_and(|p| p.contains_key(&pass));
                 if !known {
-                    let borrowed = model.figures(&scene, backend, pass).map(|(f, _)| f);
+                    let borrowed = before.figures(&scene, backend, pass).map(|(f, _)| f);
                     if let Some(first) = first_figures(new, borrowed) {
                         model
                             .scenes
@@ -338,7 +340,7 @@ pub fn merged(mut model: TimingNoise, measured: TimingNoise) -> TimingNoise {
 /// measure keeps the borrowed figure. `None` (the pass left out, its checks borrowing as
 /// before) where a tier has neither: a placeholder is no figure, and a figure of 0 no limit.
 fn first_figures(new: PassNoise, borrowed: Option<PassNoise>) -> Option<PassNoise> {
-    let label = |at: &str| format!("{at}, borrowed");
+    let label = |at: &str| format!("{}, borrowed", at.trim_end_matches(", borrowed"));
     let (host, host_at) = match (&borrowed, new.host_at != "-") {
         (_, true) => (new.host, new.host_at),
         (Some(b), false) => (b.host, label(&b.host_at)),
@@ -357,6 +359,50 @@ fn first_figures(new: PassNoise, borrowed: Option<PassNoise>) -> Option<PassNois
         drivers,
         drivers_at,
     })
+}
+
+/// A full measurement (`measured`, every source of this run) laid over `old`: its passes
+/// replace old's, a pass new to the model starting from what it borrowed from `old`
+/// ([`first_figures`]: no other host has recorded it), and every scene, backend and pass it
+/// did not measure keeps its figures. What `noise --timing --write` writes without `--source`.
+pub fn remeasured(measured: TimingNoise, old: TimingNoise) -> TimingNoise {
+    let mut model = measured;
+    for (scene, backends) in &mut model.scenes {
+        for (backend, passes) in backends.iter_mut() {
+            let new: Vec<PassId> = passes
+                .keys()
+                .copied()
+                .filter(|pass| {
+                    old.scenes
+                        .get(scene)
+                        .and_then(|b| b.get(backend))
+                        .is_none_or(|p| !p.contains_key(pass))
+                })
+                .collect();
+            for pass in new {
+                let measured = passes.remove(&pass).expect("listed above");
+                let borrowed = old.figures(scene, *backend, pass).map(|(f, _)| f);
+                if let Some(first) = first_figures(measured, borrowed) {
+                    passes.insert(pass, first);
+                }
+            }
+        }
+    }
+    for (scene, backends) in old.scenes {
+        for (backend, passes) in backends {
+            let kept = model
+                .scenes
+                .entry(scene.clone())
+                .or_default()
+                .entry(backend)
+                .or_default();
+            for (pass, figures) in passes {
+                kept.entry(pass).or_insert(figures);
+            }
+        }
+    }
+    model.measured_on = old.measured_on;
+    model
 }
 
 /// As [`merged`], except that the same-host figures of `moved` (scenes and backends whose

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use engine::backend::BackendKind;
 use engine::plan::PassId;
-use harness::golden::speed::measure::{merged, model_from, TimingMeasurement};
+use harness::golden::speed::measure::{merged, model_from, remeasured, TimingMeasurement};
 use harness::golden::speed::recorded::*;
 use harness::golden::speed::{PassNoise, Tier, TimingNoise};
 
@@ -157,12 +157,33 @@ fn a_new_scene_measured_here_keeps_the_borrowed_figure_for_other_hosts() {
         pass: PassId::ToneMap,
         factor,
     };
+    // A second new scene in the same run, with a larger figure for other hosts: the first
+    // borrows from the model as it was, not from it.
+    let another = TimingMeasurement {
+        source: "cpu-avx".to_owned(),
+        tier: Tier::OtherHost,
+        scene: "another".to_owned(),
+        ..m(BackendKind::Gl, 1.9)
+    };
+    let another_here = TimingMeasurement {
+        scene: "another".to_owned(),
+        ..m(BackendKind::Gl, 1.1)
+    };
     let measured = model_from(
-        &[m(BackendKind::Gl, 1.2), m(BackendKind::WgpuVulkan, 1.3)],
+        &[
+            m(BackendKind::Gl, 1.2),
+            m(BackendKind::WgpuVulkan, 1.3),
+            another,
+            another_here,
+        ],
         &[],
         2.0,
     );
-    let model = merged(old, measured.clone());
+    let model = merged(old.clone(), measured.clone());
+    assert_eq!(
+        model.scenes["another"][&BackendKind::Gl][&PassId::ToneMap].drivers,
+        1.9
+    );
     assert_eq!(
         model.scenes["mine"][&BackendKind::Gl][&PassId::ToneMap],
         PassNoise {
@@ -175,6 +196,23 @@ fn a_new_scene_measured_here_keeps_the_borrowed_figure_for_other_hosts() {
     assert!(
         !model.scenes["mine"].contains_key(&BackendKind::WgpuVulkan),
         "nothing to borrow on wgpu-vulkan: left out"
+    );
+    // A full measurement (no --source) gives the new scene the same start, keeps what it did
+    // not measure, and labels a figure borrowed from a borrowed one once.
+    let full = remeasured(measured.clone(), old.clone());
+    assert_eq!(
+        full.scenes["mine"][&BackendKind::Gl][&PassId::ToneMap],
+        model.scenes["mine"][&BackendKind::Gl][&PassId::ToneMap]
+    );
+    assert_eq!(full.scenes["ibl"], old.scenes["ibl"]);
+    let mut lender = TimingNoise::default();
+    lender
+        .scenes
+        .insert("ibl".to_owned(), model.scenes["mine"].clone());
+    let again = remeasured(model_from(&[m(BackendKind::Gl, 1.2)], &[], 2.0), lender);
+    assert_eq!(
+        again.scenes["mine"][&BackendKind::Gl][&PassId::ToneMap].drivers_at,
+        "host-c, borrowed"
     );
     let dir = tempfile::tempdir().unwrap();
     model.save(dir.path()).unwrap();
