@@ -249,9 +249,7 @@ pub(crate) fn finish(
                  not take: a `bless --speed-only` probes the lighting as it is and finds it \
                  unchanged. To record the slowdown this check measured, accept it: `{} \
                  --speed-only`",
-                harness::golden::command_line::accept_command(
-                    Some(out).filter(|dir| *dir != crate::default_out_dir())
-                )
+                accept_command(out)
             );
         }
     }
@@ -365,11 +363,10 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
         for v in &run.verifications {
             println!("  {}", v.summary());
         }
-        let out = report.parent().filter(|dir| *dir != default_out_dir());
         println!(
             "  to accept exactly these outputs (nothing rendered again; or the review page's \
              Accept): {}",
-            harness::golden::command_line::accept_command(out)
+            accept_command(report.parent().unwrap_or(report))
         );
     }
     print_speed(run);
@@ -399,7 +396,7 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
         // Slower passes whose timing goldens a bless from here writes: the check's own figures
         // can be accepted as they are, as its kept images can.
         let acceptable_timings = run.speed.checks.iter().any(|c| {
-            c.outcome == harness::golden::speed::SpeedOutcome::Slower && c.tier.bless_writes_here()
+            c.outcome == harness::golden::speed::SpeedOutcome::Slower && c.bless_writes_here()
         });
         let kept = match (run.verifications.is_empty(), acceptable_timings) {
             (true, false) => String::new(),
@@ -412,9 +409,7 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
                 } else {
                     "accept what it kept, as above, and"
                 },
-                harness::golden::command_line::accept_command(
-                    report.parent().filter(|dir| *dir != default_out_dir())
-                )
+                accept_command(report.parent().unwrap_or(report))
             ),
         };
         println!(
@@ -427,6 +422,12 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
             println!("  {command}");
         }
     }
+}
+
+/// `bless --from-last-check` for a check that wrote to `out`, naming the folder unless it is
+/// the default.
+fn accept_command(out: &Path) -> String {
+    harness::golden::command_line::accept_command(Some(out).filter(|dir| *dir != default_out_dir()))
 }
 
 /// Why the failing passes failed: per failing output where the change starts (or which

@@ -251,7 +251,6 @@ pub fn speed_candidates(
     scenes: &[String],
     passes: &[String],
 ) -> Result<(Vec<crate::golden::speed::SpeedCheck>, CheckContext), AcceptError> {
-    use crate::golden::speed::SpeedOutcome;
     let (run, _) = last_check(out)?;
     let hosts = run
         .backends
@@ -266,15 +265,7 @@ pub fn speed_candidates(
         .speed
         .checks
         .into_iter()
-        .filter(|c| {
-            matches!(
-                c.outcome,
-                SpeedOutcome::Slower
-                    | SpeedOutcome::Faster
-                    | SpeedOutcome::MissingGolden
-                    | SpeedOutcome::TargetsChanged(_)
-            )
-        })
+        .filter(|c| c.outcome.moved())
         .filter(|c| {
             // A scene named as the check named it: by name, or by its file's path.
             scenes.is_empty()

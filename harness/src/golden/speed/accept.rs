@@ -190,14 +190,9 @@ fn current_reference<'a>(
     cpu: &str,
     golden: f64,
 ) -> Option<(&'a str, f64)> {
-    let (name, recording) = recordings
-        .iter()
-        .find(|(_, r)| r.records(check.backend, host, cpu))?;
-    let pass = recording
-        .scenes
-        .get(scene)?
-        .get(&check.backend)?
-        .get(&check.pass)?;
-    pass.reference(golden)
-        .map(|(reference, _)| (name.as_str(), reference))
+    let (name, recording) = super::recorded::of_host(recordings, check.backend, host, cpu)?;
+    let (reference, _) = recording
+        .pass(scene, check.backend, check.pass)?
+        .reference(golden)?;
+    Some((name, reference))
 }

@@ -8,7 +8,6 @@ use std::collections::BTreeMap;
 use engine::backend::BackendKind;
 use engine::plan::PassId;
 
-use super::recorded::RecordedTimings;
 use super::{
     check_speed_with, host_fingerprint, BackendTimings, PassTiming, SpeedCheck, SpeedError,
     SpeedOutcome, Tier, TimingGoldens, TimingNoise, BLESS_PROBES, CHECK_ROUNDS,
@@ -209,19 +208,6 @@ pub fn record_scaled_check(
         .ok_or_else(|| "no timing golden to scale".to_owned())
 }
 
-/// The name of the recording in `recordings` that holds this host (`host`, `cpu`) on `kind`.
-fn recorded_as<'a>(
-    recordings: &'a [(String, RecordedTimings)],
-    kind: BackendKind,
-    host: &str,
-    cpu: &str,
-) -> Option<&'a str> {
-    recordings
-        .iter()
-        .find(|(_, r)| r.records(kind, host, cpu))
-        .map(|(name, _)| name.as_str())
-}
-
 /// How a timing bless may write a scene's goldens on a backend.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Writing {
@@ -284,7 +270,7 @@ pub fn bless_scenes(
     let mut lines = Vec::new();
     for (kind, driver) in backends {
         let host = host_fingerprint(driver);
-        let recorded = recorded_as(&recordings, *kind, &host, &cpu);
+        let recorded = super::recorded::of_host(&recordings, *kind, &host, &cpu);
         // Decided before probing: a backend whose goldens are all another host's is not probed,
         // unless this host is recorded (then its slowdowns are carried over, scaled).
         let mut writable = Vec::new();
@@ -372,18 +358,6 @@ pub fn bless_scenes(
     Ok(lines)
 }
 
-/// Whether a check's verdict is a move a bless writes: beyond its limit either way, no golden
-/// yet, or other targets than its golden's.
-fn moved(outcome: &SpeedOutcome) -> bool {
-    matches!(
-        outcome,
-        SpeedOutcome::Slower
-            | SpeedOutcome::Faster
-            | SpeedOutcome::MissingGolden
-            | SpeedOutcome::TargetsChanged(_)
-    )
-}
-
 /// The lines of a bless of this host's own section (`moving`: another host's, moving here
 /// whole): the passes that moved, every pass (`options.every_pass`, or moving), or the ones
 /// named, recorded from `probe` with `stamp`; nothing with `options.dry_run`. The section is
@@ -415,7 +389,7 @@ pub fn bless_own(
     let mut rewrite = Vec::new();
     let mut lines = Vec::new();
     for check in checks.iter().filter(|c| options.names(c.pass)) {
-        let written = every_pass || moved(&check.outcome);
+        let written = every_pass || check.outcome.moved();
         if written {
             rewrite.push(check.pass);
         }
@@ -463,7 +437,7 @@ pub fn bless_scaled(
         .map(|check| {
             let mut previous = check.describe();
             let mut this_fate = Fate::Kept;
-            let asked = !options.passes.is_empty() || moved(&check.outcome);
+            let asked = !options.passes.is_empty() || check.outcome.moved();
             let mut refused = false;
             if asked {
                 let mut scaled = goldens.clone();

@@ -103,13 +103,18 @@ pub enum SpeedError {
 /// its key (a NaN ratio would read "xNaN of golden ... ok", a negative one always "faster").
 fn positive_finite<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
     let value = <f64 as serde::Deserialize>::deserialize(deserializer)?;
-    if value.is_finite() && value > 0.0 {
+    if is_positive_finite(value) {
         Ok(value)
     } else {
         Err(serde::de::Error::custom(format!(
             "{value} is not a finite positive number"
         )))
     }
+}
+
+/// Whether `value` is a ratio or factor the speed files can hold: finite and positive.
+fn is_positive_finite(value: f64) -> bool {
+    value.is_finite() && value > 0.0
 }
 
 /// Reads a TOML file of the speed goldens: its value, or `None` when there is no file yet.

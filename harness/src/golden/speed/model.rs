@@ -168,8 +168,9 @@ impl TimingNoise {
         for (scene, backends) in &self.scenes {
             for (backend, passes) in backends {
                 for (pass, n) in passes {
-                    let figure = |x: f64| x.is_finite() && x > 0.0;
-                    if !(figure(n.host) && figure(n.drivers)) {
+                    // What reading it back would refuse (`positive_finite`).
+                    if !(super::is_positive_finite(n.host) && super::is_positive_finite(n.drivers))
+                    {
                         return Err(SpeedError::File {
                             path: Self::path(root),
                             message: format!(

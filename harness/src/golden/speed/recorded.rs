@@ -140,6 +140,11 @@ impl RecordedTimings {
             .is_some_and(|h| super::same_host(h, &self.cpu, host, cpu))
     }
 
+    /// The recorded ratios of `pass` of `scene` on `kind`.
+    pub fn pass(&self, scene: &str, kind: BackendKind, pass: PassId) -> Option<&RecordedPass> {
+        self.scenes.get(scene)?.get(&kind)?.get(&pass)
+    }
+
     /// The file of the host `name` under the golden root.
     pub fn path(root: &Path, name: &str) -> PathBuf {
         root.join("evidence").join(name).join(RECORDED_TIMING_FILE)
@@ -258,6 +263,20 @@ pub fn recorded_hosts(
             (source, measurements)
         })
         .collect())
+}
+
+/// The recording among `recordings` (named, as [`load_all`] reads them) of this host:
+/// fingerprint `host` on `kind`, CPU signature `cpu` ([`RecordedTimings::records`]).
+pub fn of_host<'a>(
+    recordings: &'a [(String, RecordedTimings)],
+    kind: BackendKind,
+    host: &str,
+    cpu: &str,
+) -> Option<(&'a str, &'a RecordedTimings)> {
+    recordings
+        .iter()
+        .find(|(_, r)| r.records(kind, host, cpu))
+        .map(|(name, r)| (name.as_str(), r))
 }
 
 /// Every recording under `root`'s evidence folder, by host name, checked: every ratio and

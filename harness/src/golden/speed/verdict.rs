@@ -30,6 +30,18 @@ pub enum SpeedOutcome {
 }
 
 impl SpeedOutcome {
+    /// Whether the pass moved as a bless or an accept writes it: beyond its limit either way,
+    /// without a golden, or at other targets than its golden's.
+    pub fn moved(&self) -> bool {
+        matches!(
+            self,
+            SpeedOutcome::Slower
+                | SpeedOutcome::Faster
+                | SpeedOutcome::MissingGolden
+                | SpeedOutcome::TargetsChanged(_)
+        )
+    }
+
     /// The verdict as one word, as the console, the summary and the review page show it.
     pub fn label(&self) -> &'static str {
         match self {
@@ -205,12 +217,8 @@ pub fn check_speed_with(
         }
         _ => Tier::OtherHost,
     };
-    let recording = (host_tier == Tier::OtherHost && !recordings.is_empty())
-        .then(|| {
-            recordings
-                .iter()
-                .find(|(_, r)| r.records(probe.backend, host, &cpu))
-        })
+    let recording = (host_tier == Tier::OtherHost)
+        .then(|| super::recorded::of_host(recordings, probe.backend, host, &cpu))
         .flatten();
     let mut checks = Vec::new();
     for pass in &probe.passes {
@@ -226,11 +234,7 @@ pub fn check_speed_with(
             _ => None,
         };
         let own = recording.and_then(|(name, r)| {
-            let recorded = r
-                .scenes
-                .get(&probe.scene)?
-                .get(&probe.backend)?
-                .get(&pass.pass)?;
+            let recorded = r.pass(&probe.scene, probe.backend, pass.pass)?;
             let (reference, spread) = recorded.reference(blessed?)?;
             Some((name, reference, spread))
         });
