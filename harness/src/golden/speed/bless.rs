@@ -73,8 +73,10 @@ pub enum Fate {
     Rewritten,
     /// Written where there was none.
     Written,
-    /// Would be written (a dry run).
+    /// Would be written over the golden there is (a dry run).
     WouldBeRewritten,
+    /// Would be written where there is none (a dry run).
+    WouldBeWritten,
     /// Left as it was.
     Kept,
 }
@@ -92,6 +94,7 @@ impl std::fmt::Display for Fate {
             Fate::Rewritten => "rewritten",
             Fate::Written => "written (new)",
             Fate::WouldBeRewritten => "would be rewritten (dry run)",
+            Fate::WouldBeWritten => "would be written (new; dry run)",
             Fate::Kept => "kept",
         })
     }
@@ -400,7 +403,11 @@ pub fn bless_own(
             previous: check.describe(),
             fate: match (written, &check.outcome) {
                 (false, _) => Fate::Kept,
-                (true, SpeedOutcome::MissingGolden) if fate == Fate::Rewritten => Fate::Written,
+                (true, SpeedOutcome::MissingGolden) => match fate {
+                    Fate::Rewritten => Fate::Written,
+                    Fate::WouldBeRewritten => Fate::WouldBeWritten,
+                    other => other,
+                },
                 (true, _) => fate,
             },
             moved_here: moving,

@@ -370,4 +370,29 @@ fn a_pass_without_a_golden_is_written_new() {
     let gl = &goldens.backends[&BackendKind::Gl];
     assert_eq!(gl.passes[&PassId::Skybox].ratio, 2.5);
     assert_eq!(gl.passes.len(), 3, "the others kept");
+    // A dry run says the same of it, and writes nothing.
+    let mut untouched = two_goldens();
+    let dry = TimingBless {
+        dry_run: true,
+        ..TimingBless::default()
+    };
+    let lines = bless_own(
+        &mut untouched,
+        &probe,
+        &checks,
+        false,
+        dry,
+        &stamp,
+        Fate::WouldBeRewritten,
+    );
+    assert_eq!(lines[0].fate, Fate::WouldBeWritten);
+    assert!(!lines[0].fate.written());
+    assert!(
+        lines[0]
+            .to_string()
+            .ends_with("; would be written (new; dry run)"),
+        "{}",
+        lines[0]
+    );
+    assert_eq!(untouched, two_goldens());
 }
