@@ -9,7 +9,8 @@
   style.textContent =
     'button.accept{margin-right:.5em} tr.accepted td{background:#e3f4e3}' +
     ' .accept-bar{margin:.5em 0} .accept-bar button{margin-right:.4em}' +
-    ' .accept-bar input.accept-reason{width:36em;margin:0 .4em .4em 0}';
+    ' .accept-bar input.accept-reason{width:36em;margin:0 .4em .4em 0}' +
+    ' ul.accept-notes{background:#f4f4e3;padding:.4em 1.6em}';
   document.head.appendChild(style);
 
   // A speed row's pass is a plan pass; the server names an accepted timing `speed <pass>`. An
@@ -41,6 +42,24 @@
   reason.placeholder = 'optional: a sentence, as in a commit message, kept beside each golden';
   reason.setAttribute('aria-label', 'why it changed');
 
+  // What each timing golden written says (how it was written, and on a recorded host how to
+  // record it again), as `bless --from-last-check` prints it: listed above the summary.
+  function note(lines) {
+    if (!lines || !lines.length) return;
+    let list = document.querySelector('ul.accept-notes');
+    if (!list) {
+      list = document.createElement('ul');
+      list.className = 'accept-notes';
+      const summary = document.getElementById('summary');
+      summary.parentNode.insertBefore(list, summary);
+    }
+    for (const line of lines) {
+      const item = document.createElement('li');
+      item.textContent = line;
+      list.appendChild(item);
+    }
+  }
+
   function accept(filter, button) {
     button.disabled = true;
     button.textContent = 'accepting…';
@@ -54,6 +73,7 @@
       .then((response) => response.json())
       .then((answer) => {
         mark(answer.accepted);
+        note(answer.notes);
         if (answer.refused.length) {
           button.disabled = false;
           button.textContent = 'refused';

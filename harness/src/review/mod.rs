@@ -70,6 +70,10 @@ pub struct AcceptAnswer {
     pub accepted: Vec<(String, String, BackendKind)>,
     /// Those refused, with why.
     pub refused: Vec<(String, String, String)>,
+    /// A line per timing golden written, as `bless --from-last-check` prints it: how it was
+    /// written and, on a recorded host, which recording that made stale and how to record the
+    /// host again.
+    pub notes: Vec<String>,
 }
 
 /// The server of one review.
@@ -312,6 +316,7 @@ impl Review {
             let mut timings = AcceptAnswer::default();
             self.accept_timings(&scenes, &[], None, reason, store, &mut timings);
             answer.accepted.extend(timings.accepted);
+            answer.notes.extend(timings.notes);
             let nothing = answer.accepted.is_empty();
             answer.refused.extend(
                 timings
@@ -354,6 +359,7 @@ impl Review {
         {
             match result {
                 Ok(done) => {
+                    answer.notes.extend(done.written.iter().cloned());
                     // Each check is written, or kept out with why.
                     for c in checks.iter().filter(|c| c.scene == scene) {
                         let pass = format!("speed {}", c.pass);

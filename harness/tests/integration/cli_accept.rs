@@ -363,13 +363,28 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
             "r.querySelector('td.result').textContent",
         ));
         assert_eq!(marked, serde_json::json!("ACCEPTED"));
+        // What was written is said on the page, as the command line says it.
+        let notes = browser.eval("document.querySelector('ul.accept-notes').textContent");
+        let notes = notes.as_str().unwrap_or_default();
+        assert!(
+            notes.contains("arrow/geometry on gl (speed): ratio ") && notes.contains("written"),
+            "{notes}"
+        );
     } else {
         let answer = server.accept(&serde_json::json!({
             "scene": "arrow", "pass": "geometry", "backend": "gl", "speed": true, "reason": why
         }));
         assert_eq!(
-            answer,
-            serde_json::json!({ "accepted": [["arrow", "speed geometry", "gl"]], "refused": [] })
+            (&answer["accepted"], &answer["refused"]),
+            (
+                &serde_json::json!([["arrow", "speed geometry", "gl"]]),
+                &serde_json::json!([])
+            )
+        );
+        let notes = answer["notes"].to_string();
+        assert!(
+            notes.contains("arrow/geometry on gl (speed): ratio ") && notes.contains("written"),
+            "{notes}"
         );
     }
     drop(server);
