@@ -241,17 +241,7 @@ pub(crate) fn finish(
     if options.json {
         println!("{}", serde_json::to_string_pretty(run)?);
     } else {
-        print_table(run, &report, failures);
-        if options.unspecialised_lighting && run.speed.checks.iter().any(|c| c.failed()) {
-            // A bless probes again, without the debug slowdown: only an accept takes it.
-            println!(
-                "note: this check ran with --debug-unspecialised-lighting, which `bless` does \
-                 not take: a `bless --speed-only` probes the lighting as it is and finds it \
-                 unchanged. To record the slowdown this check measured, accept it: `{} \
-                 --speed-only`",
-                accept_command(out)
-            );
-        }
+        print_table(run, &report, failures, options.unspecialised_lighting);
     }
     Ok(if run.passed() {
         ExitCode::SUCCESS
@@ -309,7 +299,9 @@ fn note_borrowed_limits(cases: &[Case], store: &harness::golden::GoldenStore) {
 /// The results table on stdout: a line per scene, pass and backend, then the renders and
 /// scenes that failed, the backends that disagree, a summary line, and on a failure where the
 /// images are and the bless commands.
-fn print_table(run: &CheckRun, report: &Path, failures: &str) {
+/// The console's tables and advice; `unspecialised_lighting`: the check ran with
+/// `--debug-unspecialised-lighting`, which only an accept records.
+fn print_table(run: &CheckRun, report: &Path, failures: &str, unspecialised_lighting: bool) {
     println!(
         "{:<8} {:<17} {:<12} {:<12} worst metric",
         "scene", "pass", "backend", "result"
@@ -391,6 +383,22 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
     if failed > 0 {
         if run.results.iter().any(|r| !r.outcome.passed()) {
             println!("failure images: {failures}");
+        }
+        if unspecialised_lighting {
+            // A bless renders and probes again without the debug setting, and finds the
+            // lighting as it is: only an accept takes what this check measured.
+            println!(
+                "this check ran with --debug-unspecialised-lighting, which `bless` does not \
+                 take: a bless renders and probes the lighting as it is and finds it unchanged. \
+                 To record what this check measured, accept it: `{}{}`",
+                accept_command(report.parent().unwrap_or(report)),
+                if run.results.iter().all(|r| r.outcome.passed()) {
+                    " --speed-only"
+                } else {
+                    ""
+                }
+            );
+            return;
         }
         let commands = run.bless_commands();
         // Slower passes whose timing goldens a bless from here writes: the check's own figures
@@ -537,7 +545,7 @@ fn print_speed(run: &CheckRun) {
             c.scene,
             c.pass,
             c.backend,
-            c.describe()
+            c.measurement()
         );
     }
     for e in &run.speed.errors {

@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 
 use super::{case_id, metrics_text, result_label};
 use crate::golden::check::CheckRun;
+use crate::golden::speed::verdict::noise_words;
 use crate::html::escape;
 
 /// The summary table: failing checks first, each row linking to its case.
@@ -171,10 +172,7 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
             _ => c
                 .noise
                 .as_ref()
-                .map(|(n, at)| {
-                    let borrowed = if c.borrowed { ", borrowed" } else { "" };
-                    format!("noise x{n:.2} at {at}{borrowed}")
-                })
+                .map(|(n, from)| noise_words(*n, from, c.borrowed))
                 .unwrap_or_default(),
         };
         let _ = write!(

@@ -47,6 +47,48 @@ fn a_slowed_pass_is_submitted_that_many_times_and_no_other() {
     ));
 }
 
+/// `check --debug-unspecialised-lighting` (the real regression, reproduced) fails on
+/// the lighting passes and on no other pass or image, and its only advice is to accept what it
+/// measured: a bless renders and probes the specialised lighting again and finds no change.
+#[test]
+fn the_unspecialised_lighting_fails_check_on_the_lighting_passes_only() {
+    if !common::gl_available() {
+        return;
+    }
+    let out = tempfile::tempdir().unwrap();
+    let out_arg = out.path().to_str().unwrap();
+    let (code, stdout, stderr) = common::cli::harness(&[
+        "check",
+        "--debug-unspecialised-lighting",
+        "--scene",
+        "arrow",
+        "--backend",
+        "gl",
+        "--out",
+        out_arg,
+    ]);
+    assert_eq!(code, 1, "{stdout}{stderr}");
+    let json = std::fs::read(out.path().join("last-check.json")).unwrap();
+    assert!(common::cli::failing_passes(&json).is_empty(), "{stdout}");
+    let run: serde_json::Value = serde_json::from_slice(&json).unwrap();
+    let checks: Vec<harness::golden::speed::SpeedCheck> =
+        serde_json::from_value(run["speed"]["checks"].clone()).unwrap();
+    let failed: Vec<PassId> = checks
+        .iter()
+        .filter(|c| c.failed())
+        .map(|c| c.pass)
+        .collect();
+    assert!(
+        !failed.is_empty() && failed.iter().all(|p| matches!(p, PassId::Lighting(_))),
+        "{failed:?}\n{stdout}"
+    );
+    assert!(
+        stdout.contains("bless --from-last-check") && !stdout.contains("bless --scene"),
+        "{stdout}"
+    );
+    assert_eq!(stdout.matches("SLOWER").count(), failed.len(), "{stdout}");
+}
+
 /// `--debug-unspecialised-lighting` gives every lit draw the one generic variant (every light
 /// slot a draw holds, both light types, IBL, the PBR features branched per pixel) and the same
 /// picture: the slots past a draw's lights and the IBL of a draw without it add exact zeros.

@@ -123,8 +123,30 @@ impl SpeedCheck {
         )
     }
 
-    /// One line for the table: the value against the limit, or why there is none.
+    /// The check in one line, standing alone (a JUnit message, the review page's failures, a
+    /// bless line): [`Self::measurement`] and, where it moved, the verdict in words.
     pub fn describe(&self) -> String {
+        let verdict = match self.outcome {
+            SpeedOutcome::Slower => " SLOWER",
+            SpeedOutcome::Faster if self.tier == Tier::OtherHost => {
+                " faster (this host did not bless: ratios differ between hosts)"
+            }
+            SpeedOutcome::Faster if self.tier == Tier::RecordedHost => {
+                " faster than this host's recording: bless if intended"
+            }
+            SpeedOutcome::Faster => " faster: bless if intended",
+            _ => "",
+        };
+        let measurement = self.measurement();
+        if measurement.is_empty() {
+            return measurement;
+        }
+        format!("{measurement}{verdict}")
+    }
+
+    /// The value against the limit, or why there is none, without the verdict: the console
+    /// table's value column, beside its result column (the notes under it say what to do).
+    pub fn measurement(&self) -> String {
         match (&self.outcome, self.slowdown(), self.limit) {
             (SpeedOutcome::Untimed(why), ..) => format!("untimed: {why}"),
             (SpeedOutcome::MissingGolden, ..) => {
@@ -139,35 +161,19 @@ impl SpeedCheck {
                  ms now)",
                 self.ms
             ),
-            (outcome, Some(slowdown), Some(limit)) => {
+            (_, Some(slowdown), Some(limit)) => {
                 let noise = self
                     .noise
                     .as_ref()
-                    .map(|(n, at)| {
-                        format!(
-                            "noise x{n:.2} at {at}{}",
-                            if self.borrowed { ", borrowed" } else { "" }
-                        )
-                    })
+                    .map(|(n, from)| noise_words(*n, from, self.borrowed))
                     .unwrap_or_default();
-                let what = match outcome {
-                    SpeedOutcome::Slower => " SLOWER",
-                    SpeedOutcome::Faster if self.tier == Tier::OtherHost => {
-                        " faster (this host did not bless: ratios differ between hosts)"
-                    }
-                    SpeedOutcome::Faster if self.tier == Tier::RecordedHost => {
-                        " faster than this host's recording: bless if intended"
-                    }
-                    SpeedOutcome::Faster => " faster: bless if intended",
-                    _ => "",
-                };
                 let of = if self.tier == Tier::RecordedHost {
                     "this host's recording"
                 } else {
                     "golden"
                 };
                 format!(
-                    "x{slowdown:.3} of {of} (limit x{limit:.2}, {:.2} of it; {noise}; {:.2} ms){what}",
+                    "x{slowdown:.3} of {of} (limit x{limit:.2}, {:.2} of it; {noise}; {:.2} ms)",
                     self.score().unwrap_or(0.0),
                     self.ms
                 )
@@ -175,6 +181,14 @@ impl SpeedCheck {
             _ => String::new(),
         }
     }
+}
+
+/// A limit's noise figure and where it was measured, as the console and the review page show
+/// it, from the source that gave the largest spread: "noise x1.21 from runs", "noise x1.12 from
+/// host-d's recording", with ", borrowed" where other scenes lent the figure.
+pub fn noise_words(noise: f64, from: &str, borrowed: bool) -> String {
+    let borrowed = if borrowed { ", borrowed" } else { "" };
+    format!("noise x{noise:.2} from {from}{borrowed}")
 }
 
 /// The speed checks of one probe: each pass's ratio against its golden under the limit of
@@ -338,6 +352,9 @@ pub struct SpeedCoverage {
     pub timed: usize,
     /// Passes left untimed (too short, or too noisy at this tier to catch a doubling).
     pub untimed: usize,
+    /// Passes with nothing to compare with: no timing golden yet (a new scene before its
+    /// first bless), or one of other targets.
+    pub not_compared: usize,
     /// The timed passes' limits as factors: the smallest, the median and the largest.
     pub limits: Option<[f64; 3]>,
     /// How much slower than this run each timed pass must get to fail (its limit over its
@@ -386,8 +403,12 @@ impl SpeedCoverage {
             }
             _ => String::new(),
         };
+        let not_compared = match self.not_compared {
+            0 => String::new(),
+            n => format!("; {n} without a timing golden of the same targets to compare with"),
+        };
         format!(
-            "{} passes timed {how}{limits}{from_now}; {} untimed",
+            "{} passes timed {how}{limits}{from_now}; {} untimed{not_compared}",
             self.timed, self.untimed
         )
     }
@@ -446,6 +467,7 @@ pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
         tier: Tier,
         limits: Vec<f64>,
         untimed: usize,
+        not_compared: usize,
         fails_beyond: Vec<f64>,
         recording: Option<String>,
     }
@@ -462,6 +484,7 @@ pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
                     tier: c.tier,
                     limits: Vec::new(),
                     untimed: 0,
+                    not_compared: 0,
                     fails_beyond: Vec::new(),
                     recording: None,
                 });
@@ -476,7 +499,9 @@ pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
             // A limit too wide to catch a doubling times nothing, failing beyond it or not.
             (SpeedOutcome::Untimed(_), _) => group.untimed += 1,
             (_, Some(limit)) if limit >= MUST_CATCH => group.untimed += 1,
-            (SpeedOutcome::MissingGolden | SpeedOutcome::TargetsChanged(_), _) | (_, None) => {}
+            (SpeedOutcome::MissingGolden | SpeedOutcome::TargetsChanged(_), _) | (_, None) => {
+                group.not_compared += 1;
+            }
             (_, Some(limit)) => {
                 group.limits.push(limit);
                 // From a pass's speed in this run, how much slower it may get; a pass already
@@ -497,6 +522,7 @@ pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
             tier: g.tier,
             timed: g.limits.len(),
             untimed: g.untimed,
+            not_compared: g.not_compared,
             limits: spread(g.limits),
             fails_beyond: spread(g.fails_beyond),
             recording: g.recording,

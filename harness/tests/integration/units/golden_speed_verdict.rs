@@ -376,20 +376,30 @@ fn coverage_counts_the_timed_and_untimed_passes_per_backend_and_tier() {
     ];
     let found: Vec<_> = coverage(&checks)
         .iter()
-        .map(|c| (c.backend, c.tier, c.timed, c.untimed, c.limits))
+        .map(|c| {
+            (
+                c.backend,
+                c.tier,
+                c.timed,
+                c.untimed,
+                c.not_compared,
+                c.limits,
+            )
+        })
         .collect();
     assert_eq!(
         found,
         [
-            (Gl, Tier::SameHost, 3, 1, Some([1.44, 1.6, 1.8])),
-            (WgpuVulkan, Tier::OtherHost, 1, 1, Some([1.5; 3])),
-            (Gl, Tier::RecordedHost, 1, 0, Some([1.69; 3])),
+            (Gl, Tier::SameHost, 3, 1, 1, Some([1.44, 1.6, 1.8])),
+            (WgpuVulkan, Tier::OtherHost, 1, 1, 0, Some([1.5; 3])),
+            (Gl, Tier::RecordedHost, 1, 0, 0, Some([1.69; 3])),
         ]
     );
+    // The pass without a golden is neither timed nor untimed, and said apart.
     assert_eq!(
         coverage(&checks)[0].describe(),
         "3 passes timed on the host that blessed, limits x1.44 to x1.80 (median x1.60); \
-         1 untimed"
+         1 untimed; 1 without a timing golden of the same targets to compare with"
     );
     // A recording's limits are named by the recording.
     let mut recorded = covered(Gl, Tier::RecordedHost, SpeedOutcome::Passed, Some(1.69));
