@@ -2,6 +2,7 @@
 //! limit derived from its figures as documented (margin x max(noise, resolution)); renders
 //! recorded on another host pass with room. None of this renders: it needs no backend.
 
+use crate::common;
 use engine::plan::TargetId;
 use harness::golden::noise::{self, NoiseModel, MAX_NOISE_RATIO};
 use harness::golden::portability;
@@ -107,6 +108,49 @@ fn renders_recorded_on_another_host_pass_with_room() {
         }
     }
     assert_eq!(measured, 2, "expected chess and ibl finals from host-b");
+}
+
+/// A recorded render of a picture that has changed since is measured against the golden pinned
+/// beside it (`<scene>_<pass>_<backend>.golden.png`, the golden of its day), not today's: with
+/// today's golden moved (darkened by 2/255 here) host-b's ibl final still passes with room
+/// against its pin, and a pin that no longer matches the render fails it.
+#[test]
+fn a_recorded_render_is_measured_against_its_pinned_golden() {
+    let root = common::temp_workspace();
+    let store = GoldenStore::new(root.path().join("golden"));
+    let case = suite::canonical_cases()
+        .unwrap()
+        .into_iter()
+        .find(|c| c.name() == "ibl")
+        .unwrap();
+    let host_b = store.root().join("evidence/host-b");
+    let pin = host_b.join(format!("ibl_final_gl.{}.png", portability::PINNED_GOLDEN));
+    let worst = |store: &GoldenStore| {
+        let (measurements, missed) = portability::measure_recorded(store, &case, "host-b", &host_b);
+        assert!(missed.is_empty(), "{missed:?}");
+        assert_eq!(measurements.len(), 1);
+        portability::ratios(std::slice::from_ref(&case), &measurements)
+            .iter()
+            .map(|r| r.ratio)
+            .fold(0.0, f64::max)
+    };
+    if !pin.exists() {
+        // Today's golden is the picture host-b rendered: pin it as it is.
+        std::fs::copy(store.root().join("ibl/final.png"), &pin).unwrap();
+    }
+    let pinned = worst(&store);
+    assert!(pinned <= MAX_NOISE_RATIO, "{pinned:.2} of the limit");
+    common::cli::darken(&store.root().join("ibl/final.png"), 2);
+    assert_eq!(
+        worst(&store),
+        pinned,
+        "measured against the pin, not today's golden"
+    );
+    common::cli::darken(&pin, 2);
+    assert!(
+        worst(&store) > 1.0,
+        "a pin the render does not match fails it"
+    );
 }
 
 /// Synthetic rounding of a golden light buffer's tone mapping moves 8-bit values by one step at

@@ -16,6 +16,10 @@ use crate::golden::check::CheckRun;
 use crate::golden::suite::Case;
 use crate::golden::{self, GoldenStore, Outcome};
 
+/// The infix of a recorded render's pinned golden (`chess_final_gl.golden.png`): see
+/// [`measure_recorded`].
+pub const PINNED_GOLDEN: &str = "golden";
+
 /// One measurement: a render of one scene under one source, every golden pass's checks.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Measurement {
@@ -190,13 +194,29 @@ fn measure_outputs(
     backend: Option<BackendKind>,
     outputs: &BTreeMap<TargetId, Image>,
 ) -> Vec<Measurement> {
+    measure_outputs_against(store, case, source, backend, outputs, None)
+}
+
+/// [`measure_outputs`], each output against `pinned` where given instead of its golden.
+fn measure_outputs_against(
+    store: &GoldenStore,
+    case: &Case,
+    source: &str,
+    backend: Option<BackendKind>,
+    outputs: &BTreeMap<TargetId, Image>,
+    pinned: Option<&Image>,
+) -> Vec<Measurement> {
     let mut measurements = Vec::new();
     for (&pass, image) in outputs {
         let Some(rule) = case.rules.get(&pass) else {
             continue;
         };
-        let Ok(Some(golden)) = store.load(case.name(), pass, golden::is_eight_bit(image)) else {
-            continue;
+        let golden = match pinned {
+            Some(pinned) => pinned.clone(),
+            None => match store.load(case.name(), pass, golden::is_eight_bit(image)) {
+                Ok(Some(golden)) => golden,
+                _ => continue,
+            },
         };
         if let Some(values) = values_of(&golden::check(image, Some(&golden), rule)) {
             measurements.push(Measurement {
@@ -227,7 +247,12 @@ pub fn measure_synthetic(
     )
 }
 
-/// Measures renders recorded on another host: `<dir>/<scene>_<pass>_<backend>.png|exr`.
+/// Measures renders recorded on another host: `<dir>/<scene>_<pass>_<backend>.png|exr`, each
+/// against the golden of its pass or, where the picture has changed since it was recorded,
+/// against `<scene>_<pass>_<backend>.golden.png|exr` beside it ([`PINNED_GOLDEN`]): the golden
+/// as it was when the host rendered it. A recorded render is evidence of another CPU's rounding
+/// of one picture, which the limits must hold; it cannot be rendered again of a new picture
+/// without that host, and the pinned golden keeps it evidence of the same thing.
 pub fn measure_recorded(
     store: &GoldenStore,
     case: &Case,
@@ -244,20 +269,25 @@ pub fn measure_recorded(
                 if !path.exists() {
                     continue;
                 }
-                let read = if eight_bit {
-                    crate::images::read_png(&path)
-                } else {
-                    crate::images::read_exr(&path)
+                let read = |path: &Path| {
+                    if eight_bit {
+                        crate::images::read_png(path)
+                    } else {
+                        crate::images::read_exr(path)
+                    }
                 };
-                match read {
-                    Ok(image) => {
+                let pinned = dir.join(format!("{stem}.{PINNED_GOLDEN}.{extension}"));
+                let pinned = pinned.exists().then(|| read(&pinned)).transpose();
+                match read(&path).and_then(|image| Ok((image, pinned?))) {
+                    Ok((image, pinned)) => {
                         let outputs = BTreeMap::from([(*pass, image)]);
-                        measurements.extend(measure_outputs(
+                        measurements.extend(measure_outputs_against(
                             store,
                             case,
                             source,
                             Some(backend),
                             &outputs,
+                            pinned.as_ref(),
                         ));
                     }
                     Err(e) => missed.push(Missed {

@@ -18,7 +18,7 @@ pub mod sources;
 
 pub use measuring::{
     known_driver_crash, measure, measure_environment, measure_recorded, measure_synthetic,
-    Measurement, Missed, SourceRun,
+    Measurement, Missed, SourceRun, PINNED_GOLDEN,
 };
 pub use model::{build_model, ratios, table, Ratio};
 pub use rounding::{requantize_final, step_ulps, synthetic_rounding, tone_map, ulp_noise};
