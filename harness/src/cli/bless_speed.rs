@@ -51,16 +51,17 @@ pub(super) fn bless_speed(
     for line in &lines {
         println!("{line}");
     }
-    let moved: std::collections::BTreeSet<&str> = lines
-        .iter()
-        .filter(|l| l.moved_here && l.fate.written())
-        .map(|l| l.scene.as_str())
-        .collect();
-    if !moved.is_empty() {
-        // The model's same-host figures are the previous blessing host's noise, and a check
-        // here reads them at the limits for any host until they are measured here.
-        let names: Vec<&str> = moved.into_iter().collect();
-        let scenes: String = names.iter().map(|n| format!(" --scene {n}")).collect();
+    // Goldens moved here whose same-host figures this host has not measured (where it has,
+    // from an earlier move, its checks read them at its own limits at once).
+    let model = harness::golden::speed::TimingNoise::load(store.root())?;
+    let unmeasured = harness::golden::speed::bless::moved_without_figures_here(
+        &lines,
+        &model,
+        &backends,
+        &harness::golden::speed::cpu_signature(),
+    );
+    if !unmeasured.is_empty() {
+        let scenes: String = unmeasured.iter().map(|n| format!(" --scene {n}")).collect();
         let measure = harness::golden::command_line::harness_command(&format!(
             "noise --timing --write{scenes}"
         ));
@@ -69,15 +70,24 @@ pub(super) fn bless_speed(
              same-host figures for them were measured on another host (or by a model that did \
              not yet record where), so until this host's are measured its checks read them at \
              the limits for any host. Measure them: `{measure}` (without the second Mesa: \
-             `{measure} --source runs --source busy-neighbour`). The recordings in \
-             golden/evidence/ were taken against the goldens replaced, and no longer apply to \
-             them",
-            names.join(", ")
+             `{measure} --source runs --source busy-neighbour`)",
+            unmeasured.join(", ")
+        );
+    }
+    let moved: std::collections::BTreeSet<&str> = lines
+        .iter()
+        .filter(|l| l.moved_here && l.fate.written())
+        .map(|l| l.scene.as_str())
+        .collect();
+    if !moved.is_empty() {
+        println!(
+            "note: the recordings in golden/evidence/ were taken against the timing goldens of \
+             {} that this bless replaced, and no longer apply to them",
+            moved.into_iter().collect::<Vec<_>>().join(", ")
         );
     }
     // A scene whose timing goldens are new and that the model has no figures of: its checks
     // borrow every scene's until its own are measured.
-    let model = harness::golden::speed::TimingNoise::load(store.root())?;
     let mut new: Vec<&str> = lines
         .iter()
         .filter(|l| l.fate == harness::golden::speed::bless::Fate::Written)

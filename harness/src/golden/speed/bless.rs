@@ -66,6 +66,34 @@ pub struct SpeedBlessed {
     pub refused: bool,
 }
 
+/// The scenes (sorted, once each) among `lines` whose timing goldens moved to this host whole
+/// and whose same-host figures in `model` were not measured here: their checks read them at the
+/// limits for any host until this host measures its own. `hosts` holds each backend's
+/// fingerprint here, `cpu` this host's signature ([`super::cpu_signature`]).
+pub fn moved_without_figures_here<'a>(
+    lines: &'a [SpeedBlessed],
+    model: &super::TimingNoise,
+    hosts: &[(BackendKind, String)],
+    cpu: &str,
+) -> Vec<&'a str> {
+    let measured_here = |line: &SpeedBlessed| {
+        hosts
+            .iter()
+            .find(|(kind, _)| *kind == line.backend)
+            .is_some_and(|(_, host)| {
+                model.figures_measured_on_host(&line.scene, line.backend, host, cpu)
+            })
+    };
+    let mut scenes: Vec<&str> = lines
+        .iter()
+        .filter(|l| l.moved_here && l.fate.written() && !measured_here(l))
+        .map(|l| l.scene.as_str())
+        .collect();
+    scenes.sort_unstable();
+    scenes.dedup();
+    scenes
+}
+
 /// What a timing bless did, or in a dry run would do, with a golden.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Fate {

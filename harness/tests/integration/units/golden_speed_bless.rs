@@ -396,3 +396,57 @@ fn a_pass_without_a_golden_is_written_new() {
     );
     assert_eq!(untouched, two_goldens());
 }
+
+/// After goldens move here whole, the note to measure this host's timing noise names the
+/// scenes whose same-host figures were measured elsewhere, once each, and not one whose figures
+/// this host measured already (an earlier move): there the checks read its own limits at once.
+#[test]
+fn the_measure_noise_note_names_only_moved_scenes_measured_elsewhere() {
+    use harness::golden::speed::{cpu_signature, TimingNoise};
+    let line = |scene: &str, backend: BackendKind, fate: Fate, moved_here: bool| SpeedBlessed {
+        scene: scene.to_owned(),
+        backend,
+        pass: None,
+        previous: String::new(),
+        fate,
+        moved_here,
+        refused: false,
+    };
+    let lines = [
+        line("measured-here", BackendKind::Gl, Fate::Rewritten, true),
+        line("measured-elsewhere", BackendKind::Gl, Fate::Rewritten, true),
+        line(
+            "measured-elsewhere",
+            BackendKind::WgpuVulkan,
+            Fate::Rewritten,
+            true,
+        ),
+        line("not-moved", BackendKind::Gl, Fate::Rewritten, false),
+        line("dry-run", BackendKind::Gl, Fate::WouldBeRewritten, true),
+    ];
+    let cpu = cpu_signature();
+    let mut model = TimingNoise::default();
+    for (scene, host) in [
+        ("measured-here", "this host"),
+        ("measured-elsewhere", "another host"),
+        ("not-moved", "another host"),
+        ("dry-run", "another host"),
+    ] {
+        for backend in [BackendKind::Gl, BackendKind::WgpuVulkan] {
+            model
+                .scenes
+                .entry(scene.to_owned())
+                .or_default()
+                .insert(backend, Default::default());
+            model.stamp_measured_on(scene, backend, host, &cpu);
+        }
+    }
+    let hosts = [
+        (BackendKind::Gl, "this host".to_owned()),
+        (BackendKind::WgpuVulkan, "this host".to_owned()),
+    ];
+    assert_eq!(
+        moved_without_figures_here(&lines, &model, &hosts, &cpu),
+        ["measured-elsewhere"]
+    );
+}
