@@ -56,7 +56,13 @@ pub fn summary(run: &CheckRun, report: &Path) -> String {
     {
         let label = c.outcome.label();
         let pass = format!("speed {}", c.pass);
-        failing.push(row(&c.scene, &pass, c.backend.name(), label, &c.describe()));
+        failing.push(row(
+            &c.scene,
+            &pass,
+            c.backend.name(),
+            label,
+            &c.measurement(),
+        ));
     }
     for e in &run.speed.errors {
         failing.push(row("-", "speed probe", "-", "ERROR", e));

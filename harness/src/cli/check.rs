@@ -298,9 +298,9 @@ fn note_borrowed_limits(cases: &[Case], store: &harness::golden::GoldenStore) {
 
 /// The results table on stdout: a line per scene, pass and backend, then the renders and
 /// scenes that failed, the backends that disagree, a summary line, and on a failure where the
-/// images are and the bless commands.
-/// The console's tables and advice; `unspecialised_lighting`: the check ran with
-/// `--debug-unspecialised-lighting`, which only an accept records.
+/// images are and what to do: the bless commands, or for the speed checks of a check with
+/// `--debug-unspecialised-lighting` (`unspecialised_lighting`), which a bless does not take,
+/// the accept.
 fn print_table(run: &CheckRun, report: &Path, failures: &str, unspecialised_lighting: bool) {
     println!(
         "{:<8} {:<17} {:<12} {:<12} worst metric",
@@ -361,7 +361,7 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str, unspecialised_ligh
             accept_command(report.parent().unwrap_or(report))
         );
     }
-    print_speed(run);
+    super::check_speed::print_speed(run);
     let failed = run.results.iter().filter(|r| !r.outcome.passed()).count()
         + run.speed.checks.iter().filter(|c| c.failed()).count()
         + run.speed.errors.len();
@@ -384,21 +384,35 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str, unspecialised_ligh
         if run.results.iter().any(|r| !r.outcome.passed()) {
             println!("failure images: {failures}");
         }
-        if unspecialised_lighting {
-            // A bless renders and probes again without the debug setting, and finds the
-            // lighting as it is: only an accept takes what this check measured.
-            println!(
-                "this check ran with --debug-unspecialised-lighting, which `bless` does not \
-                 take: a bless renders and probes the lighting as it is and finds it unchanged. \
-                 To record what this check measured, accept it: `{}{}`",
-                accept_command(report.parent().unwrap_or(report)),
-                if run.results.iter().all(|r| r.outcome.passed()) {
-                    " --speed-only"
-                } else {
-                    ""
-                }
-            );
-            return;
+        let failed_speed = |c: &&harness::golden::speed::SpeedCheck| c.failed();
+        if unspecialised_lighting && run.speed.checks.iter().any(|c| failed_speed(&c)) {
+            // A bless probes again without the debug setting and finds the lighting as it is:
+            // only an accept takes what this check measured, and only where a timing bless
+            // writes (this host blessed the goldens, or is recorded against them).
+            if run
+                .speed
+                .checks
+                .iter()
+                .filter(failed_speed)
+                .any(|c| c.bless_writes_here())
+            {
+                println!(
+                    "this check ran with --debug-unspecialised-lighting, which `bless` does not \
+                     take: a bless probes the lighting as it is and finds it unchanged. To record \
+                     the timings this check measured, accept them: `{} --speed-only`",
+                    accept_command(report.parent().unwrap_or(report))
+                );
+            } else {
+                println!(
+                    "this check ran with --debug-unspecialised-lighting: its slowdowns are \
+                     against another host's timing goldens, which this host neither blessed nor \
+                     is recorded against, so nothing here can record them (`harness noise \
+                     --timing --record-host NAME` records this host)"
+                );
+            }
+            if run.results.iter().all(|r| r.outcome.passed()) {
+                return;
+            }
         }
         let commands = run.bless_commands();
         // Slower passes whose timing goldens a bless from here writes: the check's own figures
@@ -517,82 +531,5 @@ fn print_load_warnings_of(run: &CheckRun, scene: &str) {
             "    and {} more (`harness inspect` lists them)",
             warnings.len() - WARNINGS_QUOTED
         );
-    }
-}
-
-/// The speed section of the table: a line per scene, pass and backend (the value against the
-/// limit, or why it is untimed), the probes that failed, and the passes that got faster.
-fn print_speed(run: &CheckRun) {
-    use harness::golden::speed::SpeedOutcome;
-    if run.speed.checks.is_empty() && run.speed.errors.is_empty() {
-        return;
-    }
-    println!(
-        "\nspeed: each pass alone over its floor, against its timing golden \
-         (golden/<scene>/timing.toml; limits from golden/timing-noise.toml), or on a recorded \
-         host against its own recording (golden/evidence/<host>/timing.toml); \"0.52 of it\" after \
-         the limit places the ratio on the way to it, ln(ratio / golden) / ln(limit): 0 \
-         unchanged, 1 at the limit (fails above), negative faster"
-    );
-    println!(
-        "{:<8} {:<22} {:<12} {:<8} value",
-        "scene", "pass", "backend", "result"
-    );
-    for c in &run.speed.checks {
-        let label = c.outcome.label();
-        println!(
-            "{:<8} {:<22} {:<12} {label:<8} {}",
-            c.scene,
-            c.pass,
-            c.backend,
-            c.measurement()
-        );
-    }
-    for e in &run.speed.errors {
-        println!("speed probe FAILED: {e}");
-    }
-    let faster = |same_host: bool| -> Vec<String> {
-        run.speed
-            .checks
-            .iter()
-            .filter(|c| {
-                c.outcome == SpeedOutcome::Faster && c.tier.bless_writes_here() == same_host
-            })
-            .map(|c| format!("{}/{} on {}", c.scene, c.pass, c.backend))
-            .collect()
-    };
-    let (here, elsewhere) = (faster(true), faster(false));
-    if !here.is_empty() {
-        println!(
-            "note: faster than their timing goldens beyond the limit (bless if intended, \
-             `harness bless --scene S --speed-only`): {}",
-            here.join(", ")
-        );
-    }
-    if !elsewhere.is_empty() {
-        println!(
-            "note: faster beyond the limit, on a host that neither blessed the timing goldens \
-             nor is recorded against them (ratios differ between hosts: record this host, or \
-             record it again, with `harness noise --timing --record-host NAME`, then bless \
-             with `--speed-only`; or move the timing goldens here whole with \
-             `harness bless --scene S --speed-only --every-pass`): {}",
-            elsewhere.join(", ")
-        );
-    }
-    let coverage = harness::golden::speed::coverage(&run.speed.checks);
-    if !coverage.is_empty() {
-        println!(
-            "what the speed checks catch here (a pass slower than its golden by more than its \
-             limit fails):"
-        );
-        for c in &coverage {
-            println!("  {:<12} {}", c.backend.name(), c.describe());
-        }
-    }
-    if let Some(advice) = harness::golden::speed::verdict::record_advice(&coverage) {
-        println!("note: {advice}");
-    }
-    for note in &run.speed.host_notes {
-        println!("note: {note}");
     }
 }

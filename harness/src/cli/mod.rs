@@ -7,6 +7,7 @@ pub(super) mod bench;
 pub(super) mod bless;
 pub(super) mod bless_speed;
 pub(super) mod check;
+pub(super) mod check_speed;
 pub(super) mod hard;
 pub(super) mod info;
 pub(super) mod noise;

@@ -51,7 +51,8 @@
       list = document.createElement('ul');
       list.className = 'accept-notes';
       const summary = document.getElementById('summary');
-      summary.parentNode.insertBefore(list, summary);
+      if (summary) summary.parentNode.insertBefore(list, summary);
+      else document.body.prepend(list);
     }
     for (const line of lines) {
       const item = document.createElement('li');
@@ -73,7 +74,6 @@
       .then((response) => response.json())
       .then((answer) => {
         mark(answer.accepted);
-        note(answer.notes);
         if (answer.refused.length) {
           button.disabled = false;
           button.textContent = 'refused';
@@ -81,6 +81,7 @@
         } else {
           button.textContent = 'accepted';
         }
+        note(answer.notes);
       })
       .catch((error) => {
         button.disabled = false;

@@ -367,7 +367,7 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
         let notes = browser.eval("document.querySelector('ul.accept-notes').textContent");
         let notes = notes.as_str().unwrap_or_default();
         assert!(
-            notes.contains("arrow/geometry on gl (speed): ratio ") && notes.contains("written"),
+            notes.contains("arrow/geometry on gl (speed): ratio ") && notes.contains("; written"),
             "{notes}"
         );
     } else {
@@ -383,7 +383,7 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
         );
         let notes = answer["notes"].to_string();
         assert!(
-            notes.contains("arrow/geometry on gl (speed): ratio ") && notes.contains("written"),
+            notes.contains("arrow/geometry on gl (speed): ratio ") && notes.contains("; written"),
             "{notes}"
         );
     }

@@ -113,7 +113,7 @@ fn renders_recorded_on_another_host_pass_with_room() {
 /// A recorded render of a picture that has changed since is measured against the golden pinned
 /// beside it (`<scene>_<pass>_<backend>.golden.png`, the golden of its day), not today's: with
 /// today's golden moved (darkened by 2/255 here) host-b's ibl final still passes with room
-/// against its pin, and a pin that no longer matches the render fails it.
+/// against its pin and fails without it, and a pin that no longer matches the render fails it.
 #[test]
 fn a_recorded_render_is_measured_against_its_pinned_golden() {
     let root = common::temp_workspace();
@@ -146,6 +146,14 @@ fn a_recorded_render_is_measured_against_its_pinned_golden() {
         pinned,
         "measured against the pin, not today's golden"
     );
+    // Without its pin, the moved golden fails the render: the pin is what kept it evidence.
+    let pinned_bytes = std::fs::read(&pin).unwrap();
+    std::fs::remove_file(&pin).unwrap();
+    assert!(
+        worst(&store) > 1.0,
+        "today's moved golden passes the render"
+    );
+    std::fs::write(&pin, pinned_bytes).unwrap();
     common::cli::darken(&pin, 2);
     assert!(
         worst(&store) > 1.0,

@@ -197,7 +197,8 @@ fn measure_outputs(
     measure_outputs_against(store, case, source, backend, outputs, None)
 }
 
-/// [`measure_outputs`], each output against `pinned` where given instead of its golden.
+/// [`measure_outputs`] against `pinned` where given instead of the golden: the golden a
+/// recorded render of one pass was taken against (`outputs` holds that one pass).
 fn measure_outputs_against(
     store: &GoldenStore,
     case: &Case,
@@ -206,6 +207,7 @@ fn measure_outputs_against(
     outputs: &BTreeMap<TargetId, Image>,
     pinned: Option<&Image>,
 ) -> Vec<Measurement> {
+    debug_assert!(pinned.is_none() || outputs.len() == 1);
     let mut measurements = Vec::new();
     for (&pass, image) in outputs {
         let Some(rule) = case.rules.get(&pass) else {
@@ -248,9 +250,10 @@ pub fn measure_synthetic(
 }
 
 /// Measures renders recorded on another host: `<dir>/<scene>_<pass>_<backend>.png|exr`, each
-/// against the golden of its pass or, where the picture has changed since it was recorded,
-/// against `<scene>_<pass>_<backend>.golden.png|exr` beside it ([`PINNED_GOLDEN`]): the golden
-/// as it was when the host rendered it. A recorded render is evidence of another CPU's rounding
+/// against the golden of its pass or, when `<scene>_<pass>_<backend>.golden.png|exr` is beside
+/// it ([`PINNED_GOLDEN`], added when a bless changed the picture it recorded), against that:
+/// the golden as it was when the host rendered it. A pin the render cannot be compared with
+/// (another size) is missed, naming it. A recorded render is evidence of another CPU's rounding
 /// of one picture, which the limits must hold; it cannot be rendered again of a new picture
 /// without that host, and the pinned golden keeps it evidence of the same thing.
 pub fn measure_recorded(
@@ -276,9 +279,28 @@ pub fn measure_recorded(
                         crate::images::read_exr(path)
                     }
                 };
-                let pinned = dir.join(format!("{stem}.{PINNED_GOLDEN}.{extension}"));
-                let pinned = pinned.exists().then(|| read(&pinned)).transpose();
+                let pin = dir.join(format!("{stem}.{PINNED_GOLDEN}.{extension}"));
+                let pinned = pin.exists().then(|| read(&pin)).transpose();
                 match read(&path).and_then(|image| Ok((image, pinned?))) {
+                    Ok((image, Some(pinned)))
+                        if (pinned.width, pinned.height) != (image.width, image.height) =>
+                    {
+                        missed.push(Missed {
+                            source: source.to_owned(),
+                            backend,
+                            scene: case.name().to_owned(),
+                            error: format!(
+                                "{}: {}x{}, but the render {} is {}x{}",
+                                pin.display(),
+                                pinned.width,
+                                pinned.height,
+                                path.display(),
+                                image.width,
+                                image.height
+                            ),
+                            known: false,
+                        });
+                    }
                     Ok((image, pinned)) => {
                         let outputs = BTreeMap::from([(*pass, image)]);
                         measurements.extend(measure_outputs_against(

@@ -368,7 +368,7 @@ pub struct SpeedCoverage {
 
 impl SpeedCoverage {
     /// One line: how many passes were timed and how, their limits (the slowdown beyond which
-    /// each fails), and how many were untimed.
+    /// each fails), how many were untimed, and how many had nothing to compare with.
     pub fn describe(&self) -> String {
         let how = match self.tier {
             Tier::SameHost => "on the host that blessed".to_owned(),
@@ -459,7 +459,8 @@ pub fn record_advice(coverage: &[SpeedCoverage]) -> Option<String> {
 }
 
 /// Per backend and tier, in the order the checks came: what the speed checks of a run can
-/// catch on this host. Checks without a golden count in neither column (they fail).
+/// catch on this host. Checks without a golden, or of other targets than their golden's, count
+/// as `not_compared` (they fail), whatever their limit.
 pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
     /// One backend and tier's checks as they are gathered.
     struct Group {
@@ -496,12 +497,12 @@ pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
             group.recording = c.noise.as_ref().map(|(_, at)| at.clone());
         }
         match (&c.outcome, c.limit) {
-            // A limit too wide to catch a doubling times nothing, failing beyond it or not.
             (SpeedOutcome::Untimed(_), _) => group.untimed += 1,
-            (_, Some(limit)) if limit >= MUST_CATCH => group.untimed += 1,
             (SpeedOutcome::MissingGolden | SpeedOutcome::TargetsChanged(_), _) | (_, None) => {
                 group.not_compared += 1;
             }
+            // A limit too wide to catch a doubling times nothing, failing beyond it or not.
+            (_, Some(limit)) if limit >= MUST_CATCH => group.untimed += 1,
             (_, Some(limit)) => {
                 group.limits.push(limit);
                 // From a pass's speed in this run, how much slower it may get; a pass already
