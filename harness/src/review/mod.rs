@@ -46,6 +46,7 @@ pub enum ReviewError {
 
 /// What one accept request asks for: a pass on a backend, a scene, or (all empty) the run.
 #[derive(Clone, Debug, Default, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct AcceptRequest {
     /// Only this scene.
     pub scene: Option<String>,

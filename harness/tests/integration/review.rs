@@ -6,7 +6,7 @@
 //! --reason` (the same words) leaves it from the same change (the blessing times aside). The
 //! server runs with rendering forbidden (`HARNESS_NO_RENDER`, which its children inherit): it
 //! accepts on the checks' own verification and renders nothing. Requests without the page's
-//! token, or naming another host, are refused.
+//! token, naming another host, or with a key it does not know, are refused.
 //!
 //! Needs Chromium, like `report` (skipped with a note without it, unless REQUIRE_CHROMIUM=1).
 
@@ -160,27 +160,7 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
     );
     let server = Server::start(root.path(), &out);
     let (url, port, token) = (server.url.clone(), server.port, server.token.clone());
-    let host = format!("Host: 127.0.0.1:{port}\r\n");
-    let post = |headers: &str| {
-        format!(
-            "POST /accept HTTP/1.1\r\n{headers}Content-Type: application/json\r\n\
-             Content-Length: 2\r\nConnection: close\r\n\r\n{{}}"
-        )
-    };
-
-    // Refused: no token, a wrong one, another host, another origin, the page without its token.
-    assert_eq!(status(port, &post(&host)), 403);
-    assert_eq!(
-        status(port, &post(&format!("{host}X-Harness-Token: 00\r\n"))),
-        403
-    );
-    let token_header = format!("X-Harness-Token: {token}\r\n");
-    let elsewhere = format!("Host: attacker.example:{port}\r\n{token_header}");
-    assert_eq!(status(port, &post(&elsewhere)), 403);
-    let origin = format!("{host}{token_header}Origin: http://attacker.example\r\n");
-    assert_eq!(status(port, &post(&origin)), 403);
-    let page = format!("GET / HTTP/1.1\r\n{host}Connection: close\r\n\r\n");
-    assert_eq!(status(port, &page), 403);
+    refuses_what_the_page_would_not_send(port, &token);
 
     let mut browser = Browser::launch(executable);
     browser.open(&url);
@@ -266,6 +246,45 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
             "golden/arrow/{name} differs from what `bless --scene arrow` writes"
         );
     }
+}
+
+/// The server refuses an accept without the page's token, with a wrong one, for another host
+/// or origin, the page itself without its token, and a request with a key it does not know (a
+/// misspelt filter is a bad request, not an empty one that would accept the whole run).
+fn refuses_what_the_page_would_not_send(port: u16, token: &str) {
+    let host = format!("Host: 127.0.0.1:{port}\r\n");
+    let post = |headers: &str| {
+        format!(
+            "POST /accept HTTP/1.1\r\n{headers}Content-Type: application/json\r\n\
+             Content-Length: 2\r\nConnection: close\r\n\r\n{{}}"
+        )
+    };
+
+    // Refused: no token, a wrong one, another host, another origin, the page without its token.
+    assert_eq!(status(port, &post(&host)), 403);
+    assert_eq!(
+        status(port, &post(&format!("{host}X-Harness-Token: 00\r\n"))),
+        403
+    );
+    let token_header = format!("X-Harness-Token: {token}\r\n");
+    let elsewhere = format!("Host: attacker.example:{port}\r\n{token_header}");
+    assert_eq!(status(port, &post(&elsewhere)), 403);
+    let origin = format!("{host}{token_header}Origin: http://attacker.example\r\n");
+    assert_eq!(status(port, &post(&origin)), 403);
+    let page = format!("GET / HTTP/1.1\r\n{host}Connection: close\r\n\r\n");
+    assert_eq!(status(port, &page), 403);
+    // A misspelt key is a bad request, not an empty filter (which would accept the whole run).
+    let misspelt = r#"{"scen":"arrow"}"#;
+    let (code, answer) = send(
+        port,
+        &format!(
+            "POST /accept HTTP/1.1\r\n{host}{token_header}Content-Type: application/json\r\n\
+             Content-Length: {}\r\nConnection: close\r\n\r\n{misspelt}",
+            misspelt.len()
+        ),
+    );
+    assert_eq!(code, 400, "{answer}");
+    assert!(answer.contains("unknown field `scen`"), "{answer}");
 }
 
 /// A CDP expression that waits (up to 2 minutes) until `done` holds of `r` (the element
