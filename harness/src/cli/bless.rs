@@ -292,7 +292,10 @@ fn bless_images(
                 };
                 let blessed =
                     bless_pass(store, lock, case, pass, image, (kind, &driver), decision)?;
-                if blessed.outcome == BlessOutcome::WouldWrite {
+                if matches!(
+                    blessed.outcome,
+                    BlessOutcome::WouldWrite | BlessOutcome::WouldWriteNew
+                ) {
                     candidates.push((pass, image.clone()));
                 }
             }

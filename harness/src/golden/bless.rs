@@ -10,8 +10,9 @@ use engine::backend::BackendKind;
 use engine::plan::TargetId;
 use engine::Image;
 
-use super::suite::{bless_change, Case};
-use super::{GoldenError, GoldenStore, SceneLock};
+use super::suite::Case;
+use super::{GoldenError, GoldenStore, Outcome, SceneLock};
+use crate::golden;
 
 /// A reason for a bless as recorded (`--reason`, the review page's field): trimmed, and None
 /// when nothing is left (an empty reason would read as one given).
@@ -89,6 +90,8 @@ pub enum BlessOutcome {
     Kept,
     /// Would be rewritten (a dry run).
     WouldWrite,
+    /// Would be written where there is no golden (a dry run).
+    WouldWriteNew,
     /// Rewritten at this path.
     Written(PathBuf),
 }
@@ -113,6 +116,7 @@ impl fmt::Display for BlessedPass {
         match &self.outcome {
             BlessOutcome::Kept => f.write_str("; kept"),
             BlessOutcome::WouldWrite => f.write_str("; would be rewritten (dry run)"),
+            BlessOutcome::WouldWriteNew => f.write_str("; would be written (dry run)"),
             BlessOutcome::Written(path) => write!(f, "\n  wrote {}", path.display()),
         }
     }
@@ -139,6 +143,8 @@ pub fn bless_pass(
     let write = change.changed || request.every_pass || request.named.contains(&pass);
     let outcome = if !write {
         BlessOutcome::Kept
+    } else if request.dry_run && change.missing {
+        BlessOutcome::WouldWriteNew
     } else if request.dry_run {
         BlessOutcome::WouldWrite
     } else {
@@ -162,4 +168,77 @@ pub fn bless_pass(
         previous: change.previous,
         outcome,
     })
+}
+
+/// What blessing one fresh pass output would change.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlessChange {
+    /// Whether the golden needs rewriting: it is missing, cannot be compared, or the output is
+    /// outside the pass's tolerance.
+    pub changed: bool,
+    /// How the output differs from the golden it would replace (recorded in blessed.toml):
+    /// "new", or the metrics against the old golden.
+    pub previous: String,
+    /// Whether there is no golden: a bless writes a new one.
+    pub missing: bool,
+}
+
+/// Compares a fresh output of `case`'s `pass` with its golden, for `harness bless` and
+/// `UPDATE_GOLDENS=1`: a pass within tolerance is left alone unless asked for by name.
+pub fn bless_change(
+    store: &GoldenStore,
+    case: &Case,
+    pass: TargetId,
+    image: &Image,
+) -> BlessChange {
+    let old = match store.load(case.name(), pass, golden::is_eight_bit(image)) {
+        Ok(Some(old)) => old,
+        Ok(None) => {
+            return BlessChange {
+                changed: true,
+                previous: "new".to_owned(),
+                missing: true,
+            }
+        }
+        // A golden that cannot be read is what a bless repairs.
+        Err(e) => {
+            return BlessChange {
+                changed: true,
+                previous: format!("old golden unreadable: {e}"),
+                missing: false,
+            }
+        }
+    };
+    match golden::check(image, Some(&old), &case.rules[&pass]) {
+        Outcome::Passed(v) | Outcome::Failed(v) => {
+            let metrics = v
+                .checks
+                .iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join("; ");
+            BlessChange {
+                changed: !v.passed,
+                previous: format!(
+                    "{} vs old golden: {metrics}",
+                    if v.passed {
+                        "within tolerance"
+                    } else {
+                        "CHANGED"
+                    }
+                ),
+                missing: false,
+            }
+        }
+        Outcome::MissingGolden => BlessChange {
+            changed: true,
+            previous: "new".to_owned(),
+            missing: true,
+        },
+        Outcome::Incomparable(why) => BlessChange {
+            changed: true,
+            previous: format!("incomparable with old golden: {why}"),
+            missing: false,
+        },
+    }
 }

@@ -102,7 +102,8 @@ fn every_mutation_fails_where_it_originates_and_no_noise_source_comes_near_a_lim
 /// The self-test reaches an extracted sun: a scene with `[quality.ibl] extract_sun` has the
 /// sun's shadow map and shadow term among its golden passes, and the shadow-bias mutation,
 /// applied to the scene as drawn, fails in the sun's `shadow_term_0` by the self-test's margin.
-/// Its goldens are blessed here, into a temporary store, from the unchanged render on gl.
+/// Its goldens are blessed here, into a temporary store, from the unchanged render on gl (a dry
+/// run first says each would be written new, and writes nothing).
 #[test]
 fn a_mutation_of_an_extracted_suns_shadow_fails_in_its_shadow_term() {
     harness::use_ibl_cache();
@@ -122,6 +123,22 @@ fn a_mutation_of_an_extracted_suns_shadow_fails_in_its_shadow_term() {
     let frame = case.render(BackendKind::Gl).unwrap();
     let lock = store.lock_scene(case.name(), |_| {}).unwrap();
     for &pass in &case.passes {
+        // A dry run first: a pass without a golden would be written new, and nothing is.
+        let dry_run = BlessRequest {
+            dry_run: true,
+            ..BlessRequest::default()
+        };
+        let output = (BackendKind::Gl, "test");
+        let image = &frame.outputs[&pass];
+        let dry = bless_pass(&store, &lock, &case, pass, image, output, dry_run).unwrap();
+        assert_eq!(dry.outcome, BlessOutcome::WouldWriteNew, "{dry}");
+        assert!(
+            dry.to_string()
+                .ends_with(": new; would be written (dry run)"),
+            "{dry}"
+        );
+        let eight_bit = harness::golden::is_eight_bit(image);
+        assert!(store.load(case.name(), pass, eight_bit).unwrap().is_none());
         let request = BlessRequest::default();
         let blessed = bless_pass(
             &store,
