@@ -141,7 +141,9 @@ fn speed_coverage(out: &mut String, run: &CheckRun) {
     for c in &coverage {
         let _ = writeln!(out, "- `{}`: {}", c.backend.name(), cell(&c.describe()));
     }
-    if let Some(advice) = crate::golden::speed::verdict::record_advice(&coverage) {
+    if let Some(advice) =
+        crate::golden::speed::verdict::record_advice(&coverage, &run.speed.recorded_as)
+    {
         let _ = writeln!(out, "\nNote: {advice}.");
     }
     for note in &run.speed.host_notes {

@@ -271,8 +271,9 @@ fn note_borrowed_limits(cases: &[Case], store: &harness::golden::GoldenStore) {
     if !cases.is_empty() && !model.exists() {
         eprintln!(
             "note: {} does not exist, so no limit is a measured one: each is the built-in \
-             fallback of its metric (measure the model with `harness noise --write`)",
-            model.display()
+             fallback of its metric (measure the model with `{}`)",
+            model.display(),
+            harness::golden::command_line::harness_command("noise --write")
         );
         return;
     }
@@ -284,13 +285,16 @@ fn note_borrowed_limits(cases: &[Case], store: &harness::golden::GoldenStore) {
             .map(|(p, _)| p.to_string())
             .collect();
         if !borrowed.is_empty() {
+            let measure = harness::golden::command_line::harness_command(&format!(
+                "noise --scene {} --write",
+                case.argument()
+            ));
             eprintln!(
                 "note: golden/noise.toml has no figures for {} ({}): its limits are the \
-                 canonical scenes' largest; measure its own with `harness noise --scene {} --write` (it needs the second \
-                 Mesa: scripts/mesa-backports.sh)",
+                 canonical scenes' largest; measure its own with `{measure}` (it needs the \
+                 second Mesa: scripts/mesa-backports.sh)",
                 case.name(),
                 borrowed.join(", "),
-                case.loaded.path.display()
             );
         }
     }
@@ -298,9 +302,9 @@ fn note_borrowed_limits(cases: &[Case], store: &harness::golden::GoldenStore) {
 
 /// The results table on stdout: a line per scene, pass and backend, then the renders and
 /// scenes that failed, the backends that disagree, a summary line, and on a failure where the
-/// images are and what to do: the bless commands, or for the speed checks of a check with
-/// `--debug-unspecialised-lighting` (`unspecialised_lighting`), which a bless does not take,
-/// the accept.
+/// images are and what to do: the bless commands, or for the speed failures of a check with
+/// `--debug-unspecialised-lighting` (`unspecialised_lighting`), that they are the debug
+/// setting's own and nothing is to be blessed.
 fn print_table(run: &CheckRun, report: &Path, failures: &str, unspecialised_lighting: bool) {
     println!(
         "{:<8} {:<17} {:<12} {:<12} worst metric",
@@ -374,8 +378,18 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str, unspecialised_ligh
     if missing > 0 {
         unloaded.push_str(&format!(", {missing} backend(s) asked for are unavailable"));
     }
+    // Untimed speed checks pass: the summary says how many, so that a run whose speed checks
+    // time little does not read as covered.
+    let untimed: usize = harness::golden::speed::coverage(&run.speed.checks)
+        .iter()
+        .map(|c| c.untimed)
+        .sum();
+    let untimed = match untimed {
+        0 => String::new(),
+        n => format!(", {n} untimed"),
+    };
     println!(
-        "{} checks ({} of speed), {failed} failed{unloaded}; report: {}",
+        "{} checks ({} of speed{untimed}), {failed} failed{unloaded}; report: {}",
         run.results.len() + run.speed.checks.len(),
         run.speed.checks.len(),
         report.display()
@@ -384,32 +398,17 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str, unspecialised_ligh
         if run.results.iter().any(|r| !r.outcome.passed()) {
             println!("failure images: {failures}");
         }
-        let failed_speed = |c: &&harness::golden::speed::SpeedCheck| c.failed();
-        if unspecialised_lighting && run.speed.checks.iter().any(|c| failed_speed(&c)) {
-            // A bless probes again without the debug setting and finds the lighting as it is:
-            // only an accept takes what this check measured, and only where a timing bless
-            // writes (this host blessed the goldens, or is recorded against them).
-            if run
-                .speed
-                .checks
-                .iter()
-                .filter(failed_speed)
-                .any(|c| c.bless_writes_here())
-            {
-                println!(
-                    "this check ran with --debug-unspecialised-lighting, which `bless` does not \
-                     take: a bless probes the lighting as it is and finds it unchanged. To record \
-                     the timings this check measured, accept them: `{} --speed-only`",
-                    accept_command(report.parent().unwrap_or(report))
-                );
-            } else {
-                println!(
-                    "this check ran with --debug-unspecialised-lighting: its slowdowns are \
-                     against another host's timing goldens, which this host neither blessed nor \
-                     is recorded against, so nothing here can record them (`harness noise \
-                     --timing --record-host NAME` records this host)"
-                );
-            }
+        if unspecialised_lighting && run.speed.checks.iter().any(|c| c.failed()) {
+            // The slowdown is the debug setting's own: a golden taken from it would hold the
+            // generic variant's cost, which no normal render has, and leave the lighting passes
+            // unable to fail.
+            println!(
+                "the speed failures are --debug-unspecialised-lighting's own: the renderer is \
+                 unchanged and `check` without it passes them, so there is nothing to bless or \
+                 accept. A deliberate slowdown of your own is blessed after its check with \
+                 `harness bless --scene S --speed-only --reason \"why\"`, or accepted from the \
+                 check with `harness bless --from-last-check --speed-only --reason \"why\"`"
+            );
             if run.results.iter().all(|r| r.outcome.passed()) {
                 return;
             }

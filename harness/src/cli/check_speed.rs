@@ -55,11 +55,11 @@ pub(super) fn print_speed(run: &CheckRun) {
     }
     if !elsewhere.is_empty() {
         println!(
-            "note: faster beyond the limit, on a host that neither blessed the timing goldens \
-             nor is recorded against them (ratios differ between hosts: record this host, or \
-             record it again, with `harness noise --timing --record-host NAME`, then bless \
-             with `--speed-only`; or move the timing goldens here whole with \
-             `harness bless --scene S --speed-only --every-pass`): {}",
+            "note: faster beyond the limit, read at the limits for any host, where ratios \
+             differ between hosts, so not yet a speed-up to bless: record this host (see the \
+             note under the coverage below), check again, and bless with `--speed-only` what is \
+             still faster; or move the timing goldens here whole with `harness bless --scene S \
+             --speed-only --every-pass`: {}",
             elsewhere.join(", ")
         );
     }
@@ -73,7 +73,9 @@ pub(super) fn print_speed(run: &CheckRun) {
             println!("  {:<12} {}", c.backend.name(), c.describe());
         }
     }
-    if let Some(advice) = harness::golden::speed::verdict::record_advice(&coverage) {
+    if let Some(advice) =
+        harness::golden::speed::verdict::record_advice(&coverage, &run.speed.recorded_as)
+    {
         println!("note: {advice}");
     }
     for note in &run.speed.host_notes {

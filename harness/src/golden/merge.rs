@@ -96,6 +96,7 @@ pub fn merge(shards: &[PathBuf]) -> Result<(CheckRun, Outputs), MergeError> {
         }
         merged.speed.checks.extend(run.speed.checks);
         merged.speed.errors.extend(run.speed.errors);
+        merged.speed.recorded_as.extend(run.speed.recorded_as);
         for note in run.speed.host_notes {
             if !merged.speed.host_notes.contains(&note) {
                 merged.speed.host_notes.push(note);

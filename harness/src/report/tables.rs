@@ -202,7 +202,9 @@ pub(super) fn speed(out: &mut String, run: &CheckRun) {
         }
         out.push_str("</ul>");
     }
-    if let Some(advice) = crate::golden::speed::verdict::record_advice(&coverage) {
+    if let Some(advice) =
+        crate::golden::speed::verdict::record_advice(&coverage, &run.speed.recorded_as)
+    {
         let _ = write!(out, "<p class=\"note\">Note: {}.</p>", escape(&advice));
     }
     for note in &run.speed.host_notes {

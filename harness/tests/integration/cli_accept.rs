@@ -287,7 +287,7 @@ fn a_slower_pass_is_accepted_from_the_last_check_as_its_timing_golden() {
         .nth(1)
         .expect("a coverage section");
     assert!(
-        coverage.contains("- `gl`: ") && coverage.contains("passes timed"),
+        coverage.contains("- `gl`: ") && coverage.contains(" timed "),
         "{summary}"
     );
     let page = std::fs::read_to_string(out.join("report.html")).unwrap();

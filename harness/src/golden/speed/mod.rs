@@ -213,6 +213,11 @@ pub struct SpeedRun {
     /// CPU exists: what in the driver fingerprint differs from it ([`near_recordings`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub host_notes: Vec<String>,
+    /// Per backend, the name of the recording in golden/evidence/ of this host (its driver
+    /// fingerprint and CPU), where there is one: what the advice to record the host again
+    /// names ([`verdict::record_advice`]).
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub recorded_as: std::collections::BTreeMap<BackendKind, String>,
 }
 
 /// Why `kind`'s checks on this host (fingerprint `host`, CPU signature `cpu`) are not read
@@ -364,6 +369,9 @@ pub fn check_scenes(
             continue;
         };
         let host = host_fingerprint(driver);
+        if let Some((name, _)) = recorded::of_host(&recordings, kind, &host, &cpu_signature()) {
+            run.recorded_as.insert(kind, name.to_owned());
+        }
         let goldens = match TimingGoldens::load(root, &probe.scene) {
             Ok(goldens) => goldens,
             Err(e) => {

@@ -381,10 +381,13 @@ impl SpeedCoverage {
                                 timing noise not measured here)"
                 .to_owned(),
         };
+        // A median says something of three passes and more; of two, both are shown.
+        let few = self.timed < 3;
         let limits = match self.limits {
             Some([low, _, high]) if format!("{low:.2}") == format!("{high:.2}") => {
                 format!(", limits x{low:.2}")
             }
+            Some([low, _, high]) if few => format!(", limits x{low:.2} and x{high:.2}"),
             Some([low, median, high]) => {
                 format!(", limits x{low:.2} to x{high:.2} (median x{median:.2})")
             }
@@ -396,10 +399,19 @@ impl SpeedCoverage {
             (Some([low, median, high]), Some([_, limit_median, limit_high]))
                 if high > limit_high * 1.1 || median > limit_median * 1.1 =>
             {
-                format!(
-                    "; from their speed in this run a pass fails only beyond x{low:.2} to \
-                     x{high:.2} slower (median x{median:.2})"
-                )
+                let range = if format!("{low:.2}") == format!("{high:.2}") {
+                    format!("x{low:.2}")
+                } else if few {
+                    format!("x{low:.2} and x{high:.2}")
+                } else {
+                    format!("x{low:.2} to x{high:.2} (median x{median:.2})")
+                };
+                let whom = if self.timed == 1 {
+                    "it fails"
+                } else {
+                    "a pass fails"
+                };
+                format!("; from their speed in this run {whom} only beyond {range} slower")
             }
             _ => String::new(),
         };
@@ -407,8 +419,9 @@ impl SpeedCoverage {
             0 => String::new(),
             n => format!("; {n} without a timing golden of the same targets to compare with"),
         };
+        let passes = if self.timed == 1 { "pass" } else { "passes" };
         format!(
-            "{} passes timed {how}{limits}{from_now}; {} untimed{not_compared}",
+            "{} {passes} timed {how}{limits}{from_now}; {} untimed{not_compared}",
             self.timed, self.untimed
         )
     }
@@ -423,34 +436,32 @@ pub const RECORD_THIS_HOST: &str = "this host is neither the one that blessed th
     (golden/evidence/NAME/timing.toml, to commit); its checks then read against its own ratios";
 
 /// Where some of `coverage` ran at [`Tier::OtherHost`], the advice every place that shows the
-/// coverage adds under it: [`RECORD_THIS_HOST`], or, on a recorded host (other passes of the
-/// backend read against its recording), that those passes' goldens were blessed since the
-/// recording and the command that takes it again.
-pub fn record_advice(coverage: &[SpeedCoverage]) -> Option<String> {
+/// coverage adds under it: [`RECORD_THIS_HOST`], or, on a host recorded on each of those
+/// backends (`recorded_as`: the recording's host name per backend, [`super::SpeedRun`]), that
+/// its recording does not hold those passes' goldens as they are (blessed since, or a scene
+/// newer than it) and the command that takes it again.
+pub fn record_advice(
+    coverage: &[SpeedCoverage],
+    recorded_as: &std::collections::BTreeMap<BackendKind, String>,
+) -> Option<String> {
+    // Passes with nothing to compare with (a new scene before its bless) want a bless first.
     let other: Vec<&SpeedCoverage> = coverage
         .iter()
-        .filter(|c| c.tier == Tier::OtherHost)
+        .filter(|c| c.tier == Tier::OtherHost && c.timed + c.untimed > 0)
         .collect();
     if other.is_empty() {
         return None;
     }
-    // Recorded on every backend read so: the recording predates those passes' goldens.
-    let recordings: Vec<Option<String>> = other
-        .iter()
-        .map(|o| {
-            coverage
-                .iter()
-                .filter(|c| c.tier == Tier::RecordedHost && c.backend == o.backend)
-                .find_map(|c| c.recording.clone())
-        })
-        .collect();
-    Some(match recordings.first() {
-        Some(Some(recording)) if recordings.iter().all(Option::is_some) => {
-            let name = recording.strip_suffix("'s recording").unwrap_or("NAME");
+    let names: Vec<Option<&String>> = other.iter().map(|o| recorded_as.get(&o.backend)).collect();
+    Some(match names.first() {
+        Some(Some(name)) if names.iter().all(Option::is_some) => {
+            let again = crate::golden::command_line::harness_command(&format!(
+                "noise --timing --record-host {name}"
+            ));
             format!(
-                "this host is recorded ({recording}), but some passes' timing goldens were \
-                 blessed since it was taken (or it does not hold them), so those were read at \
-                 the limits for any host. `harness noise --timing --record-host {name}` records \
+                "this host is recorded ({name}'s recording), but it does not hold some passes' \
+                 timing goldens as they are (blessed since it was taken, or of a scene newer \
+                 than it), so those were read at the limits for any host. `{again}` records \
                  this host again (to commit)"
             )
         }

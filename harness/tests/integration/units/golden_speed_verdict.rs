@@ -406,7 +406,7 @@ fn coverage_counts_the_timed_and_untimed_passes_per_backend_and_tier() {
     recorded.noise = Some((1.3, "host-d's recording".to_owned()));
     assert_eq!(
         coverage(&[recorded])[0].describe(),
-        "1 passes timed against host-d's recording, limits x1.69; 0 untimed"
+        "1 pass timed against host-d's recording, limits x1.69; 0 untimed"
     );
     let none_timed = coverage(&[covered(Gl, Tier::OtherHost, untimed(), None)]);
     assert_eq!(
@@ -424,7 +424,7 @@ fn coverage_counts_the_timed_and_untimed_passes_per_backend_and_tier() {
     assert_eq!(
         found[0].describe(),
         "2 passes timed on a host that did not bless, limits x1.50; from their speed in this \
-         run a pass fails only beyond x1.50 to x3.00 slower (median x3.00); 0 untimed"
+         run a pass fails only beyond x1.50 and x3.00 slower; 0 untimed"
     );
     // A pass failing already has no room left to report (it read "beyond x0.20 slower").
     let mut failing = covered(Gl, Tier::OtherHost, SpeedOutcome::Slower, Some(1.5));
@@ -440,42 +440,49 @@ fn coverage_counts_the_timed_and_untimed_passes_per_backend_and_tier() {
 }
 
 /// The advice under the coverage: none where every pass was read at this host's own limits;
-/// record this host where some were read at any host's; and on a recorded host whose
-/// recording predates some goldens (blessed since), record it again, by its name.
+/// record this host where some were read at any host's and it has no recording on that
+/// backend; and where it has one (by fingerprint and CPU, whether or not any pass of this run
+/// was read against it: a scene newer than the recording has none), record it again, by its
+/// name.
 #[test]
 fn the_advice_under_the_coverage_says_whether_to_record_this_host_or_record_it_again() {
     use harness::golden::speed::verdict::RECORD_THIS_HOST;
+    use std::collections::BTreeMap;
     use BackendKind::{Gl, WgpuVulkan};
     let mut recorded = covered(Gl, Tier::RecordedHost, SpeedOutcome::Passed, Some(1.69));
     recorded.noise = Some((1.3, "host-d's recording".to_owned()));
     let stale = covered(Gl, Tier::OtherHost, SpeedOutcome::Passed, Some(1.8));
     let elsewhere = covered(WgpuVulkan, Tier::OtherHost, SpeedOutcome::Passed, Some(1.8));
+    let on_gl = BTreeMap::from([(Gl, "host-d".to_owned())]);
+    let nowhere = BTreeMap::new();
+    // A new scene before its bless: nothing to record yet.
+    let new = covered(Gl, Tier::OtherHost, SpeedOutcome::MissingGolden, Some(1.8));
+    assert_eq!(record_advice(&coverage(&[new]), &nowhere), None);
     assert_eq!(
-        record_advice(&coverage(std::slice::from_ref(&recorded))),
+        record_advice(&coverage(std::slice::from_ref(&recorded)), &on_gl),
         None
     );
+    // Not recorded on wgpu-vulkan, which was read at any host's limits.
     assert_eq!(
-        record_advice(&coverage(&[recorded.clone(), elsewhere])).as_deref(),
+        record_advice(&coverage(&[recorded.clone(), elsewhere]), &on_gl).as_deref(),
         Some(RECORD_THIS_HOST)
     );
-    // Recorded on gl only: wgpu-vulkan read at any host's limits needs this host recorded.
     assert_eq!(
-        record_advice(&coverage(&[
-            recorded.clone(),
-            stale.clone(),
-            covered(WgpuVulkan, Tier::OtherHost, SpeedOutcome::Passed, Some(1.8)),
-        ]))
-        .as_deref(),
+        record_advice(&coverage(std::slice::from_ref(&stale)), &nowhere).as_deref(),
         Some(RECORD_THIS_HOST)
     );
-    let again = record_advice(&coverage(&[recorded, stale])).unwrap();
-    assert!(
-        again.contains(
-            "this host is recorded (host-d's recording), but some passes' timing \
-             goldens were blessed since"
-        ) && again.contains("`harness noise --timing --record-host host-d`"),
-        "{again}"
-    );
+    // Recorded on gl: whether or not a pass was read against the recording (a new scene's
+    // passes alone are not), the advice is to record it again, by its name.
+    for run in [vec![recorded, stale.clone()], vec![stale]] {
+        let again = record_advice(&coverage(&run), &on_gl).unwrap();
+        assert!(
+            again.contains(
+                "this host is recorded (host-d's recording), but it does not hold some passes' \
+                 timing goldens as they are"
+            ) && again.contains(" noise --timing --record-host host-d`"),
+            "{again}"
+        );
+    }
 }
 
 /// A timing bless's stamp at time "t", without a reason.
