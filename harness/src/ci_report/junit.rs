@@ -59,11 +59,19 @@ pub fn junit(run: &CheckRun) -> Result<String, quick_junit::SerializeError> {
         for c in run.speed.checks.iter().filter(|c| c.scene == scene) {
             let status = speed_status(c);
             let details = (status == Status::Failed).then(|| {
-                format!(
-                    "{}\nif the slowdown is intended, bless the timing goldens with:\n  {}",
-                    c.describe(),
-                    speed_bless_command(run.scene_argument(&c.scene), c.bless_writes_here())
-                )
+                if run.speed.unspecialised_lighting {
+                    format!(
+                        "{}\nthe slowdown of --debug-unspecialised-lighting, reproduced on \
+                         purpose: nothing to bless",
+                        c.describe()
+                    )
+                } else {
+                    format!(
+                        "{}\nif the slowdown is intended, bless the timing goldens with:\n  {}",
+                        c.describe(),
+                        speed_bless_command(run.scene_argument(&c.scene), c.bless_writes_here())
+                    )
+                }
             });
             suite.add_test_case(case(
                 &scene,

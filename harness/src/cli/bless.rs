@@ -388,10 +388,16 @@ pub(crate) fn from_last_check(
     } else {
         Vec::new()
     };
-    let (mut timings, checked) = if options.speed {
-        accept::speed_candidates(out, scenes, passes)?
-    } else {
-        Default::default()
+    let (mut timings, checked) = match options.speed {
+        // A debug check's timings are never taken; its images are (the same picture).
+        true => match accept::speed_candidates(out, scenes, passes) {
+            Err(e @ accept::AcceptError::DebugSlowdown) if options.images => {
+                eprintln!("note: no timings accepted: {e}");
+                Default::default()
+            }
+            other => other?,
+        },
+        false => Default::default(),
     };
     if let Some(backend) = backend {
         timings.retain(|c| c.backend == backend);

@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use engine::backend::BackendKind;
 
 use harness::golden::check::CheckRun;
+use harness::golden::speed::SpeedOutcome;
 use harness::golden::suite::{Case, LimitSource};
 
 use super::{default_out_dir, load_cases_isolated};
@@ -106,6 +107,7 @@ pub(crate) fn run(
             &available,
             |what| bar.set_message(what.to_owned()),
         );
+        run.speed.unspecialised_lighting = options.unspecialised_lighting;
         // The history is the series of an unchanged build's ratios (drift, a host's record):
         // a run with the debug slowdown is not one.
         if !options.unspecialised_lighting {
@@ -241,7 +243,7 @@ pub(crate) fn finish(
     if options.json {
         println!("{}", serde_json::to_string_pretty(run)?);
     } else {
-        print_table(run, &report, failures, options.unspecialised_lighting);
+        print_table(run, &report, failures);
     }
     Ok(if run.passed() {
         ExitCode::SUCCESS
@@ -302,10 +304,10 @@ fn note_borrowed_limits(cases: &[Case], store: &harness::golden::GoldenStore) {
 
 /// The results table on stdout: a line per scene, pass and backend, then the renders and
 /// scenes that failed, the backends that disagree, a summary line, and on a failure where the
-/// images are and what to do: the bless commands, or for the speed failures of a check with
-/// `--debug-unspecialised-lighting` (`unspecialised_lighting`), that they are the debug
-/// setting's own and nothing is to be blessed.
-fn print_table(run: &CheckRun, report: &Path, failures: &str, unspecialised_lighting: bool) {
+/// images are and what to do: the bless commands, and for the slower passes of a check with
+/// `--debug-unspecialised-lighting`, that they are the debug setting's own and nothing is to
+/// be blessed.
+fn print_table(run: &CheckRun, report: &Path, failures: &str) {
     println!(
         "{:<8} {:<17} {:<12} {:<12} worst metric",
         "scene", "pass", "backend", "result"
@@ -378,12 +380,19 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str, unspecialised_ligh
     if missing > 0 {
         unloaded.push_str(&format!(", {missing} backend(s) asked for are unavailable"));
     }
-    // Untimed speed checks pass: the summary says how many, so that a run whose speed checks
-    // time little does not read as covered.
-    let untimed: usize = harness::golden::speed::coverage(&run.speed.checks)
+    // Untimed speed checks pass (unless slower beyond even their wide limit): the summary says
+    // how many, so that a run whose speed checks time little does not read as covered.
+    let untimed = run
+        .speed
+        .checks
         .iter()
-        .map(|c| c.untimed)
-        .sum();
+        .filter(|c| {
+            !c.failed()
+                && (matches!(c.outcome, SpeedOutcome::Untimed(_))
+                    || c.limit
+                        .is_some_and(|l| l >= harness::golden::speed::MUST_CATCH))
+        })
+        .count();
     let untimed = match untimed {
         0 => String::new(),
         n => format!(", {n} untimed"),
@@ -398,27 +407,39 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str, unspecialised_ligh
         if run.results.iter().any(|r| !r.outcome.passed()) {
             println!("failure images: {failures}");
         }
-        if unspecialised_lighting && run.speed.checks.iter().any(|c| c.failed()) {
-            // The slowdown is the debug setting's own: a golden taken from it would hold the
-            // generic variant's cost, which no normal render has, and leave the lighting passes
-            // unable to fail.
+        // A debug check's slower passes are the setting's own: a golden taken from them would
+        // hold the generic variant's cost, which no normal render has, and leave the lighting
+        // passes unable to fail (the accept refuses them too). What else failed is advised on.
+        let debug_slower = |c: &harness::golden::speed::SpeedCheck| {
+            run.speed.unspecialised_lighting && c.outcome == SpeedOutcome::Slower
+        };
+        if run.speed.checks.iter().any(debug_slower) {
             println!(
-                "the speed failures are --debug-unspecialised-lighting's own: the renderer is \
-                 unchanged and `check` without it passes them, so there is nothing to bless or \
-                 accept. A deliberate slowdown of your own is blessed after its check with \
-                 `harness bless --scene S --speed-only --reason \"why\"`, or accepted from the \
-                 check with `harness bless --from-last-check --speed-only --reason \"why\"`"
+                "the slower passes are --debug-unspecialised-lighting's own: the renderer is \
+                 unchanged and `check` without the setting passes them, so there is nothing to \
+                 bless or accept. A deliberate slowdown of your own is blessed after a check \
+                 without it (`harness bless --scene S --speed-only --reason \"why\"`)"
             );
-            if run.results.iter().all(|r| r.outcome.passed()) {
+            let others = run.results.iter().any(|r| !r.outcome.passed())
+                || !run.speed.errors.is_empty()
+                || run
+                    .speed
+                    .checks
+                    .iter()
+                    .any(|c| c.failed() && !debug_slower(c));
+            if !others {
                 return;
             }
         }
         let commands = run.bless_commands();
         // Slower passes whose timing goldens a bless from here writes: the check's own figures
         // can be accepted as they are, as its kept images can.
-        let acceptable_timings = run.speed.checks.iter().any(|c| {
-            c.outcome == harness::golden::speed::SpeedOutcome::Slower && c.bless_writes_here()
-        });
+        let acceptable_timings = !run.speed.unspecialised_lighting
+            && run
+                .speed
+                .checks
+                .iter()
+                .any(|c| c.outcome == SpeedOutcome::Slower && c.bless_writes_here());
         let kept = match (run.verifications.is_empty(), acceptable_timings) {
             (true, false) => String::new(),
             (false, false) => "; or accept what this check kept, as above".to_owned(),

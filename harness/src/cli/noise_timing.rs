@@ -306,8 +306,10 @@ fn blessed_elsewhere(
         .map(|(name, _)| name);
     let record = match recorded {
         Some(name) => format!(
-            "this host is recorded as {name} already (`harness noise --timing --record-host \
-             {name}` records it again)"
+            "this host is recorded as {name} already (`{}` records it again)",
+            harness::golden::command_line::harness_command(&format!(
+                "noise --timing --record-host {name}"
+            ))
         ),
         None => {
             "or record this host's figures (`harness noise --timing --record-host NAME`)".to_owned()

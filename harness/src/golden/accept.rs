@@ -35,6 +35,14 @@ pub enum AcceptError {
     /// A scene file outside scenes/ named like a canonical scene: its goldens are not written.
     #[error("{0}")]
     SharesACanonicalName(String),
+    /// The last check ran the lighting unspecialised on purpose: its timings are the debug
+    /// setting's, not the renderer's.
+    #[error(
+        "the last check ran with --debug-unspecialised-lighting: its speed failures are that \
+         setting's own, not the renderer's, and no timing golden is taken from them (check \
+         without it, then accept or bless a slowdown of your own)"
+    )]
+    DebugSlowdown,
     /// The request names what the last check did not check (a typo, or another check's).
     #[error("the last check did not check {what} (it checked {checked}); nothing accepted")]
     NotChecked {
@@ -170,7 +178,8 @@ pub fn candidates(
 }
 
 /// The output the check kept of `candidate`'s pass, refused (an error line) when the check kept
-/// none or its golden changed after the check.
+/// none or its golden changed after the check (saying so when the golden is now that output:
+/// accepted already).
 pub fn kept_output(candidate: &Candidate) -> Result<engine::Image, String> {
     let check = &candidate.check;
     let name = format!("{}/{} ({})", check.scene, check.pass, check.backend);
@@ -181,10 +190,22 @@ pub fn kept_output(candidate: &Candidate) -> Result<engine::Image, String> {
         .and_then(|m| m.modified())
         .is_ok_and(|modified| modified > candidate.checked_at);
     if golden_changed {
-        return Err(format!(
-            "{name}: {} changed after the last check; run `harness check` again",
-            check.golden_path.display()
-        ));
+        // Accepted already (by this review or another accept): the golden is the kept output.
+        let accepted = read_output(actual)
+            .ok()
+            .zip(read_output(&check.golden_path).ok())
+            .is_some_and(|(kept, golden)| kept == golden);
+        return Err(if accepted {
+            format!(
+                "{name}: already accepted: {} is the output the last check kept",
+                check.golden_path.display()
+            )
+        } else {
+            format!(
+                "{name}: {} changed after the last check; run `harness check` again",
+                check.golden_path.display()
+            )
+        });
     }
     read_output(actual).map_err(|e| format!("{name}: {e}"))
 }
@@ -252,6 +273,9 @@ pub fn speed_candidates(
     passes: &[String],
 ) -> Result<(Vec<crate::golden::speed::SpeedCheck>, CheckContext), AcceptError> {
     let (run, _) = last_check(out)?;
+    if run.speed.unspecialised_lighting {
+        return Err(AcceptError::DebugSlowdown);
+    }
     let hosts = run
         .backends
         .iter()

@@ -11,6 +11,7 @@ use engine::Image;
 
 use crate::golden::command_line::bless_command;
 use crate::golden::metrics::Channels;
+use crate::golden::speed::SpeedOutcome;
 use crate::golden::suite::{self, Case, PassCheck};
 use crate::golden::{self, GoldenStore};
 
@@ -135,7 +136,9 @@ impl CheckRun {
     }
 
     /// One `harness bless` command per scene with a failing or missing pass, in the order of
-    /// the results (each rewrites only its scene's changed passes).
+    /// the results (each rewrites only its scene's changed passes). A slower pass of a check
+    /// with the debug slowdown ([`SpeedRun::unspecialised_lighting`](crate::golden::speed::SpeedRun))
+    /// has none: it is the setting's own.
     pub fn bless_commands(&self) -> Vec<String> {
         let mut commands: Vec<String> = Vec::new();
         for r in self.results.iter().filter(|r| !r.outcome.passed()) {
@@ -144,7 +147,13 @@ impl CheckRun {
                 commands.push(command);
             }
         }
-        for c in self.speed.checks.iter().filter(|c| c.failed()) {
+        let debug = self.speed.unspecialised_lighting;
+        for c in self
+            .speed
+            .checks
+            .iter()
+            .filter(|c| c.failed() && !(debug && c.outcome == SpeedOutcome::Slower))
+        {
             let argument = self.scene_argument(&c.scene);
             let command =
                 crate::golden::command_line::speed_bless_command(argument, c.bless_writes_here());

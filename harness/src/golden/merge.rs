@@ -41,6 +41,7 @@ pub enum MergeError {
 pub fn merge(shards: &[PathBuf]) -> Result<(CheckRun, Outputs), MergeError> {
     let mut merged = CheckRun::default();
     let mut owner: Vec<(String, String, PathBuf)> = Vec::new();
+    let mut disputed: Vec<engine::backend::BackendKind> = Vec::new();
     for (i, dir) in shards.iter().enumerate() {
         if shards[..i].contains(dir) {
             return Err(MergeError::Shard {
@@ -96,7 +97,20 @@ pub fn merge(shards: &[PathBuf]) -> Result<(CheckRun, Outputs), MergeError> {
         }
         merged.speed.checks.extend(run.speed.checks);
         merged.speed.errors.extend(run.speed.errors);
-        merged.speed.recorded_as.extend(run.speed.recorded_as);
+        // Shards of different hosts name different recordings: a backend they disagree on
+        // has none (the advice then says to record the host, without a name).
+        for (backend, name) in run.speed.recorded_as {
+            if merged
+                .speed
+                .recorded_as
+                .get(&backend)
+                .is_some_and(|n| *n != name)
+            {
+                disputed.push(backend);
+            }
+            merged.speed.recorded_as.entry(backend).or_insert(name);
+        }
+        merged.speed.unspecialised_lighting |= run.speed.unspecialised_lighting;
         for note in run.speed.host_notes {
             if !merged.speed.host_notes.contains(&note) {
                 merged.speed.host_notes.push(note);
@@ -110,6 +124,9 @@ pub fn merge(shards: &[PathBuf]) -> Result<(CheckRun, Outputs), MergeError> {
                 merged.orphans.push(orphan);
             }
         }
+    }
+    for backend in disputed {
+        merged.speed.recorded_as.remove(&backend);
     }
     let mut outputs = Outputs::new();
     for r in merged.results.iter().filter(|r| !r.outcome.passed()) {

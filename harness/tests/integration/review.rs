@@ -183,6 +183,12 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
         "r.querySelector('td.result').textContent",
     ));
     assert_eq!(marked, json!("ACCEPTED"));
+    // Accepting it again is refused as done, not as a golden changed by someone else.
+    let again = server.accept(&json!({ "scene": "arrow", "pass": "light", "backend": "gl" }));
+    assert!(
+        again["refused"].to_string().contains("already accepted"),
+        "{again}"
+    );
 
     let check = || {
         let output = common::harness_command()

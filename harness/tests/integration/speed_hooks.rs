@@ -50,7 +50,7 @@ fn a_slowed_pass_is_submitted_that_many_times_and_no_other() {
 /// `check --debug-unspecialised-lighting` (the real regression, reproduced) fails on
 /// the lighting passes and on no other pass or image, and says the failures are the debug
 /// setting's own, with nothing to bless or accept (a golden taken from them would leave the
-/// lighting passes unable to fail), and no bless commands.
+/// lighting passes unable to fail), and no bless commands; the accept refuses them.
 #[test]
 fn the_unspecialised_lighting_fails_check_on_the_lighting_passes_only() {
     if !common::gl_available() {
@@ -88,6 +88,20 @@ fn the_unspecialised_lighting_fails_check_on_the_lighting_passes_only() {
         "{stdout}"
     );
     assert!(!stdout.contains("after reviewing the report"), "{stdout}");
+    // Nor does the accept take them (a dry run: it writes nothing whatever it decides).
+    let (code, accepted, why) = common::cli::harness(&[
+        "bless",
+        "--from-last-check",
+        "--speed-only",
+        "--dry-run",
+        "--out",
+        out_arg,
+    ]);
+    assert_ne!(code, 0, "{accepted}");
+    assert!(
+        why.contains("the last check ran with --debug-unspecialised-lighting"),
+        "{why}"
+    );
     assert_eq!(stdout.matches("SLOWER").count(), failed.len(), "{stdout}");
 }
 

@@ -108,14 +108,16 @@ pub fn accept_timings(
                             "{name}: x{:.3} against {host_name}'s recording, carried into the \
                              blessing host's terms as ratio {ratio:.4}; {}. {host_name}'s recording \
                              of it is then of the golden before: the pass is read at the limits \
-                             for any host here until `harness noise --timing --record-host \
-                             {host_name}` records this host again",
+                             for any host here until `{}` records this host again",
                             c.ratio / reference,
                             if dry_run {
                                 "would be written"
                             } else {
                                 "written"
-                            }
+                            },
+                            crate::golden::command_line::harness_command(&format!(
+                                "noise --timing --record-host {host_name}"
+                            ))
                         )),
                         Err(why) => done.kept.push(kept(why)),
                     }
@@ -129,15 +131,37 @@ pub fn accept_timings(
             continue;
         }
         if !blessed_here {
-            done.kept.push(kept(format!(
-                "the check ran on a host that did not bless {}'s timing goldens (blessed on \
-                 {}) and is not recorded against them, and a backend's timing goldens are one \
-                 host's ratios. Record this host (`harness noise --timing --record-host NAME`) \
-                 and check again to accept from here, or move them all to this host: `{}`",
-                c.backend,
-                section.blessed_by(),
-                bless(false)
-            )));
+            let recorded_as = check
+                .hosts
+                .get(&c.backend)
+                .and_then(|host| super::recorded::of_host(&recordings, c.backend, host, &cpu))
+                .map(|(name, _)| name);
+            done.kept.push(kept(match recorded_as {
+                // Recorded, but not of this golden as it is: the check read it at any host's
+                // limits, which no slowdown carries over from.
+                Some(name) => format!(
+                    "this host's recording ({name}'s) does not hold {}'s timing golden of it as \
+                     it is, so the check read it at the limits for any host. Record the host \
+                     again (`{}`) and check again to accept from here, or move {}'s timing \
+                     goldens to this host: `{}`",
+                    c.backend,
+                    crate::golden::command_line::harness_command(&format!(
+                        "noise --timing --record-host {name}"
+                    )),
+                    c.backend,
+                    bless(false)
+                ),
+                None => format!(
+                    "the check ran on a host that did not bless {}'s timing goldens (blessed \
+                     on {}) and is not recorded against them, and a backend's timing goldens \
+                     are one host's ratios. Record this host (`harness noise --timing \
+                     --record-host NAME`) and check again to accept from here, or move them all \
+                     to this host: `{}`",
+                    c.backend,
+                    section.blessed_by(),
+                    bless(false)
+                ),
+            }));
             continue;
         }
         // The check's host blessed the section: its stamp stays.

@@ -218,6 +218,10 @@ pub struct SpeedRun {
     /// names ([`verdict::record_advice`]).
     #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
     pub recorded_as: std::collections::BTreeMap<BackendKind, String>,
+    /// The probes ran the lighting unspecialised (`check --debug-unspecialised-lighting`): a
+    /// slowdown reproduced on purpose, which nothing accepts as a timing golden.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub unspecialised_lighting: bool,
 }
 
 /// Why `kind`'s checks on this host (fingerprint `host`, CPU signature `cpu`) are not read

@@ -399,12 +399,11 @@ impl SpeedCoverage {
             (Some([low, median, high]), Some([_, limit_median, limit_high]))
                 if high > limit_high * 1.1 || median > limit_median * 1.1 =>
             {
+                // (Its count is not the limits': a pass already slower has no room to report.)
                 let range = if format!("{low:.2}") == format!("{high:.2}") {
                     format!("x{low:.2}")
-                } else if few {
-                    format!("x{low:.2} and x{high:.2}")
                 } else {
-                    format!("x{low:.2} to x{high:.2} (median x{median:.2})")
+                    format!("x{low:.2} to x{high:.2}")
                 };
                 let whom = if self.timed == 1 {
                     "it fails"
@@ -435,11 +434,12 @@ pub const RECORD_THIS_HOST: &str = "this host is neither the one that blessed th
     catch less. `harness noise --timing --record-host NAME` records it \
     (golden/evidence/NAME/timing.toml, to commit); its checks then read against its own ratios";
 
-/// Where some of `coverage` ran at [`Tier::OtherHost`], the advice every place that shows the
-/// coverage adds under it: [`RECORD_THIS_HOST`], or, on a host recorded on each of those
-/// backends (`recorded_as`: the recording's host name per backend, [`super::SpeedRun`]), that
-/// its recording does not hold those passes' goldens as they are (blessed since, or a scene
-/// newer than it) and the command that takes it again.
+/// Where some of `coverage` (with goldens) ran at [`Tier::OtherHost`], the advice every place
+/// that shows the coverage adds under it: [`RECORD_THIS_HOST`] on a host with no recording, or,
+/// on a recorded one (`recorded_as`: the recording's host name per backend, as the check found
+/// it, [`super::SpeedRun`]; or, from an older last-check.json, as a pass read against it names
+/// it), that its recording does not hold those passes' goldens as they are (blessed since, or a
+/// scene newer than it; or that backend is not in it), and the command that takes it again.
 pub fn record_advice(
     coverage: &[SpeedCoverage],
     recorded_as: &std::collections::BTreeMap<BackendKind, String>,
@@ -452,21 +452,56 @@ pub fn record_advice(
     if other.is_empty() {
         return None;
     }
-    let names: Vec<Option<&String>> = other.iter().map(|o| recorded_as.get(&o.backend)).collect();
-    Some(match names.first() {
-        Some(Some(name)) if names.iter().all(Option::is_some) => {
-            let again = crate::golden::command_line::harness_command(&format!(
-                "noise --timing --record-host {name}"
-            ));
-            format!(
-                "this host is recorded ({name}'s recording), but it does not hold some passes' \
-                 timing goldens as they are (blessed since it was taken, or of a scene newer \
-                 than it), so those were read at the limits for any host. `{again}` records \
-                 this host again (to commit)"
-            )
-        }
-        _ => RECORD_THIS_HOST.to_owned(),
-    })
+    // This host's recording per backend: as the check found it on disk, or (a last-check.json
+    // from before it said so) as some pass read against it names it.
+    let name_on = |backend: BackendKind| {
+        recorded_as.get(&backend).cloned().or_else(|| {
+            coverage
+                .iter()
+                .filter(|c| c.tier == Tier::RecordedHost && c.backend == backend)
+                .find_map(|c| c.recording.as_deref()?.strip_suffix("'s recording"))
+                .map(str::to_owned)
+        })
+    };
+    let names: Vec<(BackendKind, Option<String>)> = other
+        .iter()
+        .map(|o| (o.backend, name_on(o.backend)))
+        .collect();
+    // Recorded on some backend: record it again (on every backend), naming the others.
+    let any_recording = || {
+        recorded_as.values().next().cloned().or_else(|| {
+            coverage
+                .iter()
+                .find_map(|c| c.recording.as_deref()?.strip_suffix("'s recording"))
+                .map(str::to_owned)
+        })
+    };
+    let Some(name) = names
+        .iter()
+        .find_map(|(_, n)| n.clone())
+        .or_else(any_recording)
+    else {
+        return Some(RECORD_THIS_HOST.to_owned());
+    };
+    let unrecorded: Vec<BackendKind> = names
+        .iter()
+        .filter(|(_, n)| n.is_none())
+        .map(|(b, _)| *b)
+        .collect();
+    let not_on = if unrecorded.is_empty() {
+        String::new()
+    } else {
+        format!(", not on {}", crate::names(&unrecorded))
+    };
+    let again = crate::golden::command_line::harness_command(&format!(
+        "noise --timing --record-host {name}"
+    ));
+    Some(format!(
+        "this host is recorded ({name}'s recording{not_on}), but it does not hold some passes' \
+         timing goldens as they are (blessed since it was taken, or of a scene newer than it), \
+         so those were read at the limits for any host. `{again}` records this host again, on \
+         every backend (to commit)"
+    ))
 }
 
 /// Per backend and tier, in the order the checks came: what the speed checks of a run can

@@ -424,7 +424,7 @@ fn coverage_counts_the_timed_and_untimed_passes_per_backend_and_tier() {
     assert_eq!(
         found[0].describe(),
         "2 passes timed on a host that did not bless, limits x1.50; from their speed in this \
-         run a pass fails only beyond x1.50 and x3.00 slower; 0 untimed"
+         run a pass fails only beyond x1.50 to x3.00 slower; 0 untimed"
     );
     // A pass failing already has no room left to report (it read "beyond x0.20 slower").
     let mut failing = covered(Gl, Tier::OtherHost, SpeedOutcome::Slower, Some(1.5));
@@ -440,10 +440,10 @@ fn coverage_counts_the_timed_and_untimed_passes_per_backend_and_tier() {
 }
 
 /// The advice under the coverage: none where every pass was read at this host's own limits;
-/// record this host where some were read at any host's and it has no recording on that
-/// backend; and where it has one (by fingerprint and CPU, whether or not any pass of this run
-/// was read against it: a scene newer than the recording has none), record it again, by its
-/// name.
+/// record this host where some were read at any host's and it has no recording; and where it
+/// has one (by fingerprint and CPU, on any backend, whether or not any pass of this run was read
+/// against it: a scene newer than the recording has none), record it again, by its name, naming
+/// the backends it lacks.
 #[test]
 fn the_advice_under_the_coverage_says_whether_to_record_this_host_or_record_it_again() {
     use harness::golden::speed::verdict::RECORD_THIS_HOST;
@@ -462,11 +462,16 @@ fn the_advice_under_the_coverage_says_whether_to_record_this_host_or_record_it_a
         record_advice(&coverage(std::slice::from_ref(&recorded)), &on_gl),
         None
     );
-    // Not recorded on wgpu-vulkan, which was read at any host's limits.
-    assert_eq!(
-        record_advice(&coverage(&[recorded.clone(), elsewhere]), &on_gl).as_deref(),
-        Some(RECORD_THIS_HOST)
+    // Recorded on gl, not on wgpu-vulkan, which was read at any host's limits: record it again.
+    let partly = record_advice(&coverage(&[recorded.clone(), elsewhere]), &on_gl).unwrap();
+    assert!(
+        partly.contains("this host is recorded (host-d's recording, not on wgpu-vulkan)"),
+        "{partly}"
     );
+    // A last-check.json from before `recorded_as`: the recording named by a pass read
+    // against it.
+    let older = record_advice(&coverage(&[recorded.clone(), stale.clone()]), &nowhere).unwrap();
+    assert!(older.contains("--record-host host-d`"), "{older}");
     assert_eq!(
         record_advice(&coverage(std::slice::from_ref(&stale)), &nowhere).as_deref(),
         Some(RECORD_THIS_HOST)
