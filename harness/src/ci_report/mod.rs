@@ -36,8 +36,10 @@ fn speed_status(check: &SpeedCheck) -> Status {
     }
 }
 
-/// How many cases a run has, and how many did not pass (failed or errors).
-fn counts(run: &CheckRun) -> (usize, usize) {
+/// How many cases a run has, and how many did not pass (failed or errors): the console's,
+/// the summary's and the JUnit file's counts alike (a scene that did not load, a backend asked
+/// for and missing, a render or probe that failed each count as one).
+pub fn counts(run: &CheckRun) -> (usize, usize) {
     let missing = run.backends.iter().filter(|b| b.missing()).count();
     let total = run.results.len()
         + missing

@@ -31,13 +31,26 @@ pub(crate) struct Options {
 }
 
 /// Runs the check on the scenes and backends asked for (all by default), writes report.html
-/// and the failure images under `out` and prints the results; exits 1 on any failure.
+/// and the failure images under `out` and prints the results; exits 1 on any failure, and 2,
+/// writing nothing, where a `--scene` names neither a file nor a scene in scenes/ (a typo must
+/// not replace the last check that `harness review` and `bless --from-last-check` read).
 pub(crate) fn run(
     out: &Path,
     scenes: &[String],
     backends: &[BackendKind],
     options: Options,
 ) -> anyhow::Result<ExitCode> {
+    for scene in scenes {
+        if let Err(e @ engine::scene_file::SceneFileError::UnknownScene { .. }) =
+            engine::scene_file::resolve(scene, &harness::scenes_dir())
+        {
+            eprintln!(
+                "error: {e}; nothing checked, {} left as it was",
+                out.display()
+            );
+            return Ok(ExitCode::from(2));
+        }
+    }
     let (mut cases, broken) = load_cases_isolated(scenes)?;
     // What each scene was loaded from, for the speed history (before `--pass` narrows).
     let input_digests = harness::golden::scene_inputs::digests(cases.iter().map(|c| &c.inputs));
@@ -368,9 +381,9 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
         );
     }
     super::check_speed::print_speed(run);
-    let failed = run.results.iter().filter(|r| !r.outcome.passed()).count()
-        + run.speed.checks.iter().filter(|c| c.failed()).count()
-        + run.speed.errors.len();
+    // Counted as the summary and the JUnit file count them: a scene that did not load, a
+    // backend asked for and missing, a failed render or probe is one failed check each.
+    let (total, failed) = harness::ci_report::counts(run);
     let mut unloaded = if run.load_errors.is_empty() {
         String::new()
     } else {
@@ -398,8 +411,7 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
         n => format!(", {n} untimed"),
     };
     println!(
-        "{} checks ({} of speed{untimed}), {failed} failed{unloaded}; report: {}",
-        run.results.len() + run.speed.checks.len(),
+        "{total} checks ({} of speed{untimed}), {failed} failed{unloaded}; report: {}",
         run.speed.checks.len(),
         report.display()
     );

@@ -27,27 +27,30 @@ fn unknown_scene_names_list_the_canonical_scenes() {
     let (code, _, stderr) = harness(&["plan", "--scene", "chesss"]);
     assert_eq!(code, 1);
     assert!(stderr.contains("chess"), "{stderr}");
-    // `check` of it alone (named twice: once) fails without probing any scene's speed (a
-    // probe child given no scene would time every canonical one).
+    // `check` of it (named twice: once) is a usage error, said once, before anything runs or
+    // is written: a typo must not replace the last check (here a stand-in) that `harness
+    // review` and `bless --from-last-check` read.
     let out = tempfile::tempdir().unwrap();
+    let last_check = out.path().join("last-check.json");
+    std::fs::write(&last_check, "the last check").unwrap();
     let out = out.path().to_str().unwrap();
     let args = [
         "check", "--scene", "chesss", "--scene", "chesss", "--out", out,
     ];
     let (code, stdout, stderr) = harness(&args);
-    assert_eq!(code, 1, "{stderr}");
-    assert_eq!(
-        stderr.matches("scene `chesss` did not load").count(),
-        1,
+    assert_eq!(code, 2, "{stderr}");
+    assert_eq!(stderr.matches("no scene `chesss`").count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("nothing checked") && stdout.is_empty(),
         "{stderr}"
     );
-    assert!(stdout.contains("(0 of speed)"), "{stdout}");
     // The default command takes its options without its name: `harness --scene X` is `check`.
-    let (code, stdout, stderr) = harness(&["--scene", "chesss", "--out", out]);
-    assert_eq!(code, 1, "{stderr}");
-    assert!(
-        stderr.contains("scene `chesss` did not load") && stdout.contains("(0 of speed)"),
-        "{stderr}"
+    let (code, _, stderr) = harness(&["--scene", "chesss", "--out", out]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("no scene `chesss`"), "{stderr}");
+    assert_eq!(
+        std::fs::read_to_string(&last_check).unwrap(),
+        "the last check"
     );
 }
 
