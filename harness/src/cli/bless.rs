@@ -304,7 +304,7 @@ fn bless_images(
                 continue;
             }
         }
-        let mut kept = 0;
+        let (mut kept, mut written) = (0, 0);
         for pass in wanted {
             let blessed = bless_pass(
                 store,
@@ -315,10 +315,28 @@ fn bless_images(
                 (kind, &driver),
                 request,
             )?;
-            if blessed.outcome == BlessOutcome::Kept {
-                kept += 1;
+            match blessed.outcome {
+                BlessOutcome::Kept => kept += 1,
+                BlessOutcome::Written(_) => written += 1,
+                BlessOutcome::WouldWrite | BlessOutcome::WouldWriteNew => {}
             }
             println!("{blessed}");
+        }
+        if written > 0 {
+            println!(
+                "{}: recorded the backend, driver, metrics against the old goldens{} in {}",
+                case.name(),
+                if request.reason.is_some() {
+                    " and the reason"
+                } else {
+                    ""
+                },
+                store
+                    .root()
+                    .join(case.name())
+                    .join("blessed.toml")
+                    .display()
+            );
         }
         if kept > 0 {
             println!(

@@ -116,6 +116,15 @@ fn check_out_path(
     plan: &engine::plan::RenderPlan,
 ) -> anyhow::Result<()> {
     use engine::backend::TextureFormat;
+    // A folder on the way that is a file (`README.md/x.png`): refused before rendering, as a
+    // missing one is made when the images are written.
+    if let Some(file) = out.and_then(|o| o.ancestors().skip(1).find(|a| a.is_file())) {
+        anyhow::bail!(
+            "--out {}: {} is a file, not a folder",
+            out.unwrap_or(file).display(),
+            file.display()
+        );
+    }
     let Some(extension) = out.filter(|o| names_a_file(o)).and_then(|o| o.extension()) else {
         return Ok(());
     };

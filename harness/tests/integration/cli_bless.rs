@@ -284,6 +284,9 @@ fn an_extracted_sun_gets_its_shadow_goldens() {
         assert!(golden.join(file).is_file(), "no {file}:\n{stdout}");
     }
     assert!(stdout.contains("ibl_sun/shadow_term_0: new"), "{stdout}");
+    // It says where it recorded what it did.
+    let record = "ibl_sun: recorded the backend, driver, metrics against the old goldens in";
+    assert!(stdout.contains(record) && stdout.contains("ibl_sun/blessed.toml"));
     let records = std::fs::read_to_string(golden.join("blessed.toml")).unwrap();
     for pass in ["shadow_0", "shadow_term_0"] {
         assert!(records.contains(&format!("[passes.{pass}]")), "{records}");

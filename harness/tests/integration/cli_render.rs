@@ -142,9 +142,15 @@ fn render_writes_every_pass_of_a_scene_file() {
     ] {
         assert!(dir.path().join(file).is_file(), "{file} missing:\n{stdout}");
     }
-    // A file's name where a folder is needed, or the other format's extension: refused before
-    // anything is rendered, and nothing is written.
+    // A file's name where a folder is needed (also on the way to the file named), or the other
+    // format's extension: refused before anything is rendered, and nothing is written.
+    std::fs::write(dir.path().join("notes.txt"), "a file").unwrap();
     for (pass, out, says) in [
+        (
+            "final",
+            "notes.txt/final.png",
+            "notes.txt is a file, not a folder",
+        ),
         (
             "all",
             "out.png",
