@@ -323,20 +323,7 @@ fn bless_images(
             println!("{blessed}");
         }
         if written > 0 {
-            println!(
-                "{}: recorded the backend, driver, metrics against the old goldens{} in {}",
-                case.name(),
-                if request.reason.is_some() {
-                    " and the reason"
-                } else {
-                    ""
-                },
-                store
-                    .root()
-                    .join(case.name())
-                    .join("blessed.toml")
-                    .display()
-            );
+            print_record_line(store, case.name(), request.reason.is_some());
         }
         if kept > 0 {
             println!(
@@ -355,6 +342,16 @@ fn bless_images(
         }
     }
     Ok(refused)
+}
+
+/// After a scene's goldens were written (by a bless or an accept): where how each was blessed
+/// is recorded (backend, driver, the old golden's metrics where there was one, and the reason).
+fn print_record_line(store: &harness::golden::GoldenStore, scene: &str, reason: bool) {
+    println!(
+        "{scene}: recorded how each was blessed{} in {}",
+        if reason { ", and why," } else { "" },
+        store.root().join(scene).join("blessed.toml").display()
+    );
 }
 
 /// `harness bless --prune`: lists the orphans in golden/ (every scene's and golden/'s own, or
@@ -509,6 +506,13 @@ pub(crate) fn from_last_check(
         }
         for blessed in &done.accepted {
             println!("{blessed}");
+        }
+        if done
+            .accepted
+            .iter()
+            .any(|b| matches!(b.outcome, BlessOutcome::Written(_)))
+        {
+            print_record_line(&store, case.name(), options.reason.is_some());
         }
     }
     // The timing goldens, as the check measured them (a probe again would be a new measurement).

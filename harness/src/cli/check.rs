@@ -416,65 +416,80 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
         report.display()
     );
     if failed > 0 {
-        if run.results.iter().any(|r| !r.outcome.passed()) {
-            println!("failure images: {failures}");
-        }
-        // A debug check's slower passes are the setting's own: a golden taken from them would
-        // hold the generic variant's cost, which no normal render has, and leave the lighting
-        // passes unable to fail (the accept refuses them too). What else failed is advised on.
-        let debug_slower = |c: &harness::golden::speed::SpeedCheck| {
-            run.speed.unspecialised_lighting && c.outcome == SpeedOutcome::Slower
-        };
-        if run.speed.checks.iter().any(debug_slower) {
-            println!(
-                "the slower passes are --debug-unspecialised-lighting's own: the renderer is \
-                 unchanged and `check` without the setting passes them, so there is nothing to \
-                 bless or accept. A deliberate slowdown of your own is blessed after a check \
-                 without it (`harness bless --scene S --speed-only --reason \"why\"`)"
-            );
-            let others = run.results.iter().any(|r| !r.outcome.passed())
-                || !run.speed.errors.is_empty()
-                || run
-                    .speed
-                    .checks
-                    .iter()
-                    .any(|c| c.failed() && !debug_slower(c));
-            if !others {
-                return;
-            }
-        }
-        let commands = run.bless_commands();
-        // Slower passes whose timing goldens a bless from here writes: the check's own figures
-        // can be accepted as they are, as its kept images can.
-        let acceptable_timings = !run.speed.unspecialised_lighting
-            && run
+        print_advice(run, report, failures);
+    }
+}
+
+/// After a failing run: where its images are, and what to do (the bless commands, the accept,
+/// or that nothing is to be blessed).
+fn print_advice(run: &CheckRun, report: &Path, failures: &str) {
+    if run.results.iter().any(|r| !r.outcome.passed()) {
+        println!("failure images: {failures}");
+    }
+    // A debug check's slower passes are the setting's own: a golden taken from them would
+    // hold the generic variant's cost, which no normal render has, and leave the lighting
+    // passes unable to fail (the accept refuses them too). What else failed is advised on.
+    let debug_slower = |c: &harness::golden::speed::SpeedCheck| {
+        run.speed.unspecialised_lighting && c.outcome == SpeedOutcome::Slower
+    };
+    if run.speed.checks.iter().any(debug_slower) {
+        println!(
+            "the slower passes are --debug-unspecialised-lighting's own: the renderer is \
+             unchanged and `check` without the setting passes them, so there is nothing to \
+             bless or accept. A deliberate slowdown of your own is blessed after a check \
+             without it (`harness bless --scene S --speed-only --reason \"why\"`)"
+        );
+        let others = run.results.iter().any(|r| !r.outcome.passed())
+            || !run.speed.errors.is_empty()
+            || run
                 .speed
                 .checks
                 .iter()
-                .any(|c| c.outcome == SpeedOutcome::Slower && c.bless_writes_here());
-        let kept = match (run.verifications.is_empty(), acceptable_timings) {
-            (true, false) => String::new(),
-            (false, false) => "; or accept what this check kept, as above".to_owned(),
-            (verified, true) => format!(
-                "; or {} the timings this check measured, probing nothing again: `{} \
-                 --speed-only`",
-                if verified {
-                    "accept"
-                } else {
-                    "accept what it kept, as above, and"
-                },
-                accept_command(report.parent().unwrap_or(report))
-            ),
-        };
-        println!(
-            "after reviewing the report, bless what changed on purpose (one command per \
-             scene; it renders again and rewrites only the passes outside tolerance or without \
-             a golden; add --reason \"why\" to record why{kept}).{}",
-            harness::golden::command_line::moves_timings_note(&commands)
-        );
-        for command in commands {
-            println!("  {command}");
+                .any(|c| c.failed() && !debug_slower(c));
+        if !others {
+            return;
         }
+    }
+    let commands = run.bless_commands();
+    // Slower passes whose timing goldens a bless from here writes: the check's own figures
+    // can be accepted as they are, as its kept images can.
+    let acceptable_timings = !run.speed.unspecialised_lighting
+        && run
+            .speed
+            .checks
+            .iter()
+            .any(|c| c.outcome == SpeedOutcome::Slower && c.bless_writes_here());
+    if commands.is_empty() && run.verifications.is_empty() && !acceptable_timings {
+        // Only what no bless fixes failed: a scene that did not load, a backend asked for
+        // and missing, a render or probe that failed (each said above).
+        println!(
+            "nothing here for a bless to take: fix what failed above (a scene that did not \
+             load, a backend asked for and unavailable, a render or speed probe that failed)"
+        );
+        return;
+    }
+    let kept = match (run.verifications.is_empty(), acceptable_timings) {
+        (true, false) => String::new(),
+        (false, false) => "; or accept what this check kept, as above".to_owned(),
+        (verified, true) => format!(
+            "; or {} the timings this check measured, probing nothing again: `{} \
+             --speed-only`",
+            if verified {
+                "accept"
+            } else {
+                "accept what it kept, as above, and"
+            },
+            accept_command(report.parent().unwrap_or(report))
+        ),
+    };
+    println!(
+        "after reviewing the report, bless what changed on purpose (one command per \
+         scene; it renders again and rewrites only the passes outside tolerance or without \
+         a golden; add --reason \"why\" to record why{kept}).{}",
+        harness::golden::command_line::moves_timings_note(&commands)
+    );
+    for command in commands {
+        println!("  {command}");
     }
 }
 

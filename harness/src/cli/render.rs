@@ -118,7 +118,12 @@ fn check_out_path(
     use engine::backend::TextureFormat;
     // A folder on the way that is a file (`README.md/x.png`): refused before rendering, as a
     // missing one is made when the images are written.
-    if let Some(file) = out.and_then(|o| o.ancestors().skip(1).find(|a| a.is_file())) {
+    // (`out` itself is checked too where it is used as a folder.)
+    let on_the_way = out.and_then(|o| {
+        let skip = usize::from(names_a_file(o));
+        o.ancestors().skip(skip).find(|a| a.is_file())
+    });
+    if let Some(file) = on_the_way {
         anyhow::bail!(
             "--out {}: {} is a file, not a folder",
             out.unwrap_or(file).display(),

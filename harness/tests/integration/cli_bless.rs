@@ -285,7 +285,7 @@ fn an_extracted_sun_gets_its_shadow_goldens() {
     }
     assert!(stdout.contains("ibl_sun/shadow_term_0: new"), "{stdout}");
     // It says where it recorded what it did.
-    let record = "ibl_sun: recorded the backend, driver, metrics against the old goldens in";
+    let record = "ibl_sun: recorded how each was blessed in ";
     assert!(stdout.contains(record) && stdout.contains("ibl_sun/blessed.toml"));
     let records = std::fs::read_to_string(golden.join("blessed.toml")).unwrap();
     for pass in ["shadow_0", "shadow_term_0"] {

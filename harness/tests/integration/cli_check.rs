@@ -66,6 +66,11 @@ fn a_broken_scene_is_one_failed_case_and_the_others_are_checked() {
         );
     }
     assert!(stdout.contains("1 scene(s) did not load"), "{stdout}");
+    // No bless fixes a scene that does not load: no bless advice.
+    assert!(
+        stdout.contains("nothing here for a bless to take") && !stdout.contains("after reviewing"),
+        "{stdout}"
+    );
     let report = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(report.contains("scene broken did not load"));
     // The canonical scenes pass: the review page shows them as thumbnails and stays small

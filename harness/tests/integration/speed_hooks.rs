@@ -58,31 +58,42 @@ fn the_unspecialised_lighting_fails_check_on_the_lighting_passes_only() {
     }
     let out = tempfile::tempdir().unwrap();
     let out_arg = out.path().to_str().unwrap();
-    let (code, stdout, stderr) = common::cli::harness(&[
-        "check",
-        "--debug-unspecialised-lighting",
-        "--scene",
-        "arrow",
-        "--backend",
-        "gl",
-        "--out",
-        out_arg,
-    ]);
-    assert_eq!(code, 1, "{stdout}{stderr}");
-    let json = std::fs::read(out.path().join("last-check.json")).unwrap();
-    assert!(common::cli::failing_passes(&json).is_empty(), "{stdout}");
-    let run: serde_json::Value = serde_json::from_slice(&json).unwrap();
-    let checks: Vec<harness::golden::speed::SpeedCheck> =
-        serde_json::from_value(run["speed"]["checks"].clone()).unwrap();
-    let failed: Vec<PassId> = checks
-        .iter()
-        .filter(|c| c.failed())
-        .map(|c| c.pass)
-        .collect();
-    assert!(
-        !failed.is_empty() && failed.iter().all(|p| matches!(p, PassId::Lighting(_))),
-        "{failed:?}\n{stdout}"
-    );
+    let check = || {
+        let (code, stdout, stderr) = common::cli::harness(&[
+            "check",
+            "--debug-unspecialised-lighting",
+            "--scene",
+            "arrow",
+            "--backend",
+            "gl",
+            "--out",
+            out_arg,
+        ]);
+        assert_eq!(code, 1, "{stdout}{stderr}");
+        let json = std::fs::read(out.path().join("last-check.json")).unwrap();
+        assert!(common::cli::failing_passes(&json).is_empty(), "{stdout}");
+        let run: serde_json::Value = serde_json::from_slice(&json).unwrap();
+        let checks: Vec<harness::golden::speed::SpeedCheck> =
+            serde_json::from_value(run["speed"]["checks"].clone()).unwrap();
+        let failed: Vec<PassId> = checks
+            .iter()
+            .filter(|c| c.failed())
+            .map(|c| c.pass)
+            .collect();
+        (failed, stdout)
+    };
+    let lighting_only = |failed: &[PassId]| {
+        !failed.is_empty() && failed.iter().all(|p| matches!(p, PassId::Lighting(_)))
+    };
+    // A check's timing noise is measured with one busy neighbour; this suite can run beside a
+    // whole other build (two on two cores): a pass other than lighting failing once is checked
+    // again, and must not fail again.
+    let (mut failed, mut stdout) = check();
+    if !lighting_only(&failed) {
+        eprintln!("checked again: {failed:?} failed");
+        (failed, stdout) = check();
+    }
+    assert!(lighting_only(&failed), "{failed:?}\n{stdout}");
     assert!(
         stdout.contains("so there is nothing to bless or accept"),
         "{stdout}"
