@@ -270,10 +270,12 @@ pub(crate) fn finish(
 pub(crate) fn merge(shards: &[PathBuf], out: &Path, options: &Options) -> anyhow::Result<ExitCode> {
     let (run, outputs) = harness::golden::merge::merge(shards)?;
     let store = harness::golden::GoldenStore::workspace();
-    // The failure images stay in the shards' folders.
+    // The failure images stay in the shards' folders: those that have any.
     let failures: Vec<String> = shards
         .iter()
-        .map(|s| s.join("failures").display().to_string())
+        .map(|s| s.join("failures"))
+        .filter(|f| f.is_dir())
+        .map(|f| f.display().to_string())
         .collect();
     finish(&run, &outputs, &store, out, &failures.join(", "), options)
 }

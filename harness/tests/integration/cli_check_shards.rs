@@ -71,6 +71,9 @@ fn sharded_checks_merge_into_one_report() {
         merged.join("summary.md").to_str().unwrap(),
     ]);
     assert_eq!(code, Some(1), "{text}");
+    // The failure images are where they are: the failing shard's folder, not the passing ones'.
+    let failures = format!("failure images: {}", arrow.join("failures").display());
+    assert!(text.lines().any(|l| l == failures), "{text}");
     let whole = root.path().join("unsharded");
     let (code, whole_text) = run(&[
         "check",
