@@ -350,7 +350,7 @@ fn print_record_line(store: &harness::golden::GoldenStore, scene: &str, reason: 
     println!(
         "{scene}: recorded how each was blessed{} in {}",
         if reason { ", and why," } else { "" },
-        store.root().join(scene).join("blessed.toml").display()
+        store.record_path(scene).display()
     );
 }
 
@@ -403,16 +403,17 @@ pub(crate) fn from_last_check(
     } else {
         Vec::new()
     };
-    let (mut timings, checked) = match options.speed {
-        // A debug check's timings are never taken; its images are (the same picture).
-        true => match accept::speed_candidates(out, scenes, passes) {
+    // A debug check's timings are never taken; its images are (the same picture).
+    let (mut timings, checked) = if options.speed {
+        match accept::speed_candidates(out, scenes, passes) {
             Err(e @ accept::AcceptError::DebugSlowdown) if options.images => {
                 eprintln!("note: no timings accepted: {e}");
                 Default::default()
             }
             other => other?,
-        },
-        false => Default::default(),
+        }
+    } else {
+        Default::default()
     };
     if let Some(backend) = backend {
         timings.retain(|c| c.backend == backend);

@@ -401,12 +401,7 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
         .speed
         .checks
         .iter()
-        .filter(|c| {
-            !c.failed()
-                && (matches!(c.outcome, SpeedOutcome::Untimed(_))
-                    || c.limit
-                        .is_some_and(|l| l >= harness::golden::speed::MUST_CATCH))
-        })
+        .filter(|c| c.untimed() && !c.failed())
         .count();
     let untimed = match untimed {
         0 => String::new(),
@@ -431,9 +426,7 @@ fn print_advice(run: &CheckRun, report: &Path, failures: &str) {
     // A debug check's slower passes are the setting's own: a golden taken from them would
     // hold the generic variant's cost, which no normal render has, and leave the lighting
     // passes unable to fail (the accept refuses them too). What else failed is advised on.
-    let debug_slower = |c: &harness::golden::speed::SpeedCheck| {
-        run.speed.unspecialised_lighting && c.outcome == SpeedOutcome::Slower
-    };
+    let debug_slower = |c: &harness::golden::speed::SpeedCheck| run.speed.is_debug_slowdown(c);
     if run.speed.checks.iter().any(debug_slower) {
         println!(
             "the slower passes are --debug-unspecialised-lighting's own: the renderer is \

@@ -11,7 +11,6 @@ use engine::Image;
 
 use crate::golden::command_line::bless_command;
 use crate::golden::metrics::Channels;
-use crate::golden::speed::SpeedOutcome;
 use crate::golden::suite::{self, Case, PassCheck};
 use crate::golden::{self, GoldenStore};
 
@@ -137,7 +136,7 @@ impl CheckRun {
 
     /// One `harness bless` command per scene with a failing or missing pass, in the order of
     /// the results (each rewrites only its scene's changed passes). A slower pass of a check
-    /// with the debug slowdown ([`SpeedRun::unspecialised_lighting`](crate::golden::speed::SpeedRun))
+    /// with the debug slowdown ([`SpeedRun::is_debug_slowdown`](crate::golden::speed::SpeedRun))
     /// has none: it is the setting's own.
     pub fn bless_commands(&self) -> Vec<String> {
         let mut commands: Vec<String> = Vec::new();
@@ -147,12 +146,11 @@ impl CheckRun {
                 commands.push(command);
             }
         }
-        let debug = self.speed.unspecialised_lighting;
         for c in self
             .speed
             .checks
             .iter()
-            .filter(|c| c.failed() && !(debug && c.outcome == SpeedOutcome::Slower))
+            .filter(|c| c.failed() && !self.speed.is_debug_slowdown(c))
         {
             let argument = self.scene_argument(&c.scene);
             let command =

@@ -276,7 +276,8 @@ impl GoldenStore {
             .decodes
     }
 
-    fn record_path(&self, scene: &str) -> PathBuf {
+    /// `golden/<scene>/blessed.toml`: how each pass of the scene was blessed.
+    pub fn record_path(&self, scene: &str) -> PathBuf {
         self.root.join(scene).join("blessed.toml")
     }
 

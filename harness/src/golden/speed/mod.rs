@@ -224,6 +224,14 @@ pub struct SpeedRun {
     pub unspecialised_lighting: bool,
 }
 
+impl SpeedRun {
+    /// Whether `check` is a pass slowed on purpose by `--debug-unspecialised-lighting`: the
+    /// setting's own, which no bless or accept takes.
+    pub fn is_debug_slowdown(&self, check: &SpeedCheck) -> bool {
+        self.unspecialised_lighting && check.outcome == SpeedOutcome::Slower
+    }
+}
+
 /// Why `kind`'s checks on this host (fingerprint `host`, CPU signature `cpu`) are not read
 /// against a recording that has this CPU: per such recording, the parts of the fingerprint
 /// (the ` | `-separated driver, Mesa, LLVM and driver variables) found only here and only there.

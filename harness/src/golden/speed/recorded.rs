@@ -265,6 +265,16 @@ pub fn recorded_hosts(
         .collect())
 }
 
+/// How a check names the recording of `host` it was read against: "host-d's recording".
+pub fn label(host: &str) -> String {
+    format!("{host}'s recording")
+}
+
+/// The host a [`label`] names.
+pub fn host_of_label(label: &str) -> Option<&str> {
+    label.strip_suffix("'s recording")
+}
+
 /// The recording among `recordings` (named, as [`load_all`] reads them) of this host:
 /// fingerprint `host` on `kind`, CPU signature `cpu` ([`RecordedTimings::records`]).
 pub fn of_host<'a>(

@@ -115,6 +115,17 @@ impl SpeedCheck {
                 && matches!(self.outcome, SpeedOutcome::TargetsChanged(_)))
     }
 
+    /// Whether the pass has no verdict at this tier though it was compared: untimed (too short
+    /// or too noisy), or a limit too wide to catch a doubling ([`MUST_CATCH`]; such a pass still
+    /// fails beyond it).
+    pub fn untimed(&self) -> bool {
+        match (&self.outcome, self.limit) {
+            (SpeedOutcome::Untimed(_), _) => true,
+            (SpeedOutcome::MissingGolden | SpeedOutcome::TargetsChanged(_), _) | (_, None) => false,
+            (_, Some(limit)) => limit >= MUST_CATCH,
+        }
+    }
+
     /// Whether this check fails the run.
     pub fn failed(&self) -> bool {
         matches!(
@@ -256,7 +267,7 @@ pub fn check_speed_with(
             Some((name, reference, spread)) => (
                 Tier::RecordedHost,
                 Some(reference),
-                Some((spread, format!("{name}'s recording"))),
+                Some((spread, super::recorded::label(name))),
                 false,
             ),
             None => {
@@ -454,28 +465,22 @@ pub fn record_advice(
     }
     // This host's recording per backend: as the check found it on disk, or (a last-check.json
     // from before it said so) as some pass read against it names it.
+    let in_coverage = |backend: Option<BackendKind>| {
+        coverage
+            .iter()
+            .filter(|c| backend.is_none_or(|b| c.backend == b))
+            .find_map(|c| super::recorded::host_of_label(c.recording.as_deref()?))
+            .map(str::to_owned)
+    };
     let name_on = |backend: BackendKind| {
-        recorded_as.get(&backend).cloned().or_else(|| {
-            coverage
-                .iter()
-                .filter(|c| c.tier == Tier::RecordedHost && c.backend == backend)
-                .find_map(|c| c.recording.as_deref()?.strip_suffix("'s recording"))
-                .map(str::to_owned)
-        })
+        (recorded_as.get(&backend).cloned()).or_else(|| in_coverage(Some(backend)))
     };
     let names: Vec<(BackendKind, Option<String>)> = other
         .iter()
         .map(|o| (o.backend, name_on(o.backend)))
         .collect();
     // Recorded on some backend: record it again (on every backend), naming the others.
-    let any_recording = || {
-        recorded_as.values().next().cloned().or_else(|| {
-            coverage
-                .iter()
-                .find_map(|c| c.recording.as_deref()?.strip_suffix("'s recording"))
-                .map(str::to_owned)
-        })
-    };
+    let any_recording = || (recorded_as.values().next().cloned()).or_else(|| in_coverage(None));
     let Some(name) = names
         .iter()
         .find_map(|(_, n)| n.clone())
@@ -543,12 +548,11 @@ pub fn coverage(checks: &[SpeedCheck]) -> Vec<SpeedCoverage> {
             group.recording = c.noise.as_ref().map(|(_, at)| at.clone());
         }
         match (&c.outcome, c.limit) {
-            (SpeedOutcome::Untimed(_), _) => group.untimed += 1,
+            // A limit too wide to catch a doubling times nothing, failing beyond it or not.
+            _ if c.untimed() => group.untimed += 1,
             (SpeedOutcome::MissingGolden | SpeedOutcome::TargetsChanged(_), _) | (_, None) => {
                 group.not_compared += 1;
             }
-            // A limit too wide to catch a doubling times nothing, failing beyond it or not.
-            (_, Some(limit)) if limit >= MUST_CATCH => group.untimed += 1,
             (_, Some(limit)) => {
                 group.limits.push(limit);
                 // From a pass's speed in this run, how much slower it may get; a pass already

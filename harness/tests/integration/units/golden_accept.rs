@@ -40,6 +40,22 @@ fn on(host: &str) -> CheckContext {
     }
 }
 
+/// A probe of arrow on gl: its geometry pass at twice its floor.
+fn arrow_geometry_probe() -> SceneSpeed {
+    SceneSpeed {
+        scene: "arrow".to_owned(),
+        backend: BackendKind::Gl,
+        rounds: 4,
+        passes: vec![PassSpeed {
+            pass: PassId::Geometry,
+            pass_ms: vec![2.0],
+            floor_ms: vec![1.0],
+            targets: None,
+            unslowed_ms: Vec::new(),
+        }],
+    }
+}
+
 /// Accepting a speed check from the last check writes the ratio it measured (with the reason)
 /// where the check's host blessed the backend's timing goldens, asked of the file as it is now
 /// (a section re-blessed elsewhere since the check is not written into), and keeps it out,
@@ -53,18 +69,7 @@ fn a_timing_golden_is_accepted_only_on_the_host_that_blessed_it() {
     let store = GoldenStore::new(dir.path());
     std::fs::create_dir_all(dir.path().join("arrow")).unwrap();
     let mut goldens = TimingGoldens::default();
-    let probe = SceneSpeed {
-        scene: "arrow".to_owned(),
-        backend: BackendKind::Gl,
-        rounds: 4,
-        passes: vec![PassSpeed {
-            pass: PassId::Geometry,
-            pass_ms: vec![2.0],
-            floor_ms: vec![1.0],
-            targets: None,
-            unslowed_ms: Vec::new(),
-        }],
-    };
+    let probe = arrow_geometry_probe();
     let cpu = cpu_signature();
     let stamp = Stamp {
         host: "the EPYC",
@@ -145,18 +150,7 @@ fn a_recorded_host_accepts_a_slowdown_scaled_into_the_blessing_hosts_terms() {
     let store = GoldenStore::new(dir.path());
     std::fs::create_dir_all(dir.path().join("arrow")).unwrap();
     let cpu = cpu_signature();
-    let probe = SceneSpeed {
-        scene: "arrow".to_owned(),
-        backend: BackendKind::Gl,
-        rounds: 4,
-        passes: vec![PassSpeed {
-            pass: PassId::Geometry,
-            pass_ms: vec![2.0],
-            floor_ms: vec![1.0],
-            targets: None,
-            unslowed_ms: Vec::new(),
-        }],
-    };
+    let probe = arrow_geometry_probe();
     let stamp = Stamp {
         host: "the EPYC",
         cpu: "family 25 model 1 stepping 1",
