@@ -48,7 +48,13 @@ pub(super) fn bless_speed(
         },
         |what| eprintln!("{what} ..."),
     )?;
-    for line in &lines {
+    for line in lines
+        .iter()
+        .filter(|l| l.fate != harness::golden::speed::bless::Fate::KeptAsAnotherHosts)
+    {
+        println!("{line}");
+    }
+    for line in harness::golden::speed::bless::another_hosts_lines(&lines, &scenes) {
         println!("{line}");
     }
     // Goldens moved here whose same-host figures this host has not measured (where it has,

@@ -43,6 +43,21 @@ pub fn speed_bless_command(scene: &str, writes_here: bool) -> String {
     format!("{} {flags}", bless_command(scene))
 }
 
+/// The command that moves the timing goldens of `scenes` (as
+/// [`crate::golden::suite::Case::argument`] gives them) to this host whole, every backend's and
+/// every pass: one command for a bless that kept them as another host's.
+pub fn move_timings_command(scenes: &[&str]) -> String {
+    let scenes: String = scenes
+        .iter()
+        .map(|scene| format!(" --scene {}", shell_quote(scene)))
+        .collect();
+    format!(
+        "{}{} bless{scenes} {MOVE_TIMINGS_HERE}",
+        workspace(),
+        harness()
+    )
+}
+
 /// `harness ARGS` as [`bless_command`] names the harness and the workspace: the command to
 /// paste here.
 pub fn harness_command(args: &str) -> String {

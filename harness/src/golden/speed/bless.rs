@@ -107,6 +107,9 @@ pub enum Fate {
     WouldBeWritten,
     /// Left as it was.
     Kept,
+    /// Left as it was, every pass of the scene on the backend: another host's timing goldens
+    /// ([`kept_as_another_hosts`]).
+    KeptAsAnotherHosts,
 }
 
 impl Fate {
@@ -123,7 +126,7 @@ impl std::fmt::Display for Fate {
             Fate::Written => "written (new)",
             Fate::WouldBeRewritten => "would be rewritten (dry run)",
             Fate::WouldBeWritten => "would be written (new; dry run)",
-            Fate::Kept => "kept",
+            Fate::Kept | Fate::KeptAsAnotherHosts => "kept",
         })
     }
 }
@@ -147,18 +150,17 @@ impl std::fmt::Display for SpeedBlessed {
 }
 
 /// Why a bless on this host (fingerprint `host`, CPU signature `cpu`) keeps the timing goldens
-/// `existing` of a scene (its command-line `argument`) on one backend as they are, or None when
-/// it may rewrite them: where there are none yet, where this host blessed them, or where they
-/// are asked to move here (`move_here`: the backend's goldens then move to this host whole). A
-/// backend's goldens are one host's ratios: another CPU puts a pass x0.4 to x1.75 away, so a
-/// few passes blessed here among another host's would be judged against the wrong host's
-/// figures.
+/// `existing` of a scene on one backend as they are, or None when it may rewrite them: where
+/// there are none yet, where this host blessed them, or where they are asked to move here
+/// (`move_here`: the backend's goldens then move to this host whole). A backend's goldens are
+/// one host's ratios: another CPU puts a pass x0.4 to x1.75 away, so a few passes blessed here
+/// among another host's would be judged against the wrong host's figures. What to do instead
+/// is said once for every such line ([`another_hosts_lines`]).
 pub fn kept_as_another_hosts(
     existing: Option<&BackendTimings>,
     host: &str,
     cpu: &str,
     move_here: bool,
-    argument: &str,
 ) -> Option<String> {
     let existing = existing?;
     if move_here || existing.blessed_on(host, cpu) {
@@ -166,13 +168,57 @@ pub fn kept_as_another_hosts(
     }
     Some(format!(
         "blessed on another host ({}, {}); a backend's timing goldens are one host's ratios, \
-         so none is rewritten from here. A recorded host blesses a slowdown into them scaled \
-         by its own recording (`harness noise --timing --record-host NAME` records this one); \
-         to move every backend's to this host instead: {}",
+         so none is rewritten from here",
         existing.blessed_by(),
-        existing.blessed,
-        crate::golden::command_line::speed_bless_command(argument, false)
+        existing.blessed
     ))
+}
+
+/// The lines of a bless's [`Fate::KeptAsAnotherHosts`] among `lines`, said once: one line per
+/// backend and reason naming every scene it holds for (`arguments` maps a scene to its
+/// command-line argument), then what to do instead, with one command for them all. Empty where
+/// there are none.
+pub fn another_hosts_lines(lines: &[SpeedBlessed], arguments: &[(String, String)]) -> Vec<String> {
+    let kept: Vec<&SpeedBlessed> = lines
+        .iter()
+        .filter(|l| l.fate == Fate::KeptAsAnotherHosts)
+        .collect();
+    if kept.is_empty() {
+        return Vec::new();
+    }
+    let mut groups: Vec<(BackendKind, &str, Vec<&str>)> = Vec::new();
+    for line in &kept {
+        match groups
+            .iter_mut()
+            .find(|(backend, why, _)| *backend == line.backend && *why == line.previous)
+        {
+            Some((_, _, scenes)) => scenes.push(&line.scene),
+            None => groups.push((line.backend, &line.previous, vec![&line.scene])),
+        }
+    }
+    let mut said: Vec<String> = groups
+        .iter()
+        .map(|(backend, why, scenes)| {
+            format!("{} on {backend} (speed): kept: {why}", scenes.join(", "))
+        })
+        .collect();
+    let mut scenes: Vec<&str> = Vec::new();
+    for line in &kept {
+        let argument = arguments
+            .iter()
+            .find(|(name, _)| *name == line.scene)
+            .map_or(line.scene.as_str(), |(_, argument)| argument.as_str());
+        if !scenes.contains(&argument) {
+            scenes.push(argument);
+        }
+    }
+    said.push(format!(
+        "note: a recorded host blesses a slowdown into another host's timing goldens, scaled by \
+         its own recording (`harness noise --timing --record-host NAME` records this one); to \
+         move them to this host instead, every backend's and every pass: {}",
+        crate::golden::command_line::move_timings_command(&scenes)
+    ));
+    said
 }
 
 /// Writes the timing golden of `check`'s pass, a check on a recorded host
@@ -308,7 +354,7 @@ pub fn bless_scenes(
         for (scene, argument) in scenes {
             let goldens = TimingGoldens::load(root, scene)?;
             let existing = goldens.backends.get(kind);
-            match kept_as_another_hosts(existing, &host, &cpu, options.move_here, argument) {
+            match kept_as_another_hosts(existing, &host, &cpu, options.move_here) {
                 Some(_) if recorded.is_some() => {
                     writable.push((scene.clone(), argument.clone(), Writing::Scaled));
                 }
@@ -317,7 +363,7 @@ pub fn bless_scenes(
                     backend: *kind,
                     pass: None,
                     previous: why,
-                    fate: Fate::Kept,
+                    fate: Fate::KeptAsAnotherHosts,
                     moved_here: false,
                     refused: true,
                 }),

@@ -48,38 +48,91 @@ fn a_bless_keeps_another_hosts_timing_goldens_unless_every_pass_moves() {
         passes: Default::default(),
     };
     let here = ("host-c", "family 6 model 207 stepping 2");
+    assert_eq!(kept_as_another_hosts(None, here.0, here.1, false), None);
     assert_eq!(
-        kept_as_another_hosts(None, here.0, here.1, false, "arrow"),
+        kept_as_another_hosts(Some(&section), "the EPYC", &section.cpu, false),
         None
     );
     assert_eq!(
-        kept_as_another_hosts(Some(&section), "the EPYC", &section.cpu, false, "arrow"),
+        kept_as_another_hosts(Some(&section), here.0, here.1, true),
         None
     );
-    assert_eq!(
-        kept_as_another_hosts(Some(&section), here.0, here.1, true, "arrow"),
-        None
-    );
-    let why = kept_as_another_hosts(Some(&section), here.0, here.1, false, "arrow").unwrap();
+    let why = kept_as_another_hosts(Some(&section), here.0, here.1, false).unwrap();
     assert!(
-        why.contains(
+        why.starts_with(
             "blessed on another host (the EPYC, family 23 model 49 stepping 0, \
              2026-11-25T10:00:00Z)"
-        ) && why.ends_with("bless --scene arrow --speed-only --every-pass"),
+        ),
         "{why}"
     );
     // The same fingerprint on another CPU is another host.
-    assert!(kept_as_another_hosts(Some(&section), "the EPYC", here.1, false, "arrow").is_some());
+    assert!(kept_as_another_hosts(Some(&section), "the EPYC", here.1, false).is_some());
     // Goldens that keep no CPU are kept on every host, and the refusal says why.
     let unsigned = BackendTimings {
         cpu: String::new(),
         ..section.clone()
     };
-    let why = kept_as_another_hosts(Some(&unsigned), "the EPYC", here.1, false, "arrow").unwrap();
-    assert!(
-        why.contains("a CPU they do not record") && why.contains("--record-host NAME"),
-        "{why}"
+    let why = kept_as_another_hosts(Some(&unsigned), "the EPYC", here.1, false).unwrap();
+    assert!(why.contains("a CPU they do not record"), "{why}");
+}
+
+/// A bless that keeps another host's timing goldens in several scenes says so once per
+/// backend, naming the scenes, and gives one command that moves them all (after a driver
+/// change every scene is another host's: one line each made eight near-identical paragraphs).
+#[test]
+fn another_hosts_goldens_kept_are_said_once_per_backend_with_one_command() {
+    let kept = |scene: &str, backend: BackendKind, why: &str| SpeedBlessed {
+        scene: scene.to_owned(),
+        backend,
+        pass: None,
+        previous: why.to_owned(),
+        fate: Fate::KeptAsAnotherHosts,
+        moved_here: false,
+        refused: true,
+    };
+    let mut lines = Vec::new();
+    for scene in ["arrow", "chess", "mine"] {
+        lines.push(kept(
+            scene,
+            BackendKind::Gl,
+            "blessed on another host (gl's)",
+        ));
+        lines.push(kept(
+            scene,
+            BackendKind::WgpuVulkan,
+            "blessed on another host (vk's)",
+        ));
+    }
+    // A line of another fate is not among them.
+    lines.push(SpeedBlessed {
+        fate: Fate::Kept,
+        ..kept("corner", BackendKind::Gl, "within its limit")
+    });
+    let arguments = [
+        ("arrow".to_owned(), "arrow".to_owned()),
+        ("chess".to_owned(), "chess".to_owned()),
+        ("mine".to_owned(), "/tmp/my scenes/mine.toml".to_owned()),
+    ];
+    let said = another_hosts_lines(&lines, &arguments);
+    assert_eq!(said.len(), 3, "{said:#?}");
+    assert_eq!(
+        said[0],
+        "arrow, chess, mine on gl (speed): kept: blessed on another host (gl's)"
     );
+    assert_eq!(
+        said[1],
+        "arrow, chess, mine on wgpu-vulkan (speed): kept: blessed on another host (vk's)"
+    );
+    assert!(
+        said[2].contains("--record-host NAME")
+            && said[2].ends_with(
+                "bless --scene arrow --scene chess --scene '/tmp/my scenes/mine.toml' \
+                 --speed-only --every-pass"
+            ),
+        "{}",
+        said[2]
+    );
+    assert!(another_hosts_lines(&lines[6..], &arguments).is_empty());
 }
 
 /// A check read against this host's recording carries its slowdown into the blessing host's
