@@ -248,3 +248,23 @@ fn a_recorded_host_accepts_a_slowdown_scaled_into_the_blessing_hosts_terms() {
         "nothing written"
     );
 }
+
+/// A check's numbers come back from last-check.json bit for bit: the accept compares the
+/// recording's reference a check read against with the one it reads now exactly, and serde_json
+/// without `float_roundtrip` parsed about one 17-digit value in ten a bit off (a median such as
+/// 9.577200000000001 read back as 9.5772), so such a pass was refused as "changed since" on
+/// every accept.
+#[test]
+fn a_checks_numbers_come_back_from_its_json_bit_for_bit() {
+    let mut check = slower(BackendKind::Gl);
+    check.golden = Some((9.5771 + 9.5773) / 2.0);
+    check.ratio = 1.8654000000000002;
+    let text = serde_json::to_string(&check).unwrap();
+    let back: SpeedCheck = serde_json::from_str(&text).unwrap();
+    assert_eq!(
+        back.golden.map(f64::to_bits),
+        check.golden.map(f64::to_bits),
+        "{text}"
+    );
+    assert_eq!(back.ratio.to_bits(), check.ratio.to_bits(), "{text}");
+}
