@@ -371,7 +371,8 @@ pub(crate) fn prune(scenes: &[String], dry_run: bool) -> anyhow::Result<ExitCode
         println!("no orphans in {}", store.root().display());
         return Ok(ExitCode::SUCCESS);
     }
-    for orphan in &orphans {
+    // What a prune keeps says so on its own line below.
+    for orphan in orphans.iter().filter(|o| o.kind.prunable()) {
         println!("orphan: {orphan}");
     }
     let lines = harness::golden::orphans::prune(&store, &orphans, dry_run, |path| {

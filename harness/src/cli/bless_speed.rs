@@ -67,7 +67,10 @@ pub(super) fn bless_speed(
         &harness::golden::speed::cpu_signature(),
     );
     if !unmeasured.is_empty() {
-        let scenes: String = unmeasured.iter().map(|n| format!(" --scene {n}")).collect();
+        let scenes: String = unmeasured
+            .iter()
+            .map(|n| format!(" {}", harness::golden::command_line::scene_flag(n)))
+            .collect();
         let measure = harness::golden::command_line::harness_command(&format!(
             "noise --timing --write{scenes}"
         ));
@@ -104,7 +107,8 @@ pub(super) fn bless_speed(
     new.dedup();
     for scene in new {
         let measure = harness::golden::command_line::harness_command(&format!(
-            "noise --timing --write --scene {scene}"
+            "noise --timing --write {}",
+            harness::golden::command_line::scene_flag(scene)
         ));
         println!(
             "note: {scene}'s timing goldens are new, and golden/timing-noise.toml has no figures \

@@ -141,7 +141,11 @@ pub(crate) fn run(
         }
     }
     for orphan in &run.orphans {
-        eprintln!("note: orphan: {orphan} (`harness bless --prune` removes it)");
+        if orphan.kind.prunable() {
+            eprintln!("note: orphan: {orphan} (`harness bless --prune` removes it)");
+        } else {
+            eprintln!("note: {orphan}");
+        }
     }
     for b in &run.backends {
         match &b.unavailable {
@@ -303,8 +307,8 @@ fn note_borrowed_limits(cases: &[Case], store: &harness::golden::GoldenStore) {
             .collect();
         if !borrowed.is_empty() {
             let measure = harness::golden::command_line::harness_command(&format!(
-                "noise --scene {} --write",
-                case.argument()
+                "noise {} --write",
+                harness::golden::command_line::scene_flag(&case.argument())
             ));
             eprintln!(
                 "note: golden/noise.toml has no figures for {} ({}): its limits are the \

@@ -54,7 +54,8 @@ pub(super) fn record_host(
             Some((kind, host)) => eprintln!(
                 "note: {scene} left out: this host blessed its timing goldens on {kind} \
                  ({host}), so its figures there are this host's own noise (`harness noise \
-                 --timing --scene {scene}`), not another host's"
+                 --timing {}`), not another host's",
+                harness::golden::command_line::scene_flag(&scene)
             ),
             None => kept.push((scene, argument)),
         }

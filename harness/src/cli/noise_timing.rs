@@ -255,8 +255,12 @@ fn blessed_elsewhere(
     let Some((first, kind, blessed_by, cpu_known)) = elsewhere.first().cloned() else {
         return Ok(None);
     };
-    let scene_args =
-        |names: &[&str]| -> String { names.iter().map(|n| format!(" --scene {n}")).collect() };
+    let scene_args = |names: &[&str]| -> String {
+        names
+            .iter()
+            .map(|n| format!(" {}", harness::golden::command_line::scene_flag(n)))
+            .collect()
+    };
     // The scenes blessed where the first was are said with it; any others after it.
     let (alike, unlike): (Vec<&str>, Vec<&str>) = {
         let (alike, unlike): (Vec<_>, Vec<_>) = elsewhere[1..]

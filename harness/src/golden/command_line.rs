@@ -7,12 +7,7 @@
 /// shell where needed. In a workspace named by `HARNESS_ROOT`, the command names it too:
 /// pasted without it, it would bless the checkout the shell stands in.
 pub fn bless_command(scene: &str) -> String {
-    format!(
-        "{}{} bless --scene {}",
-        workspace(),
-        harness(),
-        shell_quote(scene)
-    )
+    format!("{}{} bless {}", workspace(), harness(), scene_flag(scene))
 }
 
 /// The `harness check` command line of one scene (`scene` as the user gave it) writing to
@@ -22,10 +17,10 @@ pub fn check_command(scene: &str, out: Option<&std::path::Path>) -> String {
         format!(" --out {}", shell_quote(&dir.to_string_lossy()))
     });
     format!(
-        "{}{} check --scene {}{out}",
+        "{}{} check {}{out}",
         workspace(),
         harness(),
-        shell_quote(scene)
+        scene_flag(scene)
     )
 }
 
@@ -49,7 +44,7 @@ pub fn speed_bless_command(scene: &str, writes_here: bool) -> String {
 pub fn move_timings_command(scenes: &[&str]) -> String {
     let scenes: String = scenes
         .iter()
-        .map(|scene| format!(" --scene {}", shell_quote(scene)))
+        .map(|scene| format!(" {}", scene_flag(scene)))
         .collect();
     format!(
         "{}{} bless{scenes} {MOVE_TIMINGS_HERE}",
@@ -127,6 +122,16 @@ fn workspace() -> String {
 }
 
 /// `word` as one word of a POSIX shell: as it is when it needs no quoting, else single-quoted.
+/// `--scene SCENE` for a printed command, quoted for a POSIX shell; `--scene=SCENE` where the
+/// scene begins with `-` (a file `-x.toml` in scenes/), which would otherwise read as a flag.
+pub fn scene_flag(scene: &str) -> String {
+    if scene.starts_with('-') {
+        format!("--scene={}", shell_quote(scene))
+    } else {
+        format!("--scene {}", shell_quote(scene))
+    }
+}
+
 fn shell_quote(word: &str) -> String {
     let plain = !word.is_empty()
         && word

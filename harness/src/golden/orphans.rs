@@ -28,6 +28,20 @@ pub enum OrphanKind {
     },
     /// Neither a golden nor a file the harness keeps there.
     Stray,
+    /// Goldens of current passes in a folder whose blessed.toml is missing or records nothing
+    /// (`path` is the blessed.toml): the records were lost, not the goldens made by hand, so
+    /// a prune keeps them and says how to restore the records.
+    RecordsLost {
+        /// How many goldens the folder holds.
+        goldens: usize,
+    },
+}
+
+impl OrphanKind {
+    /// Whether `harness bless --prune` removes it ([`OrphanKind::RecordsLost`] it keeps).
+    pub fn prunable(&self) -> bool {
+        !matches!(self, OrphanKind::RecordsLost { .. })
+    }
 }
 
 /// A file (or folder) in golden/ that nothing produces or records.
@@ -57,13 +71,22 @@ impl fmt::Display for Orphan {
                 format!("records `{pass}`, which has no golden in {scene}")
             }
             OrphanKind::Stray => "not a golden nor a file the harness keeps here".to_owned(),
+            OrphanKind::RecordsLost { goldens } => format!(
+                "missing or records nothing, beside {goldens} golden(s) of {scene}: restore it \
+                 from version control (`git checkout -- {}`), or record them again with `{} \
+                 --every-pass`; a prune keeps them",
+                self.path.display(),
+                crate::golden::command_line::bless_command(scene)
+            ),
         };
         write!(f, "{}: {why}", self.path.display())
     }
 }
 
-/// Files golden/ keeps at its top level besides the scene folders.
-const TOP_LEVEL: [&str; 4] = ["README.md", "noise.toml", "timing-noise.toml", "evidence"];
+/// Files golden/ keeps at its top level besides the scene folders: no scene may be named as one
+/// (its folder would be one of them, and a prune would clear it).
+pub(crate) const TOP_LEVEL: [&str; 4] =
+    ["README.md", "noise.toml", "timing-noise.toml", "evidence"];
 /// Files a scene folder keeps besides its goldens.
 const SCENE_FILES: [&str; 3] = ["blessed.toml", "timing.toml", LOCK_FILE];
 
@@ -119,6 +142,7 @@ fn in_scene(store: &GoldenStore, case: &Case) -> Result<Vec<Orphan>, GoldenError
         scene: Some(scene.to_owned()),
     };
     let mut orphans = Vec::new();
+    let mut unrecorded_goldens = 0;
     for (name, path, is_dir) in entries(&dir)? {
         if SCENE_FILES.contains(&name.as_str()) {
             continue;
@@ -129,6 +153,11 @@ fn in_scene(store: &GoldenStore, case: &Case) -> Result<Vec<Orphan>, GoldenError
             .find(|&&pass| store.path(scene, pass, case.is_eight_bit(pass)) == path);
         let kind = match golden_pass {
             Some(pass) if records.contains_key(&pass.to_string()) => continue,
+            // No record at all: counted, and said once below.
+            Some(_) if records.is_empty() => {
+                unrecorded_goldens += 1;
+                continue;
+            }
             Some(_) => OrphanKind::Unrecorded,
             None if !is_dir && is_image(&path) => OrphanKind::PassGone,
             None => OrphanKind::Stray,
@@ -145,6 +174,14 @@ fn in_scene(store: &GoldenStore, case: &Case) -> Result<Vec<Orphan>, GoldenError
                 OrphanKind::RecordWithoutGolden { pass: pass.clone() },
             ));
         }
+    }
+    if unrecorded_goldens > 0 {
+        orphans.push(orphan(
+            store.record_path(scene),
+            OrphanKind::RecordsLost {
+                goldens: unrecorded_goldens,
+            },
+        ));
     }
     Ok(orphans)
 }
@@ -194,6 +231,10 @@ pub fn prune(
             _ => None,
         };
         for orphan in orphans.iter().filter(|o| o.scene.as_deref() == scene) {
+            if !orphan.kind.prunable() {
+                lines.push(format!("kept: {orphan}"));
+                continue;
+            }
             let remove_error = |e: std::io::Error| GoldenError::Record {
                 path: orphan.path.clone(),
                 message: format!("cannot remove: {e}"),
@@ -217,7 +258,10 @@ pub fn prune(
                     }
                     lines.push(format!("{} {}", verb, orphan.path.display()));
                 }
-                OrphanKind::PassGone | OrphanKind::Unrecorded | OrphanKind::Stray => {
+                OrphanKind::PassGone
+                | OrphanKind::Unrecorded
+                | OrphanKind::Stray
+                | OrphanKind::RecordsLost { .. } => {
                     if !dry_run {
                         if orphan.path.is_dir() {
                             std::fs::remove_dir_all(&orphan.path).map_err(remove_error)?;

@@ -57,6 +57,19 @@ pub enum SuiteError {
         /// The rule error.
         source: RuleError,
     },
+    /// The scene's name is one golden/ keeps for itself (`evidence`, `noise.toml`, ...): its
+    /// goldens would be written among those files, and a prune would remove them.
+    #[error(
+        "{path}: the scene is named `{name}`, which golden/ keeps for itself (golden/{name} \
+         holds no scene's goldens): give the scene another name (`name = \"...\"` in the file, \
+         or rename the file)"
+    )]
+    ReservedName {
+        /// Scene file.
+        path: PathBuf,
+        /// The name.
+        name: String,
+    },
     /// `[tolerances]` names a pass the scene has no golden for.
     #[error(
         "{path}: [tolerances.{pass}]: the scene has no golden pass `{pass}` (it has: {known})"
@@ -131,6 +144,12 @@ impl Case {
 
     /// [`Case::load_with`] of a scene already loaded.
     pub fn from_loaded(mut loaded: LoadedScene, model: &NoiseModel) -> Result<Case, SuiteError> {
+        if crate::golden::orphans::TOP_LEVEL.contains(&loaded.scene.name.as_str()) {
+            return Err(SuiteError::ReservedName {
+                path: loaded.path.clone(),
+                name: loaded.scene.name.clone(),
+            });
+        }
         let inputs = crate::golden::scene_inputs::SceneInputs::of(&loaded);
         // A shadowed light's shadow term is where a shadow change first shows: golden renders
         // read it back (a full-screen pass per shadowed light).

@@ -461,7 +461,8 @@ pub fn moved_here_notes(checks: &[SpeedCheck]) -> Vec<String> {
                  host (or by a model that did not yet record where)"
             };
             let measure = crate::golden::command_line::harness_command(&format!(
-                "noise --timing --write --scene {scene}"
+                "noise --timing --write {}",
+                crate::golden::command_line::scene_flag(scene)
             ));
             format!(
                 "{scene}'s timing goldens on {} were blessed on this host, but {whose}, so they \

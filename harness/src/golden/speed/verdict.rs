@@ -327,8 +327,10 @@ pub fn check_speed_with(
             }
             _ => SpeedOutcome::Untimed(format!(
                 "no timing noise measured for {} on {} (measure it with `harness noise \
-                 --timing --write --scene {}` on the host that blessed its timing goldens)",
-                pass.pass, probe.backend, probe.scene
+                 --timing --write {}` on the host that blessed its timing goldens)",
+                pass.pass,
+                probe.backend,
+                crate::golden::command_line::scene_flag(&probe.scene)
             )),
         };
         checks.push(SpeedCheck {

@@ -190,3 +190,57 @@ fn a_scene_file_elsewhere_keeps_its_golden_folder() {
     bless(&lock, TargetId::Final, None);
     assert_eq!(store.scene_file("pyramid").unwrap(), None);
 }
+
+/// A scene folder whose blessed.toml is missing or empty lost its records, not its goldens: the
+/// orphans say so once (with how to restore them), and a prune keeps every golden.
+#[test]
+fn a_prune_keeps_goldens_whose_records_were_lost() {
+    use harness::golden::orphans::{find, prune, OrphanKind};
+    use harness::golden::suite::Case;
+    let workspace = tempfile::tempdir().unwrap();
+    let store = GoldenStore::new(workspace.path().join("golden"));
+    let from = harness::golden::GoldenStore::workspace()
+        .root()
+        .join("arrow");
+    let dir = store.root().join("arrow");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut goldens = 0;
+    for entry in std::fs::read_dir(&from).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|x| x == "png" || x == "exr") {
+            std::fs::copy(&path, dir.join(path.file_name().unwrap())).unwrap();
+            goldens += 1;
+        }
+    }
+    let case = Case::load("arrow").unwrap();
+    for records in [None, Some("")] {
+        if let Some(text) = records {
+            std::fs::write(dir.join("blessed.toml"), text).unwrap();
+        }
+        let orphans = find(&store, std::slice::from_ref(&case), None).unwrap();
+        assert!(
+            orphans.len() == 1
+                && orphans[0].kind == OrphanKind::RecordsLost { goldens }
+                && !orphans[0].kind.prunable(),
+            "{orphans:?}"
+        );
+        let text = orphans[0].to_string();
+        assert!(
+            text.contains("git checkout -- ") && text.contains("bless --scene arrow --every-pass"),
+            "{text}"
+        );
+        let lines = prune(&store, &orphans, false, |_| {}).unwrap();
+        assert!(
+            lines.len() == 1 && lines[0].starts_with("kept: "),
+            "{lines:?}"
+        );
+        let left = std::fs::read_dir(&dir)
+            .unwrap()
+            .filter(|e| {
+                let path = e.as_ref().unwrap().path();
+                path.extension().is_some_and(|x| x == "png" || x == "exr")
+            })
+            .count();
+        assert_eq!(left, goldens);
+    }
+}

@@ -85,6 +85,35 @@ fn a_scene_files_tolerances_are_read_and_flip_is_refused_on_a_float_pass() {
     );
 }
 
+/// A scene named as one of golden/'s own entries (`evidence`, which holds other hosts'
+/// recordings) is refused when it loads: its goldens would land among them, and a prune would
+/// take the recordings for a pass that is gone.
+#[test]
+fn a_scene_may_not_be_named_as_goldens_own_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let arrow = arrow_with(dir.path(), "");
+    let text = std::fs::read_to_string(&arrow).unwrap();
+    for name in ["evidence", "noise.toml"] {
+        let path = dir.path().join("named.toml");
+        std::fs::write(&path, format!("name = \"{name}\"\n{text}")).unwrap();
+        let error = Case::load(path.to_str().unwrap()).err().unwrap();
+        let text = error.to_string();
+        assert!(
+            matches!(error, SuiteError::ReservedName { .. })
+                && text.contains("named.toml")
+                && text.contains(&format!("named `{name}`")),
+            "{text}"
+        );
+    }
+    // A file named so, without a name of its own, is named by its stem.
+    let path = dir.path().join("evidence.toml");
+    std::fs::write(&path, &text).unwrap();
+    assert!(matches!(
+        Case::load(path.to_str().unwrap()),
+        Err(SuiteError::ReservedName { .. })
+    ));
+}
+
 /// A scene without figures of its own borrows each pass's largest limit as a number of pixels:
 /// corner's 30 pixels at 256x256 (a fraction of 4.58e-4) are 30 pixels of a 512x512 G-buffer
 /// target (1.15e-4), not 120; chess's light, 147 pixels at 512x512, is the light's largest.
@@ -112,4 +141,18 @@ fn a_borrowed_limit_keeps_its_pixel_count() {
         metric: Metric::FlipMean,
         limit: 0.0208
     }));
+}
+
+/// A printed command names a scene so that a shell and the argument parser read it back: quoted
+/// where needed, and as `--scene=-x` where it begins with a dash (`--scene -x` reads as a flag).
+#[test]
+fn printed_commands_name_any_scene_so_it_reads_back() {
+    use harness::golden::command_line::{bless_command, scene_flag};
+    assert_eq!(scene_flag("chess"), "--scene chess");
+    assert_eq!(scene_flag("-dash"), "--scene=-dash");
+    assert_eq!(
+        scene_flag("my scenes/a b.toml"),
+        "--scene 'my scenes/a b.toml'"
+    );
+    assert!(bless_command("-dash").ends_with("bless --scene=-dash"));
 }
