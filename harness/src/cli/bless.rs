@@ -168,6 +168,15 @@ pub(crate) fn run(
         })?;
         locks.insert(name.to_owned(), lock);
     }
+    // Before anything is written: what would stop the bless half-way through a scene.
+    for case in &cases {
+        if options.images {
+            harness::golden::bless::preflight(&store, case)?;
+        }
+        if options.speed {
+            harness::golden::speed::TimingGoldens::load(store.root(), case.name())?;
+        }
+    }
     let mut refused = 0;
     if options.images {
         refused = bless_images(&cases, &store, &locks, passes, kind, &options)?;

@@ -177,14 +177,36 @@ pub fn candidates(
         .collect())
 }
 
-/// The output the check kept of `candidate`'s pass, refused (an error line) when the check kept
-/// none or its golden changed after the check (saying so when the golden is now that output:
-/// accepted already).
-pub fn kept_output(candidate: &Candidate) -> Result<engine::Image, String> {
+/// Why the output a check kept of a pass is not accepted ([`kept_output`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum NotKept {
+    /// The pass's golden was written after the check (accepted already, or overtaken): this
+    /// pass is left out, the scene's others are accepted.
+    Settled(String),
+    /// The check kept none, or it cannot be read, or it is not the pass's size or kind: the
+    /// check's outputs of the scene are not whole, so nothing of it is accepted.
+    Unusable(String),
+}
+
+impl std::fmt::Display for NotKept {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NotKept::Settled(why) | NotKept::Unusable(why) => f.write_str(why),
+        }
+    }
+}
+
+/// The output the check kept of `candidate`'s pass of `case`, or why not: the check kept none,
+/// or it is unreadable or not the size and kind of the pass's target ([`NotKept::Unusable`]),
+/// or the golden changed after the check, saying so when the golden is now that output
+/// (accepted already; [`NotKept::Settled`]).
+pub fn kept_output(candidate: &Candidate, case: &Case) -> Result<engine::Image, NotKept> {
     let check = &candidate.check;
     let name = format!("{}/{} ({})", check.scene, check.pass, check.backend);
     let Some(actual) = &check.artifacts.actual else {
-        return Err(format!("{name}: the check kept no output to accept"));
+        return Err(NotKept::Unusable(format!(
+            "{name}: the check kept no output to accept"
+        )));
     };
     let golden_changed = std::fs::metadata(&check.golden_path)
         .and_then(|m| m.modified())
@@ -195,7 +217,7 @@ pub fn kept_output(candidate: &Candidate) -> Result<engine::Image, String> {
             .ok()
             .zip(read_output(&check.golden_path).ok())
             .is_some_and(|(kept, golden)| kept == golden);
-        return Err(if accepted {
+        return Err(NotKept::Settled(if accepted {
             format!(
                 "{name}: already accepted: {} is the output the last check kept",
                 check.golden_path.display()
@@ -205,9 +227,37 @@ pub fn kept_output(candidate: &Candidate) -> Result<engine::Image, String> {
                 "{name}: {} changed after the last check; run `harness check` again",
                 check.golden_path.display()
             )
-        });
+        }));
     }
-    read_output(actual).map_err(|e| format!("{name}: {e}"))
+    let image = read_output(actual).map_err(|e| NotKept::Unusable(format!("{name}: {e}")))?;
+    let expected = case.target(check.pass).map(|t| (t.width, t.height));
+    if expected != Some((image.width, image.height))
+        || crate::golden::is_eight_bit(&image) != case.is_eight_bit(check.pass)
+    {
+        return Err(NotKept::Unusable(format!(
+            "{name}: {} is {}x{} {}, where the pass renders {}",
+            actual.display(),
+            image.width,
+            image.height,
+            if crate::golden::is_eight_bit(&image) {
+                "8-bit"
+            } else {
+                "float"
+            },
+            case.target(check.pass)
+                .map_or("nothing".to_owned(), |t| format!(
+                    "{}x{} {}",
+                    t.width,
+                    t.height,
+                    if case.is_eight_bit(check.pass) {
+                        "8-bit"
+                    } else {
+                        "float"
+                    }
+                ))
+        )));
+    }
+    Ok(image)
 }
 
 /// Accepts `image`, the output the last check kept of `candidate`'s pass of `case`
@@ -397,12 +447,24 @@ pub fn accept_scene(
     }
     let mut done = SceneAcceptance::default();
     let mut kept = Vec::new();
+    let mut unusable = Vec::new();
     for &candidate in candidates {
-        match kept_output(candidate) {
+        match kept_output(candidate, case) {
             Ok(image) => kept.push((candidate, image)),
-            Err(why) => done.refused.push((candidate.check.pass, why)),
+            Err(NotKept::Settled(why)) => done.refused.push((candidate.check.pass, why)),
+            Err(NotKept::Unusable(why)) => unusable.push(why),
         }
     }
+    // A scene's passes are accepted together or not at all: its light without its final
+    // would leave goldens of two different pictures.
+    if !unusable.is_empty() {
+        return Err(format!(
+            "{}: nothing of it accepted, as the check's outputs of it are not whole: {}",
+            case.name(),
+            unusable.join("; ")
+        ));
+    }
+    crate::golden::bless::preflight(store, case).map_err(|e| e.to_string())?;
     if !options.dry_run && !options.unverified && !kept.is_empty() {
         if let Some(recorded) = recorded_verification(store, case, &kept) {
             done.verified_by_check = true;

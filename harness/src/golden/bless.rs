@@ -242,3 +242,25 @@ pub fn bless_change(
         },
     }
 }
+
+/// What a bless of `case` can see before it writes anything, so that it does not stop half-way
+/// through a scene for it: blessed.toml must read (it is rewritten with each pass), and no
+/// golden's path (in either format) may be a folder. Checked for every scene before any is
+/// written.
+pub fn preflight(store: &GoldenStore, case: &Case) -> Result<(), GoldenError> {
+    store.records(case.name())?;
+    for &pass in &case.passes {
+        for eight_bit in [true, false] {
+            let path = store.path(case.name(), pass, eight_bit);
+            if path.is_dir() {
+                return Err(GoldenError::Record {
+                    message: "is a folder where the golden of a pass belongs: nothing blessed \
+                              (move it away)"
+                        .to_owned(),
+                    path,
+                });
+            }
+        }
+    }
+    Ok(())
+}

@@ -375,6 +375,9 @@ impl GoldenStore {
                 });
             }
         }
+        // Read first: a blessed.toml that does not read must stop the bless before the golden
+        // is written, not after (a golden no record says anything of).
+        let mut records = self.records(scene)?;
         let eight_bit = is_eight_bit(image);
         let path = self.path(scene, pass, eight_bit);
         images::write_image(image, &path, images::FileCompression::Balanced)?;
@@ -383,7 +386,6 @@ impl GoldenStore {
         if stale.exists() {
             let _ = std::fs::remove_file(stale);
         }
-        let mut records = self.records(scene)?;
         records.insert(
             pass.to_string(),
             BlessRecord {

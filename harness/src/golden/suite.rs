@@ -252,6 +252,11 @@ impl Case {
         scene_argument(&self.loaded.path)
     }
 
+    /// The target a golden pass renders to (None for a pass the scene does not have).
+    pub fn target(&self, pass: TargetId) -> Option<&TargetSpec> {
+        self.targets.get(&pass)
+    }
+
     /// Pixels of a pass's output (0 for an unknown pass).
     pub fn pixels(&self, pass: TargetId) -> usize {
         self.targets

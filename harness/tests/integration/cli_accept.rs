@@ -445,3 +445,96 @@ fn a_speed_only_bless_that_keeps_another_hosts_goldens_fails() {
     assert!(!stderr.contains("probe 1 of"), "{stderr}");
     assert_eq!(std::fs::read_to_string(&timing).unwrap(), elsewhere);
 }
+
+/// A scene's kept outputs are accepted together or not at all: with one of them gone, or one
+/// that is not the size of its pass (accepted unverified, nothing else would notice), the
+/// accept refuses the scene, naming the file, and writes none of its goldens.
+#[test]
+fn an_accept_with_a_kept_output_missing_or_misfit_writes_none_of_the_scene() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    let scene = root.path().join("scenes/corner.toml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(text.contains("exposure = 1.0\n"), "{text}");
+    std::fs::write(&scene, text.replace("exposure = 1.0\n", "exposure = 1.7\n")).unwrap();
+    let out = root.path().join("out");
+    let run = |args: &[&str]| {
+        common::harness_command()
+            .args(args)
+            .arg("--out")
+            .arg(&out)
+            .env("HARNESS_ROOT", root.path())
+            .output()
+            .unwrap()
+    };
+    let checked = run(&[
+        "check",
+        "--scene",
+        "corner",
+        "--backend",
+        "gl",
+        "--no-speed",
+        "--no-verify",
+    ]);
+    assert_eq!(checked.status.code(), Some(1));
+    let kept = out.join("failures/corner/gl");
+    let mut outputs: Vec<_> = std::fs::read_dir(&kept)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            p.file_stem()
+                .is_some_and(|s| s.to_string_lossy().ends_with("_actual"))
+        })
+        .collect();
+    outputs.sort();
+    assert!(outputs.len() >= 2, "{outputs:?}");
+    let golden = root.path().join("golden/corner");
+    let before = super::cli_bless::snapshot(&golden);
+    let accept = || {
+        run(&[
+            "bless",
+            "--from-last-check",
+            "--no-speed",
+            "--unverified",
+            "--backend",
+            "gl",
+        ])
+    };
+    let tiny = engine::Image {
+        width: 4,
+        height: 4,
+        format: engine::backend::TextureFormat::Rgba8Unorm,
+        data: engine::ImageData::U8(vec![128; 64]),
+    };
+    let png = outputs
+        .iter()
+        .find(|p| p.extension().is_some_and(|x| x == "png"))
+        .expect("an 8-bit output kept")
+        .clone();
+    let saved = std::fs::read(&png).unwrap();
+    harness::images::write_image(&tiny, &png, harness::images::FileCompression::Fast).unwrap();
+    let misfit = accept();
+    let stdout = String::from_utf8_lossy(&misfit.stdout);
+    assert_eq!(misfit.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("REFUSED corner: nothing of it accepted")
+            && stdout.contains("is 4x4 8-bit, where the pass renders"),
+        "{stdout}"
+    );
+    std::fs::write(&png, saved).unwrap();
+    let gone = outputs.last().unwrap();
+    std::fs::remove_file(gone).unwrap();
+    let missing = accept();
+    let stdout = String::from_utf8_lossy(&missing.stdout);
+    assert_eq!(missing.status.code(), Some(1), "{stdout}");
+    let name = gone.file_name().unwrap().to_string_lossy().into_owned();
+    assert!(
+        stdout.contains("REFUSED corner: nothing of it accepted") && stdout.contains(&name),
+        "{stdout}"
+    );
+    let after = super::cli_bless::snapshot(&golden);
+    let changed = super::cli_bless::changed_files(&golden, &before, &after);
+    assert!(changed.is_empty(), "{changed:?}");
+}

@@ -360,3 +360,85 @@ fn verified_bless_refuses_a_golden_only_one_backend_renders() {
     assert!(stdout.contains("nothing written"), "{stdout}");
     assert_eq!(crate::cli_bless::snapshot(&golden), before);
 }
+
+/// A bless that would stop half-way through a scene stops before it writes anything: a
+/// blessed.toml that does not read, a folder where a golden belongs, a timing.toml that does
+/// not read. Each names the file; the scene's goldens are as they were.
+#[test]
+fn a_bless_that_cannot_finish_a_scene_writes_none_of_it() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    // A change every pass from the light on shows: several goldens to write.
+    let scene = root.path().join("scenes/corner.toml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(text.contains("exposure = 1.0\n"), "{text}");
+    std::fs::write(&scene, text.replace("exposure = 1.0\n", "exposure = 1.7\n")).unwrap();
+    let golden = root.path().join("golden/corner");
+    let bless = |args: &[&str]| {
+        common::harness_command()
+            .args(["bless", "--scene", "corner", "--unverified"])
+            .args(args)
+            .env("HARNESS_ROOT", root.path())
+            .output()
+            .unwrap()
+    };
+    // The file, how to break it and mend it, and the bless's flags.
+    type Fault<'a> = (&'a str, &'a dyn Fn(), &'a dyn Fn(), &'a [&'a str]);
+    let faults: [Fault; 3] = [
+        (
+            "blessed.toml",
+            &|| {
+                let path = golden.join("blessed.toml");
+                let mut text = std::fs::read_to_string(&path).unwrap();
+                text.push_str("\noops = \n");
+                std::fs::write(path, text).unwrap();
+            },
+            &|| {
+                let path = golden.join("blessed.toml");
+                let text = std::fs::read_to_string(&path).unwrap();
+                std::fs::write(path, text.replace("\noops = \n", "")).unwrap();
+            },
+            &["--no-speed"],
+        ),
+        (
+            "final.exr",
+            &|| std::fs::create_dir(golden.join("final.exr")).unwrap(),
+            &|| std::fs::remove_dir(golden.join("final.exr")).unwrap(),
+            &["--no-speed"],
+        ),
+        (
+            "timing.toml",
+            &|| {
+                let path = golden.join("timing.toml");
+                let mut text = std::fs::read_to_string(&path).unwrap();
+                text.push_str("\n[[[\n");
+                std::fs::write(path, text).unwrap();
+            },
+            &|| {
+                let path = golden.join("timing.toml");
+                let text = std::fs::read_to_string(&path).unwrap();
+                std::fs::write(path, text.replace("\n[[[\n", "")).unwrap();
+            },
+            &[],
+        ),
+    ];
+    for (file, break_it, mend_it, args) in faults {
+        break_it();
+        let before = super::cli_bless::snapshot(&golden);
+        let output = bless(args);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{file}: {stderr}");
+        assert!(stderr.contains(file), "{file}: {stderr}");
+        let after = super::cli_bless::snapshot(&golden);
+        let changed = super::cli_bless::changed_files(&golden, &before, &after);
+        assert!(changed.is_empty(), "{file}: {changed:?} written");
+        mend_it();
+    }
+    // Mended, the same bless writes the change.
+    let output = bless(&["--no-speed"]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}");
+    assert!(stdout.contains("wrote "), "{stdout}");
+}
