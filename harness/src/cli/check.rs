@@ -272,16 +272,17 @@ pub(crate) fn finish(
 /// `harness report --merge DIR...`: the shards' runs joined into one, written under `out` like a
 /// check's (page, last-check.json, and the JUnit and summary `options` asks for).
 pub(crate) fn merge(shards: &[PathBuf], out: &Path, options: &Options) -> anyhow::Result<ExitCode> {
-    let (run, outputs) = harness::golden::merge::merge(shards)?;
+    let (run, outputs) = harness::golden::merge::merge(shards, out)?;
     let store = harness::golden::GoldenStore::workspace();
-    // The failure images stay in the shards' folders: those that have any.
-    let failures: Vec<String> = shards
-        .iter()
-        .map(|s| s.join("failures"))
-        .filter(|f| f.is_dir())
-        .map(|f| f.display().to_string())
-        .collect();
-    finish(&run, &outputs, &store, out, &failures.join(", "), options)
+    let failures = out.join("failures");
+    finish(
+        &run,
+        &outputs,
+        &store,
+        out,
+        &failures.display().to_string(),
+        options,
+    )
 }
 
 /// Notes on stderr each scene whose limits are borrowed from the canonical scenes (or a

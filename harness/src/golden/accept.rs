@@ -129,7 +129,17 @@ fn last_check(out: &Path) -> Result<(CheckRun, SystemTime), AcceptError> {
     let checked_at = std::fs::metadata(&path)
         .and_then(|m| m.modified())
         .map_err(|e| error(e.to_string()))?;
-    let run = serde_json::from_slice(&bytes).map_err(|e| error(e.to_string()))?;
+    let mut run: CheckRun = serde_json::from_slice(&bytes).map_err(|e| error(e.to_string()))?;
+    // Paths as the check's machine wrote them: its kept outputs are read from this folder's
+    // copies (a CI job's `out`, downloaded), and the goldens are this workspace's, which an
+    // accept writes.
+    let goldens = crate::golden::GoldenStore::workspace();
+    for result in &mut run.results {
+        crate::golden::merge::rebase(&mut result.artifacts, out);
+        if let Some(file) = result.golden_path.file_name() {
+            result.golden_path = goldens.root().join(&result.scene).join(file);
+        }
+    }
     Ok((run, checked_at))
 }
 

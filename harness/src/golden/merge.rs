@@ -1,9 +1,10 @@
 //! Sharded checks joined: `harness check --scene S --out DIR` on several CI jobs, each leaving its
 //! `last-check.json` and `failures/` in its DIR; `harness report --merge DIR... --out OUT` joins
 //! them into one run (one page, one JUnit file, one summary, and a `last-check.json` that
-//! `bless --from-last-check` and `harness review` accept from). The failure images stay in the
-//! shards' folders: a path recorded on the job that wrote it is looked up again under the
-//! folder it was downloaded to (`<DIR>/failures/<scene>/<backend>/<file>`).
+//! `bless --from-last-check` and `harness review` accept from). The failure images are copied
+//! into OUT's `failures/` (a path recorded on the job that wrote it is looked up again under the
+//! folder it was downloaded to, `<DIR>/failures/<scene>/<backend>/<file>`), so the joined folder
+//! stands alone: its page links them beside it, and `harness review` serves them.
 
 use std::path::{Path, PathBuf};
 
@@ -22,6 +23,22 @@ pub enum MergeError {
         /// What went wrong.
         message: String,
     },
+    /// The joined run would be written into one of the shards, over its own results.
+    #[error("{out} is one of the shards: write the joined run to a folder of its own")]
+    OutIsShard {
+        /// The folder.
+        out: PathBuf,
+    },
+    /// A failure image could not be copied into the joined folder.
+    #[error("{from}: cannot copy it to {to}: {message}")]
+    Copy {
+        /// The shard's file.
+        from: PathBuf,
+        /// Where it was going.
+        to: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
     /// Two shards checked the same scene on the same backend.
     #[error("{scene} on {backend} is in two shards ({first} and {second}): shard by scene")]
     Overlap {
@@ -36,9 +53,19 @@ pub enum MergeError {
     },
 }
 
-/// The runs under `shards` as one, with the outputs of its failing passes read back from the
-/// shards' failure images (for the page's viewers).
-pub fn merge(shards: &[PathBuf]) -> Result<(CheckRun, Outputs), MergeError> {
+/// The runs under `shards` as one, to be written to `out` (not one of them): their failure
+/// images copied into `out/failures/`, and the outputs of its failing passes read back from them
+/// (for the page's viewers).
+pub fn merge(shards: &[PathBuf], out: &Path) -> Result<(CheckRun, Outputs), MergeError> {
+    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => a == b,
+    };
+    if shards.iter().any(|shard| same(shard, out)) {
+        return Err(MergeError::OutIsShard {
+            out: out.to_owned(),
+        });
+    }
     let mut merged = CheckRun::default();
     let mut owner: Vec<(String, String, PathBuf)> = Vec::new();
     let mut disputed: Vec<engine::backend::BackendKind> = Vec::new();
@@ -128,6 +155,9 @@ pub fn merge(shards: &[PathBuf]) -> Result<(CheckRun, Outputs), MergeError> {
     for backend in disputed {
         merged.speed.recorded_as.remove(&backend);
     }
+    for r in &mut merged.results {
+        gather(&mut r.artifacts, out)?;
+    }
     let mut outputs = Outputs::new();
     for r in merged.results.iter().filter(|r| !r.outcome.passed()) {
         let Some(actual) = &r.artifacts.actual else {
@@ -145,9 +175,9 @@ pub fn merge(shards: &[PathBuf]) -> Result<(CheckRun, Outputs), MergeError> {
     Ok((merged, outputs))
 }
 
-/// Points `artifacts` recorded on another machine at the copies under `dir`: a path that does
-/// not exist is looked up as `<dir>/failures/<scene>/<backend>/<file>` (its last three parts).
-fn rebase(artifacts: &mut Artifacts, dir: &Path) {
+/// Copies the files of `artifacts` (each as `<shard>/failures/<scene>/<backend>/<file>`) to the
+/// same place under `out`, and points them there.
+fn gather(artifacts: &mut Artifacts, out: &Path) -> Result<(), MergeError> {
     for path in [
         &mut artifacts.actual,
         &mut artifacts.golden,
@@ -156,15 +186,47 @@ fn rebase(artifacts: &mut Artifacts, dir: &Path) {
     .into_iter()
     .flatten()
     {
-        if path.exists() {
+        let parts: Vec<_> = path.iter().collect();
+        if parts.len() < 3 || !path.exists() {
             continue;
         }
+        let tail: PathBuf = parts[parts.len() - 3..].iter().collect();
+        let to = out.join("failures").join(tail);
+        let copy = || -> std::io::Result<()> {
+            if let Some(dir) = to.parent() {
+                std::fs::create_dir_all(dir)?;
+            }
+            std::fs::copy(&*path, &to).map(|_| ())
+        };
+        copy().map_err(|e| MergeError::Copy {
+            from: path.clone(),
+            to: to.clone(),
+            message: e.to_string(),
+        })?;
+        *path = to;
+    }
+    Ok(())
+}
+
+/// Points `artifacts` recorded in another place (another machine's job, a folder since moved)
+/// at the copies under `dir`, the folder `check --out` wrote them to as it is here: each path is
+/// looked up as `<dir>/failures/<scene>/<backend>/<file>` (its last three parts), and kept as
+/// recorded where there is no such copy.
+pub(crate) fn rebase(artifacts: &mut Artifacts, dir: &Path) {
+    for path in [
+        &mut artifacts.actual,
+        &mut artifacts.golden,
+        &mut artifacts.diff,
+    ]
+    .into_iter()
+    .flatten()
+    {
         let parts: Vec<_> = path.iter().collect();
         if parts.len() >= 3 {
             let tail: PathBuf = parts[parts.len() - 3..].iter().collect();
-            let moved = dir.join("failures").join(tail);
-            if moved.exists() {
-                *path = moved;
+            let here = dir.join("failures").join(tail);
+            if here.exists() {
+                *path = here;
             }
         }
     }

@@ -180,11 +180,48 @@ impl Review {
                     }
                 }
             }
-            _ => tiny_http::Response::from_string("not found\n")
-                .with_status_code(404)
-                .boxed(),
+            (tiny_http::Method::Get, path) if path.starts_with("/failures/") => {
+                self.failure_file(path)
+            }
+            _ => not_found(),
         };
         let _ = request.respond(response);
+    }
+
+    /// A file the page links under `failures/` (the check's kept outputs, goldens and
+    /// differences), read from the check's folder; anything outside it is not found. Served
+    /// without the token, as the page's links carry none: the same files are on this machine's
+    /// disk, and the Host check keeps other sites' pages from reading them.
+    fn failure_file(&self, url_path: &str) -> tiny_http::ResponseBox {
+        let Some(relative) = percent_decoded(url_path.trim_start_matches('/')) else {
+            return not_found();
+        };
+        let relative = std::path::Path::new(&relative);
+        let plain = relative
+            .components()
+            .all(|c| matches!(c, std::path::Component::Normal(_)));
+        let root = self.out.join("failures");
+        let file = self.out.join(relative);
+        let inside = match (file.canonicalize(), root.canonicalize()) {
+            (Ok(file), Ok(root)) => file.starts_with(root) && file.is_file(),
+            _ => false,
+        };
+        if !plain || !inside {
+            return not_found();
+        }
+        let Ok(bytes) = std::fs::read(&file) else {
+            return not_found();
+        };
+        let kind = if file.extension().is_some_and(|x| x == "png") {
+            "image/png"
+        } else {
+            "application/octet-stream"
+        };
+        let mut response = tiny_http::Response::from_data(bytes);
+        if let Ok(header) = tiny_http::Header::from_bytes("Content-Type", kind) {
+            response.add_header(header);
+        }
+        response.boxed()
     }
 
     /// The review page with the token, what was accepted, and the Accept script.
@@ -398,4 +435,29 @@ fn token() -> std::io::Result<String> {
     let mut bytes = [0u8; 16];
     std::fs::File::open("/dev/urandom")?.read_exact(&mut bytes)?;
     Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())
+}
+
+fn not_found() -> tiny_http::ResponseBox {
+    tiny_http::Response::from_string("not found\n")
+        .with_status_code(404)
+        .boxed()
+}
+
+/// `text` with its `%XX` escapes decoded (a URL's path), or None where one is malformed or the
+/// result is not UTF-8.
+fn percent_decoded(text: &str) -> Option<String> {
+    let bytes = text.as_bytes();
+    let mut decoded = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
+            decoded.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            decoded.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(decoded).ok()
 }

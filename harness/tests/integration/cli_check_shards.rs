@@ -1,5 +1,6 @@
 //! `check` split into shards (`--scene` per job, each with its own `--out`) and joined by
-//! `report --merge`: one run equal to the unsharded check.
+//! `report --merge`: one run equal to the unsharded check; and a job's `out` folder accepted
+//! from in another checkout, as a CI artifact is.
 
 use crate::common;
 
@@ -71,8 +72,8 @@ fn sharded_checks_merge_into_one_report() {
         merged.join("summary.md").to_str().unwrap(),
     ]);
     assert_eq!(code, Some(1), "{text}");
-    // The failure images are where they are: the failing shard's folder, not the passing ones'.
-    let failures = format!("failure images: {}", arrow.join("failures").display());
+    // The failure images are copied beside the joined page, which then stands alone.
+    let failures = format!("failure images: {}", merged.join("failures").display());
     assert!(text.lines().any(|l| l == failures), "{text}");
     let whole = root.path().join("unsharded");
     let (code, whole_text) = run(&[
@@ -139,6 +140,10 @@ fn sharded_checks_merge_into_one_report() {
     assert_eq!(report.failures, 2, "{text}");
     let page = std::fs::read_to_string(merged.join("report.html")).unwrap();
     assert!(page.contains("data-scene=\"corner\"") && page.contains("id=\"case-arrow-light\""));
+    // Its links are to the copies beside it, which travel with the folder.
+    assert!(!page.contains("file://"));
+    assert!(page.contains("href=\"failures/arrow/gl/light_actual.exr\""));
+    assert!(merged.join("failures/arrow/gl/light_actual.exr").is_file());
     let (code, text) = run(&[
         "bless",
         "--from-last-check",
@@ -158,6 +163,15 @@ fn sharded_checks_merge_into_one_report() {
 
     // Only there to overlap: not verified.
     let (_, _, again) = shard_with("arrow", "shard-arrow-again", false);
+    refuses_overlapping_shards(&run, &arrow, &again);
+}
+
+/// The harness run in the test's workspace: its exit code and its output.
+type Run<'a> = &'a dyn Fn(&[&str]) -> (Option<i32>, String);
+
+/// A scene checked in two shards, a shard given twice, and a joined run written into one of
+/// its shards (over that shard's own run) are refused.
+fn refuses_overlapping_shards(run: Run, arrow: &std::path::Path, again: &std::path::Path) {
     let twice = [arrow.to_str().unwrap(), again.to_str().unwrap()];
     let (code, text) = run(&[&["report", "--merge"][..], &twice].concat());
     assert_eq!(code, Some(1), "{text}");
@@ -165,6 +179,14 @@ fn sharded_checks_merge_into_one_report() {
     let (code, text) = run(&["report", "--merge", twice[0], twice[0]]);
     assert_eq!(code, Some(1), "{text}");
     assert!(text.contains("given twice"), "{text}");
+    let before = std::fs::read(arrow.join("last-check.json")).unwrap();
+    let (code, text) = run(&["report", "--merge", twice[0], "--out", twice[0]]);
+    assert_eq!(code, Some(1), "{text}");
+    assert!(text.contains("is one of the shards"), "{text}");
+    assert_eq!(
+        std::fs::read(arrow.join("last-check.json")).unwrap(),
+        before
+    );
 }
 
 /// `xml` without the attributes named (` name="..."`): JUnit's times, which no two runs share.
@@ -179,4 +201,82 @@ fn without_attributes(xml: &str, names: &[&str]) -> String {
         }
     }
     out
+}
+
+/// A CI job's `out` folder, downloaded: its last-check.json names the job's paths, which do not
+/// exist here. Accepting from it in another checkout reads the kept outputs from the download
+/// and writes (and guards) that checkout's goldens, not the paths the job recorded.
+#[test]
+fn a_downloaded_check_is_accepted_in_another_checkout() {
+    if !common::gl_available() {
+        return;
+    }
+    let change = |root: &std::path::Path| {
+        let scene = root.join("scenes/corner.toml");
+        let text = std::fs::read_to_string(&scene).unwrap();
+        assert!(text.contains("exposure = 1.0\n"), "{text}");
+        std::fs::write(&scene, text.replace("exposure = 1.0\n", "exposure = 1.7\n")).unwrap();
+    };
+    let (job, mine) = (common::temp_workspace(), common::temp_workspace());
+    change(job.path());
+    change(mine.path());
+    let job_out = job.path().join("out");
+    let checked = common::harness_command()
+        .args([
+            "check",
+            "--scene",
+            "corner",
+            "--backend",
+            "gl",
+            "--no-speed",
+        ])
+        .arg("--out")
+        .arg(&job_out)
+        .env("HARNESS_ROOT", job.path())
+        .output()
+        .unwrap();
+    assert_eq!(checked.status.code(), Some(1));
+    // Downloaded: the job's folder is gone, its copy is here.
+    let download = mine.path().join("artifact");
+    std::fs::rename(&job_out, &download).unwrap();
+    let recorded = std::fs::read_to_string(download.join("last-check.json")).unwrap();
+    assert!(recorded.contains(&job_out.display().to_string()));
+    let job_goldens = super::cli_bless::snapshot(&job.path().join("golden"));
+    let accepted = common::harness_command()
+        .args([
+            "bless",
+            "--from-last-check",
+            "--no-speed",
+            "--backend",
+            "gl",
+        ])
+        .arg("--out")
+        .arg(&download)
+        .env("HARNESS_ROOT", mine.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&accepted.stdout);
+    let stderr = String::from_utf8_lossy(&accepted.stderr);
+    assert!(accepted.status.success(), "{stdout}{stderr}");
+    let written = format!("wrote {}", mine.path().join("golden/corner").display());
+    assert!(stdout.contains(&written), "{stdout}");
+    let after = super::cli_bless::snapshot(&job.path().join("golden"));
+    let changed = super::cli_bless::changed_files(job.path(), &job_goldens, &after);
+    assert!(changed.is_empty(), "{changed:?}");
+    // Accepted again: this checkout's goldens are the ones rewritten since the check.
+    let again = common::harness_command()
+        .args([
+            "bless",
+            "--from-last-check",
+            "--no-speed",
+            "--backend",
+            "gl",
+        ])
+        .arg("--out")
+        .arg(&download)
+        .env("HARNESS_ROOT", mine.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&again.stdout);
+    assert!(stdout.contains("already accepted"), "{stdout}");
 }

@@ -22,8 +22,10 @@ use crate::common;
 fn send(port: u16, request: &str) -> (u16, String) {
     let mut stream = TcpStream::connect(("127.0.0.1", port)).unwrap();
     stream.write_all(request.as_bytes()).unwrap();
-    let mut answer = String::new();
-    let _ = stream.read_to_string(&mut answer);
+    // Bytes first: a PNG served is no UTF-8 (read_to_string would keep nothing of it).
+    let mut bytes = Vec::new();
+    let _ = stream.read_to_end(&mut bytes);
+    let answer = String::from_utf8_lossy(&bytes).into_owned();
     let code = answer
         .split_whitespace()
         .nth(1)
@@ -161,6 +163,7 @@ fn accepting_a_pass_on_the_review_page_blesses_what_the_check_kept() {
     let server = Server::start(root.path(), &out);
     let (url, port, token) = (server.url.clone(), server.port, server.token.clone());
     refuses_what_the_page_would_not_send(port, &token);
+    serves_the_files_the_page_links(port, &out);
 
     let mut browser = Browser::launch(executable);
     browser.open(&url);
@@ -291,6 +294,41 @@ fn refuses_what_the_page_would_not_send(port: u16, token: &str) {
     );
     assert_eq!(code, 400, "{answer}");
     assert!(answer.contains("unknown field `scen`"), "{answer}");
+}
+
+/// The page's links to the check's failure images resolve on the server (they carry no token);
+/// nothing outside `failures/` does, however the path is spelt.
+fn serves_the_files_the_page_links(port: u16, out: &std::path::Path) {
+    let get = |path: &str| {
+        send(
+            port,
+            &format!("GET {path} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n"),
+        )
+    };
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let linked: Vec<&str> = page
+        .split("href=\"")
+        .skip(1)
+        .filter_map(|rest| rest.split('"').next())
+        .filter(|link| link.starts_with("failures/"))
+        .collect();
+    assert!(linked.iter().any(|l| l.ends_with(".png")), "{linked:?}");
+    for link in linked {
+        let (code, answer) = get(&format!("/{link}"));
+        assert_eq!(code, 200, "{link}: {answer}");
+        if link.ends_with(".png") {
+            assert!(answer.contains("PNG\r\n"), "{link}");
+        }
+    }
+    for outside in [
+        "/failures/../last-check.json",
+        "/failures/%2e%2e/last-check.json",
+        "/failures/arrow/../../report.html",
+        "/failures/",
+        "/last-check.json",
+    ] {
+        assert_eq!(get(outside).0, 404, "{outside}");
+    }
 }
 
 /// A CDP expression that waits (up to 2 minutes) until `done` holds of `r` (the element
