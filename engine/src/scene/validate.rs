@@ -29,6 +29,7 @@ fn validate(scene: &Scene) -> Result<(), InvalidScene> {
         check_output_and_camera(scene)?;
         for object in &scene.objects {
             check_object(object, scene.textures.len())?;
+            check_reach(object, scene.camera.position)?;
         }
         for (i, light) in scene.lights.iter().enumerate() {
             check_light(i, light)?;
@@ -136,18 +137,22 @@ fn check_object(object: &Object, texture_count: usize) -> Result<(), String> {
         ));
     }
     let m = &object.material;
-    let scalars = [
-        m.roughness,
-        m.metallic,
-        m.specular,
-        m.anisotropy,
-        m.clearcoat,
-        m.clearcoat_roughness,
-        m.specular_exponent,
+    let [r, g, b] = m.base_color;
+    let named = [
+        ("base color r", r),
+        ("base color g", g),
+        ("base color b", b),
+        ("roughness", m.roughness),
+        ("metallic", m.metallic),
+        ("specular", m.specular),
+        ("anisotropy", m.anisotropy),
+        ("clearcoat", m.clearcoat),
+        ("clearcoat roughness", m.clearcoat_roughness),
+        ("specular exponent", m.specular_exponent),
     ];
-    if !m.base_color.iter().chain(&scalars).all(|v| v.is_finite()) {
+    if let Some((name, value)) = named.iter().find(|(_, v)| !v.is_finite()) {
         return Err(format!(
-            "object `{}`: material has a NaN or infinite parameter",
+            "object `{}`: material {name} is {value}, not a finite number",
             object.name
         ));
     }
@@ -181,6 +186,36 @@ fn check_object(object: &Object, texture_count: usize) -> Result<(), String> {
     {
         return Err(format!(
             "object `{}`: mesh index out of range ({vertex_count} vertices)",
+            object.name
+        ));
+    }
+    Ok(())
+}
+
+/// The farthest an object may reach from the camera: the lighting squares camera-relative
+/// coordinates in 32-bit floats (lengths, dot products), which overflow past about 1.8e19
+/// (the square root of f32's largest value); beyond it an object vanishes or turns black
+/// without a word. 1e18 leaves a margin of 18 for the sums.
+pub const MAX_REACH: f64 = 1e18;
+
+/// An object's vertices, placed by its transform, lie within [`MAX_REACH`] of the camera.
+fn check_reach(object: &Object, camera: DVec3) -> Result<(), String> {
+    let t = &object.transform;
+    let far = object
+        .mesh
+        .vertices
+        .iter()
+        .map(|v| {
+            let local = DVec3::from(v.position.map(f64::from)) * t.scale;
+            (t.translation + t.rotation * local - camera)
+                .abs()
+                .max_element()
+        })
+        .fold(0.0f64, f64::max);
+    if far > MAX_REACH {
+        return Err(format!(
+            "object `{}` reaches {far:.3e} from the camera (its transform or its mesh's \
+             coordinates), beyond {MAX_REACH:e}: the lighting's 32-bit arithmetic overflows there",
             object.name
         ));
     }

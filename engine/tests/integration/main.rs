@@ -11,5 +11,6 @@ mod ibl;
 mod materials;
 mod obj_errors;
 mod scene_files;
+mod scene_values;
 mod tangents;
 mod textures;
