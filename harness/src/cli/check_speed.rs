@@ -48,8 +48,9 @@ pub(super) fn print_speed(run: &CheckRun) {
     let (here, elsewhere) = (faster(true), faster(false));
     if !here.is_empty() {
         println!(
-            "note: faster than their timing goldens beyond the limit (bless if intended, \
-             `harness bless --scene S --speed-only`): {}",
+            "note: faster than their timing goldens beyond the limit (bless if intended, `{}`): \
+             {}",
+            harness::golden::command_line::harness_command("bless --scene S --speed-only"),
             here.join(", ")
         );
     }

@@ -315,9 +315,10 @@ fn blessed_elsewhere(
                 "noise --timing --record-host {name}"
             ))
         ),
-        None => {
-            "or record this host's figures (`harness noise --timing --record-host NAME`)".to_owned()
-        }
+        None => format!(
+            "or record this host's figures (`{}`)",
+            harness::golden::command_line::harness_command("noise --timing --record-host NAME")
+        ),
     };
     Ok(Some((
         why,

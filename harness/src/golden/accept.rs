@@ -234,8 +234,9 @@ pub fn kept_output(candidate: &Candidate, case: &Case) -> Result<engine::Image, 
             )
         } else {
             format!(
-                "{name}: {} changed after the last check; run `harness check` again",
-                check.golden_path.display()
+                "{name}: {} changed after the last check; run `{}` again",
+                check.golden_path.display(),
+                crate::golden::command_line::harness_command("check")
             )
         }));
     }

@@ -214,8 +214,9 @@ pub fn another_hosts_lines(lines: &[SpeedBlessed], arguments: &[(String, String)
     }
     said.push(format!(
         "note: a recorded host blesses a slowdown into another host's timing goldens, scaled by \
-         its own recording (`harness noise --timing --record-host NAME` records this one); to \
-         move them to this host instead, every backend's and every pass: {}",
+         its own recording (`{}` records this one); to move them to this host instead, every \
+         backend's and every pass: {}",
+        crate::golden::command_line::harness_command("noise --timing --record-host NAME"),
         crate::golden::command_line::move_timings_command(&scenes)
     ));
     said

@@ -439,16 +439,19 @@ impl SpeedCoverage {
     }
 }
 
-/// What to do where checks ran at [`Tier::OtherHost`]: record the host, so that its checks
-/// read against its own ratios.
-pub const RECORD_THIS_HOST: &str = "this host is neither the one that blessed the timing \
-    goldens nor a recorded one (by driver fingerprint and CPU signature; goldens that keep no \
-    signature name no host), so its speed checks use limits wide enough for any host, and \
-    catch less. `harness noise --timing --record-host NAME` records it \
-    (golden/evidence/NAME/timing.toml, to commit); its checks then read against its own ratios";
+/// What to do where checks ran at [`Tier::OtherHost`]: record this host (the command as run here).
+pub fn record_this_host() -> String {
+    format!(
+        "this host is neither the one that blessed the timing goldens nor a recorded one (by \
+         driver fingerprint and CPU signature; goldens that keep no signature name no host), so \
+         its speed checks use limits wide enough for any host, and catch less. `{}` records it \
+         (golden/evidence/NAME/timing.toml, to commit); its checks then read its own ratios",
+        crate::golden::command_line::harness_command("noise --timing --record-host NAME")
+    )
+}
 
 /// Where some of `coverage` (with goldens) ran at [`Tier::OtherHost`], the advice every place
-/// that shows the coverage adds under it: [`RECORD_THIS_HOST`] on a host with no recording, or,
+/// that shows the coverage adds under it: [`record_this_host`] on a host with no recording, or,
 /// on a recorded one (`recorded_as`: the recording's host name per backend, as the check found
 /// it, [`super::SpeedRun`]; or, from an older last-check.json, as a pass read against it names
 /// it), that its recording does not hold those passes' goldens as they are (blessed since, or a
@@ -488,7 +491,7 @@ pub fn record_advice(
         .find_map(|(_, n)| n.clone())
         .or_else(any_recording)
     else {
-        return Some(RECORD_THIS_HOST.to_owned());
+        return Some(record_this_host());
     };
     let unrecorded: Vec<BackendKind> = names
         .iter()

@@ -446,7 +446,7 @@ fn coverage_counts_the_timed_and_untimed_passes_per_backend_and_tier() {
 /// the backends it lacks.
 #[test]
 fn the_advice_under_the_coverage_says_whether_to_record_this_host_or_record_it_again() {
-    use harness::golden::speed::verdict::RECORD_THIS_HOST;
+    use harness::golden::speed::verdict::record_this_host;
     use std::collections::BTreeMap;
     use BackendKind::{Gl, WgpuVulkan};
     let mut recorded = covered(Gl, Tier::RecordedHost, SpeedOutcome::Passed, Some(1.69));
@@ -474,7 +474,7 @@ fn the_advice_under_the_coverage_says_whether_to_record_this_host_or_record_it_a
     assert!(older.contains("--record-host host-d`"), "{older}");
     assert_eq!(
         record_advice(&coverage(std::slice::from_ref(&stale)), &nowhere).as_deref(),
-        Some(RECORD_THIS_HOST)
+        Some(record_this_host().as_str())
     );
     // Recorded on gl: whether or not a pass was read against the recording (a new scene's
     // passes alone are not), the advice is to record it again, by its name.
