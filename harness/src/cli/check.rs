@@ -40,6 +40,12 @@ pub(crate) fn run(
     backends: &[BackendKind],
     options: Options,
 ) -> anyhow::Result<ExitCode> {
+    let (junit, summary) = (options.junit.as_deref(), options.summary.as_deref());
+    let unwritable = super::preflight::report_problem(out, junit, summary);
+    if let Some(why) = unwritable.or_else(|| super::preflight::no_scenes(scenes)) {
+        eprintln!("error: {why}; nothing checked");
+        return Ok(ExitCode::from(2));
+    }
     for scene in scenes {
         if let Err(e @ engine::scene_file::SceneFileError::UnknownScene { .. }) =
             engine::scene_file::resolve(scene, &harness::scenes_dir())
@@ -272,6 +278,11 @@ pub(crate) fn finish(
 /// `harness report --merge DIR...`: the shards' runs joined into one, written under `out` like a
 /// check's (page, last-check.json, and the JUnit and summary `options` asks for).
 pub(crate) fn merge(shards: &[PathBuf], out: &Path, options: &Options) -> anyhow::Result<ExitCode> {
+    let (junit, summary) = (options.junit.as_deref(), options.summary.as_deref());
+    if let Some(why) = super::preflight::report_problem(out, junit, summary) {
+        eprintln!("error: {why}; nothing joined");
+        return Ok(ExitCode::from(2));
+    }
     let (run, outputs) = harness::golden::merge::merge(shards, out)?;
     let store = harness::golden::GoldenStore::workspace();
     let failures = out.join("failures");

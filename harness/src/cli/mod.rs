@@ -13,6 +13,7 @@ pub(super) mod info;
 pub(super) mod noise;
 pub(super) mod noise_record;
 pub(super) mod noise_timing;
+pub(super) mod preflight;
 pub(super) mod render;
 pub(super) mod review;
 pub(super) mod selftest;

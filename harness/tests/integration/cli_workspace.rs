@@ -54,6 +54,52 @@ fn unknown_scene_names_list_the_canonical_scenes() {
     );
 }
 
+/// What a check would fail at only after rendering everything is refused first, as a usage
+/// error that writes nothing: `--out` a file, a JUnit or summary file under a file or at a
+/// folder; and a suite with no scene (a mistyped HARNESS_ROOT), which would pass with no check.
+#[test]
+fn a_check_that_cannot_write_or_has_no_scene_is_refused_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, "").unwrap();
+    let file = file.to_str().unwrap();
+    let under = format!("{file}/report.xml");
+    let folder = dir.path().to_str().unwrap();
+    for (args, said) in [
+        (vec!["--out", file], "--out "),
+        (
+            vec!["--junit", under.as_str()],
+            "a-file is a file, not a folder",
+        ),
+        (vec!["--summary", folder], "is a folder, not a file"),
+    ] {
+        let all = [&["check", "--scene", "corner", "--no-speed"][..], &args].concat();
+        let (code, stdout, stderr) = harness(&all);
+        assert_eq!(code, 2, "{args:?}: {stderr}");
+        assert!(
+            stderr.contains(said) && stderr.contains("nothing checked") && stdout.is_empty(),
+            "{args:?}: {stderr}"
+        );
+    }
+    let (code, _, stderr) = harness(&["report", "--merge", folder, "--out", file]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("nothing joined"), "{stderr}");
+    // A workspace with no scene (the root mistyped).
+    let empty = tempfile::tempdir().unwrap();
+    let output = common::harness_command()
+        .args(["check", "--no-speed"])
+        .env("HARNESS_ROOT", empty.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("holds no scene (HARNESS_ROOT is "),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_dir(empty.path()).unwrap().count(), 0);
+}
+
 /// The committed scene assets are exactly what the generator writes, so they can be regenerated.
 #[test]
 fn scene_assets_regenerate_byte_for_byte() {
