@@ -189,7 +189,7 @@ impl DriverInfo {
         let all = format!("{} {} {}", self.api_version, self.renderer, self.driver);
         self.mesa_version = version_after(&all, "Mesa ");
         self.llvm_version = version_after(&all, "LLVM ");
-        self.env = result_env();
+        self.env = result_env(self.backend);
         self
     }
 }
@@ -219,9 +219,25 @@ const RESULT_ENV_PREFIXES: &[&str] = &[
     "WGPU_",
 ];
 
-fn result_env() -> BTreeMap<String, String> {
+/// Of [`RESULT_ENV_PREFIXES`], those that reach only the other kind of backend: the Vulkan
+/// loader's and lavapipe's for the GL backends, EGL's and the GL drivers' for Vulkan, wgpu's
+/// for `gl` (which does not use it). A variable set for one backend is no change of another's
+/// driver (a `gl` fingerprint that named VK_DRIVER_FILES read as a driver change).
+fn reaches_only_others(kind: BackendKind, name: &str) -> bool {
+    let vulkan = ["VK_", "LVP_"];
+    let gl = ["LIBGL_", "__EGL_VENDOR_LIBRARY", "EGL_PLATFORM"];
+    let others: &[&str] = match kind {
+        BackendKind::Gl => &["VK_", "LVP_", "WGPU_"],
+        BackendKind::WgpuGl => &vulkan,
+        BackendKind::WgpuVulkan => &gl,
+    };
+    others.iter().any(|p| name.starts_with(p))
+}
+
+fn result_env(kind: BackendKind) -> BTreeMap<String, String> {
     std::env::vars()
         .filter(|(k, _)| RESULT_ENV_PREFIXES.iter().any(|p| k.starts_with(p)))
+        .filter(|(k, _)| !reaches_only_others(kind, k))
         .collect()
 }
 
@@ -498,5 +514,29 @@ mod tests {
         .complete();
         assert_eq!(info.mesa_version.as_deref(), Some("22.3.6"));
         assert_eq!(info.llvm_version.as_deref(), Some("15.0.6"));
+    }
+
+    /// A variable that points one kind of backend's loader elsewhere is in that kind's
+    /// fingerprint only; Mesa's own (llvmpipe's, under both) are in every one.
+    #[test]
+    fn a_loader_variable_is_in_its_own_backends_fingerprint_only() {
+        use BackendKind::{Gl, WgpuGl, WgpuVulkan};
+        for (name, kinds) in [
+            ("VK_DRIVER_FILES", &[WgpuVulkan][..]),
+            ("LVP_POISON_MEMORY", &[WgpuVulkan]),
+            ("__EGL_VENDOR_LIBRARY_FILENAMES", &[Gl, WgpuGl]),
+            ("LIBGL_DRIVERS_PATH", &[Gl, WgpuGl]),
+            ("WGPU_BACKEND", &[WgpuGl, WgpuVulkan]),
+            ("LP_NUM_THREADS", &[Gl, WgpuGl, WgpuVulkan]),
+            ("GALLIUM_OVERRIDE_CPU_CAPS", &[Gl, WgpuGl, WgpuVulkan]),
+        ] {
+            for kind in BackendKind::ALL {
+                assert_eq!(
+                    !reaches_only_others(kind, name),
+                    kinds.contains(&kind),
+                    "{name} on {kind}"
+                );
+            }
+        }
     }
 }

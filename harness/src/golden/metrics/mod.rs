@@ -100,15 +100,26 @@ pub struct LargestDifference {
     pub difference: f64,
     /// Pixels with any channel different.
     pub differing_pixels: usize,
+    /// The golden's value in that channel (None in results from before it was kept): how
+    /// large the difference is against what it differs from.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub golden: Option<f64>,
 }
 
 impl std::fmt::Display for LargestDifference {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} px differ, the most {:.4e} at ({}, {})",
-            self.differing_pixels, self.difference, self.x, self.y
-        )
+            "{} px differ, the most {:.4e}",
+            self.differing_pixels, self.difference
+        )?;
+        // As a share of the golden's value too: a difference of 3.1 in a light buffer of 78
+        // is 4%, not what the bare number suggests beside a relative limit.
+        if let Some(golden) = self.golden.filter(|g| *g != 0.0 && g.is_finite()) {
+            let percent = 100.0 * self.difference / golden.abs();
+            write!(f, " ({percent:.3}% of the golden's {golden:.4e})")?;
+        }
+        write!(f, " at ({}, {})", self.x, self.y)
     }
 }
 
@@ -279,11 +290,19 @@ impl<'a> Pair<'a> {
             }
         }
         let (index, difference) = worst?;
+        // The channel that differs most there, and the golden's value in it.
+        let at = index * self.channels..(index + 1) * self.channels;
+        let golden = self.actual[at.clone()]
+            .iter()
+            .zip(&self.golden[at])
+            .max_by(|(a, g), (b, h)| (*a - *g).abs().total_cmp(&(*b - *h).abs()))
+            .map(|(_, g)| f64::from(*g));
         Some(LargestDifference {
             x: (index % self.width) as u32,
             y: (index / self.width) as u32,
             difference,
             differing_pixels: differing,
+            golden,
         })
     }
 

@@ -94,6 +94,12 @@ fn largest_difference_says_where_and_how_many() {
         .unwrap();
     assert_eq!((worst.x, worst.y, worst.differing_pixels), (2, 1, 2));
     assert!((worst.difference - 20.0 / 255.0).abs() < 1e-6);
+    // Said against the golden's value in that channel too: 20 of 10 is 200%.
+    assert!((worst.golden.unwrap() - 10.0 / 255.0).abs() < 1e-6);
+    assert_eq!(
+        worst.to_string(),
+        "2 px differ, the most 7.8431e-2 (200.000% of the golden's 3.9216e-2) at (2, 1)"
+    );
     assert_eq!(
         Pair::new(&golden, &golden).unwrap().largest_difference(),
         None
