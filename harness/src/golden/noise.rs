@@ -138,6 +138,16 @@ impl NoiseModel {
                             figures.limit
                         ));
                     }
+                    // A fraction of pixels and a FLIP error lie in 0..1: a limit of 1 or more
+                    // passes every render, a check that cannot fire.
+                    let fraction =
+                        metric.starts_with("fraction_over") || metric.starts_with("flip");
+                    if fraction && figures.limit >= 1.0 {
+                        return Some(format!(
+                            "{key}: limit {} can never be exceeded: the metric lies in 0..1",
+                            figures.limit
+                        ));
+                    }
                     let values = std::iter::once(("resolution", &figures.resolution))
                         .chain(figures.noise.iter().map(|(k, v)| (k.as_str(), v)));
                     for (name, value) in values {

@@ -183,8 +183,18 @@ impl Case {
                 path: loaded.path.clone(),
                 source,
             })?;
+            let eight_bit_pass = targets.get(&pass).is_some_and(eight_bit);
+            if let Some(message) = rule.never_fails_on_eight_bit().filter(|_| eight_bit_pass) {
+                return Err(SuiteError::Tolerance {
+                    path: loaded.path.clone(),
+                    source: crate::golden::tolerance::RuleError {
+                        path: name.clone(),
+                        message,
+                    },
+                });
+            }
             if let Some(metric) = rule.flip_metric() {
-                if !targets.get(&pass).is_some_and(eight_bit) {
+                if !eight_bit_pass {
                     return Err(SuiteError::FlipOnFloatPass {
                         path: loaded.path.clone(),
                         pass,

@@ -165,3 +165,54 @@ impl Rule {
         Ok(Rule::Check { metric, limit })
     }
 }
+
+impl Rule {
+    /// Where a check of this rule can never fail on an 8-bit pass, whose values lie in 0..1 so
+    /// that no difference exceeds 1: the first such check and why (a limit the values cannot
+    /// reach passes every render, a check that cannot fire). None where each can fail.
+    pub fn never_fails_on_eight_bit(&self) -> Option<String> {
+        let (metric, limit) = match self {
+            Rule::All(rules) | Rule::Any(rules) => {
+                return rules.iter().find_map(Rule::never_fails_on_eight_bit)
+            }
+            Rule::Check { metric, limit } => (metric, *limit),
+        };
+        // The largest error a value can have: 1, or at most 1 / floor where it is relative (its
+        // denominator, max(|golden|, floor), is at least the floor).
+        let largest = |floor: Option<f64>| floor.map_or(1.0, |f| 1.0 / f);
+        match *metric {
+            Metric::MaxAbs { .. } | Metric::Rmse if limit >= 1.0 => Some(format!(
+                "`max` {limit} can never be exceeded on an 8-bit pass, whose differences lie \
+                 in 0..1"
+            )),
+            Metric::Psnr if limit <= 0.0 => Some(format!(
+                "`min` {limit} can never be undercut on an 8-bit pass, whose PSNR is at least 0"
+            )),
+            Metric::FractionOver {
+                threshold, floor, ..
+            } if threshold >= largest(floor) => Some(format!(
+                "`threshold` {} can never be exceeded on an 8-bit pass: no pixel's error there \
+                 goes beyond {}",
+                short(threshold),
+                short(largest(floor))
+            )),
+            Metric::Relative { floor, .. } if limit >= largest(Some(floor)) => Some(format!(
+                "`max` {} can never be exceeded on an 8-bit pass: with `floor` {} no relative \
+                 error there goes beyond {}",
+                short(limit),
+                short(floor),
+                short(largest(Some(floor)))
+            )),
+            _ => None,
+        }
+    }
+}
+
+/// `x` for a message: as written where it is of everyday size, else in scientific notation.
+fn short(x: f64) -> String {
+    if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+        format!("{x:.3e}")
+    } else {
+        format!("{}", (x * 1e6).round() / 1e6)
+    }
+}

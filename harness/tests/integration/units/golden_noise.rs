@@ -31,6 +31,12 @@ fn a_limit_that_is_not_a_finite_positive_number_is_an_error_naming_its_key() {
         ("limit = 0.014", "limit = nan", "limit NaN"),
         ("limit = 0.014", "limit = inf", "limit inf"),
         ("limit = 0.014", "limit = -1.0", "limit -1"),
+        // A FLIP error lies in 0..1: a limit of 1 or more could never fail.
+        (
+            "limit = 0.014",
+            "limit = 5.0",
+            "limit 5 can never be exceeded",
+        ),
         ("margin = 3.0", "margin = nan", "margin NaN"),
         ("= 0.002", "= -0.5", "drivers/gl -0.5"),
     ] {

@@ -85,6 +85,52 @@ fn a_scene_files_tolerances_are_read_and_flip_is_refused_on_a_float_pass() {
     );
 }
 
+/// A scene file's limit that no 8-bit render can reach (its values lie in 0..1) is refused when
+/// the scene loads, naming the file, the pass and why; the same limit on a float pass, whose
+/// values are not bounded, loads.
+#[test]
+fn a_limit_an_eight_bit_pass_can_never_reach_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    for (rule, says) in [
+        (
+            "metric = \"max_abs\", max = 1.0",
+            "`max` 1 can never be exceeded",
+        ),
+        (
+            "metric = \"rmse\", max = 2.0",
+            "`max` 2 can never be exceeded",
+        ),
+        ("metric = \"psnr\", min = -1e9", "can never be undercut"),
+        (
+            "metric = \"fraction_over\", threshold = 1.0, max = 1e-4",
+            "`threshold` 1 can never be exceeded",
+        ),
+        (
+            "metric = \"relative\", percentile = 0.5, floor = 1e30, max = 0.01",
+            "with `floor` 1.000e30 no relative error there goes beyond 1.000e-30",
+        ),
+    ] {
+        let file = arrow_with(
+            dir.path(),
+            &format!("[tolerances.final]\nall = [{{ {rule} }}]"),
+        );
+        let error = Case::load(file.to_str().unwrap()).err().unwrap();
+        let text = error.to_string();
+        assert!(
+            matches!(error, SuiteError::Tolerance { .. })
+                && text.contains("arrow_tolerances.toml")
+                && text.contains("final")
+                && text.contains(says),
+            "{rule}: {text}"
+        );
+    }
+    let float = arrow_with(
+        dir.path(),
+        "[tolerances.light]\nall = [{ metric = \"max_abs\", max = 5.0 }]",
+    );
+    assert!(Case::load(float.to_str().unwrap()).is_ok());
+}
+
 /// A scene named as one of golden/'s own entries (`evidence`, which holds other hosts'
 /// recordings) is refused when it loads: its goldens would land among them, and a prune would
 /// take the recordings for a pass that is gone.
