@@ -244,7 +244,7 @@ impl IblSettings {
         }
         if !(1..=MAX_EXTRACTED_LIGHTS).contains(&self.extracted_lights) {
             return Some(format!(
-                "ibl extracted_lights {} must be in 1..{MAX_EXTRACTED_LIGHTS}",
+                "ibl extracted_lights {} must be from 1 to {MAX_EXTRACTED_LIGHTS}",
                 self.extracted_lights
             ));
         }

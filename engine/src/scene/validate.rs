@@ -80,8 +80,13 @@ fn check_output_and_camera(scene: &Scene) -> Result<(), String> {
         ));
     }
     if !(q.exposure.is_finite() && q.exposure > 0.0) {
+        let beyond = if q.exposure.is_infinite() {
+            " (a number beyond f32's range, about 3.4e38, reads as inf)"
+        } else {
+            ""
+        };
         return Err(format!(
-            "exposure {} must be finite and positive",
+            "exposure {} must be finite and positive{beyond}",
             q.exposure
         ));
     }
@@ -313,7 +318,7 @@ fn check_environment(scene: &Scene) -> Result<(), String> {
     }
     if !env.rotation_degrees.is_finite() {
         return Err(format!(
-            "environment rotation_degrees {} must be finite",
+            "environment rotation {} must be finite",
             env.rotation_degrees
         ));
     }
