@@ -158,6 +158,18 @@ impl TimingNoise {
                 ),
             });
         }
+        // The smallest limit, min_noise ^ margin: infinite, no slowdown could exceed any limit.
+        let floor = model.min_noise.powf(model.margin);
+        if !floor.is_finite() {
+            return Err(SpeedError::File {
+                path,
+                message: format!(
+                    "margin {} makes even the smallest limit (min_noise {} ^ margin) x{floor}, \
+                     which no slowdown can exceed",
+                    model.margin, model.min_noise
+                ),
+            });
+        }
         Ok(model)
     }
 

@@ -57,6 +57,16 @@ fn limits_are_noise_to_the_margin_and_another_host_counts_the_drivers() {
     assert_eq!(TimingNoise::load(dir.path()).unwrap(), model);
     let merged = harness::golden::speed::measure::merged(TimingNoise::default(), model.clone());
     assert_eq!(merged.measured_on, model.measured_on);
+    // A margin that makes every limit infinite (none could fire) is refused, naming it.
+    let path = TimingNoise::path(dir.path());
+    let text = std::fs::read_to_string(&path).unwrap();
+    let margin = text.lines().find(|l| l.starts_with("margin = ")).unwrap();
+    std::fs::write(&path, text.replace(margin, "margin = 5000.0")).unwrap();
+    let error = TimingNoise::load(dir.path()).unwrap_err().to_string();
+    assert!(
+        error.contains("timing-noise.toml") && error.contains("margin 5000 makes even"),
+        "{error}"
+    );
 }
 
 /// Measuring this host's noise for goldens moved here replaces the previous host's same-host
