@@ -159,6 +159,12 @@ pub(crate) fn run(
     names.sort_unstable();
     names.dedup();
     let mut locks = std::collections::BTreeMap::new();
+    // Folders the locks make for new scenes: a dry run leaves none of them behind.
+    let made: Vec<std::path::PathBuf> = names
+        .iter()
+        .map(|name| store.root().join(name))
+        .filter(|dir| !dir.exists())
+        .collect();
     for name in names {
         let lock = store.lock_scene(name, |path| {
             eprintln!(
@@ -199,6 +205,13 @@ pub(crate) fn run(
                  pass) were kept, not blessed (each line above says why and what to run)"
             );
             refused += refused_timings;
+        }
+    }
+    if options.dry_run {
+        drop(locks);
+        for dir in made {
+            let _ = std::fs::remove_file(dir.join(harness::golden::LOCK_FILE));
+            let _ = std::fs::remove_dir(dir);
         }
     }
     Ok(if refused == 0 {

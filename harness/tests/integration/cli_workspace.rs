@@ -147,3 +147,27 @@ fn an_unavailable_backend_names_the_variable_that_redirected_its_loader() {
         "{stdout}"
     );
 }
+
+/// A dry run of a new scene's bless says what it would write and leaves nothing behind, not
+/// even the folder its lock was taken in (which `bless --prune` would then call an orphan).
+#[test]
+fn a_dry_run_bless_of_a_new_scene_leaves_no_folder() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    std::fs::copy(
+        root.path().join("scenes/corner.toml"),
+        root.path().join("scenes/fresh.toml"),
+    )
+    .unwrap();
+    let output = common::harness_command()
+        .args(["bless", "--scene", "fresh", "--dry-run", "--no-speed"])
+        .env("HARNESS_ROOT", root.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}");
+    assert!(stdout.contains("would be written (dry run)"), "{stdout}");
+    assert!(!root.path().join("golden/fresh").exists());
+}
