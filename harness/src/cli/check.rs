@@ -412,13 +412,9 @@ fn print_table(run: &CheckRun, report: &Path, failures: &str) {
         unloaded.push_str(&format!(", {missing} backend(s) asked for are unavailable"));
     }
     // Untimed speed checks pass (unless slower beyond even their wide limit): the summary says
-    // how many, so that a run whose speed checks time little does not read as covered.
-    let untimed = run
-        .speed
-        .checks
-        .iter()
-        .filter(|c| c.untimed() && !c.failed())
-        .count();
+    // how many, so that a run whose speed checks time little does not read as covered; counted
+    // as the coverage below counts them, failed or not.
+    let untimed = run.speed.checks.iter().filter(|c| c.untimed()).count();
     let untimed = match untimed {
         0 => String::new(),
         n => format!(", {n} untimed"),
@@ -482,14 +478,15 @@ fn print_advice(run: &CheckRun, report: &Path, failures: &str) {
     let kept = match (run.verifications.is_empty(), acceptable_timings) {
         (true, false) => String::new(),
         (false, false) => "; or accept what this check kept, as above".to_owned(),
-        (verified, true) => format!(
-            "; or {} the timings this check measured, probing nothing again: `{} \
+        // The accept takes the kept images and the measured timings both, unless told one.
+        (true, true) => format!(
+            "; or accept the timings this check measured, probing nothing again: `{} \
              --speed-only`",
-            if verified {
-                "accept"
-            } else {
-                "accept what it kept, as above, and"
-            },
+            accept_command(report.parent().unwrap_or(report))
+        ),
+        (false, true) => format!(
+            "; or accept what it kept and the timings it measured, rendering and probing \
+             nothing again: `{}`",
             accept_command(report.parent().unwrap_or(report))
         ),
     };
