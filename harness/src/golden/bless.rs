@@ -21,9 +21,39 @@ pub fn given_reason(text: &str) -> Option<&str> {
 }
 
 /// Why `case`'s goldens may not be written, when it is a file outside scenes/ that
-/// shares a canonical scene's name ([`refusal_for`]).
+/// shares a canonical scene's name ([`refusal_for`]), or the name of another file outside
+/// scenes/ whose goldens its folder holds.
 pub fn refusal(case: &Case) -> Option<String> {
     refusal_for(case.name(), &case.loaded.path.to_string_lossy())
+        .or_else(|| another_files_folder(case))
+}
+
+/// Why a scene file outside scenes/ may not write golden/<name>/: its blessed.toml records
+/// another scene file, still there, as the one its goldens were blessed from (two files named
+/// alike would overwrite each other's goldens without a word).
+fn another_files_folder(case: &Case) -> Option<String> {
+    if is_canonical(case) {
+        return None;
+    }
+    let recorded = GoldenStore::workspace()
+        .scene_file(case.name())
+        .ok()
+        .flatten()?;
+    let same = match (recorded.canonicalize(), case.loaded.path.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    (!same && recorded.is_file()).then(|| {
+        format!(
+            "{} is named `{}`, as is {}, whose goldens golden/{}/ holds (its blessed.toml \
+             records that file): its goldens would be written over them. Give this file a name \
+             of its own (`name = \"...\"`), or bless that one",
+            case.loaded.path.display(),
+            case.name(),
+            recorded.display(),
+            case.name()
+        )
+    })
 }
 
 /// Why the goldens of the scene `name`, loaded from `argument` (a canonical name or a scene

@@ -171,3 +171,40 @@ fn a_dry_run_bless_of_a_new_scene_leaves_no_folder() {
     assert!(stdout.contains("would be written (dry run)"), "{stdout}");
     assert!(!root.path().join("golden/fresh").exists());
 }
+
+/// Two scene files outside scenes/ named alike share golden/<name>/: once one is blessed there,
+/// blessing the other is refused, naming both, and the first's goldens stay as they were.
+#[test]
+fn a_scene_file_named_like_another_files_blessed_scene_is_refused() {
+    if !common::gl_available() {
+        return;
+    }
+    let root = common::temp_workspace();
+    let corner = std::fs::read_to_string(root.path().join("scenes/corner.toml")).unwrap();
+    let mine = root.path().join("mine");
+    std::fs::create_dir_all(&mine).unwrap();
+    let (first, second) = (mine.join("first.toml"), mine.join("second.toml"));
+    std::fs::write(&first, format!("name = \"twin\"\n{corner}")).unwrap();
+    let brighter = corner.replace("exposure = 1.0\n", "exposure = 1.7\n");
+    std::fs::write(&second, format!("name = \"twin\"\n{brighter}")).unwrap();
+    let bless = |file: &std::path::Path| {
+        common::harness_command()
+            .args(["bless", "--no-speed", "--unverified", "--scene"])
+            .arg(file)
+            .env("HARNESS_ROOT", root.path())
+            .output()
+            .unwrap()
+    };
+    assert!(bless(&first).status.success());
+    let golden = root.path().join("golden/twin");
+    let before = super::cli_bless::snapshot(&golden);
+    let refused = bless(&second);
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("second.toml is named `twin`, as is ") && stderr.contains("first.toml"),
+        "{stderr}"
+    );
+    let after = super::cli_bless::snapshot(&golden);
+    assert!(super::cli_bless::changed_files(&golden, &before, &after).is_empty());
+}
