@@ -1,5 +1,6 @@
 //! Scene-file values that load as numbers but would render wrong without a word: each is
-//! refused when the scene loads, naming the object and the value.
+//! refused when the scene loads, naming the object and the value. And a scene of scenes/ that
+//! is no file: loading it says what it is.
 
 use engine::scene_file;
 
@@ -50,4 +51,19 @@ fn an_object_beyond_what_32_bit_lighting_reaches_is_refused() {
     let text = format!("{CAMERA}[[objects]]\nmesh = \"builtin:sphere\"\nposition = [0, 0, -1e5]\n");
     std::fs::write(&path, text).unwrap();
     assert!(scene_file::load(&path).is_ok());
+}
+
+/// A folder in scenes/ named like a scene resolves as that scene, and loading it says it is not
+/// a file (where "no scene `x`", beside a list of the scenes that names x, contradicted itself).
+#[test]
+fn a_folder_named_like_a_scene_says_it_is_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("folder.toml")).unwrap();
+    assert_eq!(scene_file::canonical_scenes(dir.path()), ["folder"]);
+    let path = scene_file::resolve("folder", dir.path()).unwrap();
+    let e = scene_file::load(&path).err().unwrap().to_string();
+    assert!(
+        e.contains("folder.toml: cannot read scene file") && e.contains("directory"),
+        "{e}"
+    );
 }
