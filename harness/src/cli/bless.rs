@@ -159,20 +159,8 @@ pub(crate) fn run(
     names.sort_unstable();
     names.dedup();
     let mut locks = std::collections::BTreeMap::new();
-    // Folders the locks make for new scenes: a dry run leaves none of them behind.
-    let made: Vec<std::path::PathBuf> = names
-        .iter()
-        .map(|name| store.root().join(name))
-        .filter(|dir| !dir.exists())
-        .collect();
     for name in names {
-        let lock = store.lock_scene(name, |path| {
-            eprintln!(
-                "waiting for another `harness bless` of {name} to finish (it holds {})",
-                path.display()
-            );
-        })?;
-        locks.insert(name.to_owned(), lock);
+        locks.insert(name.to_owned(), scene_lock(&store, name, options.dry_run)?);
     }
     // Before anything is written: what would stop the bless half-way through a scene.
     for case in &cases {
@@ -207,18 +195,29 @@ pub(crate) fn run(
             refused += refused_timings;
         }
     }
-    if options.dry_run {
-        drop(locks);
-        for dir in made {
-            let _ = std::fs::remove_file(dir.join(harness::golden::LOCK_FILE));
-            let _ = std::fs::remove_dir(dir);
-        }
-    }
     Ok(if refused == 0 {
         ExitCode::SUCCESS
     } else {
         ExitCode::FAILURE
     })
+}
+
+/// The lock a bless of `scene` holds: waiting, saying so, while another bless holds it; none
+/// at all for a dry run, which writes nothing (a lock would make the folder of a new scene).
+fn scene_lock(
+    store: &harness::golden::GoldenStore,
+    scene: &str,
+    dry_run: bool,
+) -> anyhow::Result<harness::golden::SceneLock> {
+    if dry_run {
+        return Ok(store.dry_run_lock(scene));
+    }
+    Ok(store.lock_scene(scene, |path| {
+        eprintln!(
+            "waiting for another `harness bless` of {scene} to finish (it holds {})",
+            path.display()
+        );
+    })?)
 }
 
 /// Whether `candidates`, the new goldens of `case`, reproduce under every verification source
@@ -473,15 +472,9 @@ pub(crate) fn from_last_check(
     }
     let store = harness::golden::GoldenStore::workspace();
     let exe = std::env::current_exe()?;
-    let on_wait = |scene: &str, path: &std::path::Path| {
-        eprintln!(
-            "waiting for another `harness bless` of {scene} to finish (it holds {})",
-            path.display()
-        );
-    };
     let mut refused = 0;
     for case in &cases {
-        let lock = store.lock_scene(case.name(), |path| on_wait(case.name(), path))?;
+        let lock = scene_lock(&store, case.name(), dry_run)?;
         let mine: Vec<&accept::Candidate> = candidates
             .iter()
             .filter(|c| c.check.scene == case.name())

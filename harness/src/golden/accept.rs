@@ -209,8 +209,13 @@ impl std::fmt::Display for NotKept {
 /// The output the check kept of `candidate`'s pass of `case`, or why not: the check kept none,
 /// or it is unreadable or not the size and kind of the pass's target ([`NotKept::Unusable`]),
 /// or the golden changed after the check, saying so when the golden is now that output
-/// (accepted already; [`NotKept::Settled`]).
-pub fn kept_output(candidate: &Candidate, case: &Case) -> Result<engine::Image, NotKept> {
+/// (accepted already; [`NotKept::Settled`]), else with the check to run again (writing to
+/// `check_out`, the folder the accept reads).
+pub fn kept_output(
+    candidate: &Candidate,
+    case: &Case,
+    check_out: Option<&Path>,
+) -> Result<engine::Image, NotKept> {
     let check = &candidate.check;
     let name = format!("{}/{} ({})", check.scene, check.pass, check.backend);
     let Some(actual) = &check.artifacts.actual else {
@@ -218,9 +223,16 @@ pub fn kept_output(candidate: &Candidate, case: &Case) -> Result<engine::Image, 
             "{name}: the check kept no output to accept"
         )));
     };
-    let golden_changed = std::fs::metadata(&check.golden_path)
-        .and_then(|m| m.modified())
-        .is_ok_and(|modified| modified > candidate.checked_at);
+    // By content where the check kept the golden's digest (a checkout newer than a downloaded
+    // check has newer files, not other goldens); by time for a check from before it kept one.
+    let golden_changed = match &check.golden_digest {
+        Some(then) => {
+            crate::golden::scene_inputs::file_digest(&check.golden_path).as_ref() != Some(then)
+        }
+        None => std::fs::metadata(&check.golden_path)
+            .and_then(|m| m.modified())
+            .is_ok_and(|modified| modified > candidate.checked_at),
+    };
     if golden_changed {
         // Accepted already (by this review or another accept): the golden is the kept output.
         let accepted = read_output(actual)
@@ -234,9 +246,9 @@ pub fn kept_output(candidate: &Candidate, case: &Case) -> Result<engine::Image, 
             )
         } else {
             format!(
-                "{name}: {} changed after the last check; run `{}` again",
+                "{name}: {} changed after the last check; check it again: `{}`",
                 check.golden_path.display(),
-                crate::golden::command_line::harness_command("check")
+                crate::golden::command_line::check_command(&check.scene_argument, check_out)
             )
         }));
     }
@@ -460,7 +472,7 @@ pub fn accept_scene(
     let mut kept = Vec::new();
     let mut unusable = Vec::new();
     for &candidate in candidates {
-        match kept_output(candidate, case) {
+        match kept_output(candidate, case, options.check_out) {
             Ok(image) => kept.push((candidate, image)),
             Err(NotKept::Settled(why)) => done.refused.push((candidate.check.pass, why)),
             Err(NotKept::Unusable(why)) => unusable.push(why),
@@ -547,8 +559,12 @@ pub fn accept_all_timings(
     scenes
         .into_iter()
         .map(|scene| {
-            let result = store
-                .lock_scene(scene, &on_wait)
+            let lock = if dry_run {
+                Ok(store.dry_run_lock(scene))
+            } else {
+                store.lock_scene(scene, &on_wait)
+            };
+            let result = lock
                 .map_err(|e| e.to_string())
                 .and_then(|lock| accept_timings(store, &lock, checks, check, dry_run, reason));
             (scene.to_owned(), result)

@@ -29,8 +29,8 @@ pub fn refusal(case: &Case) -> Option<String> {
 }
 
 /// Why a scene file outside scenes/ may not write golden/<name>/: its blessed.toml records
-/// another scene file, still there, as the one its goldens were blessed from (two files named
-/// alike would overwrite each other's goldens without a word).
+/// another scene file, still there and still of that name, as the one its goldens were
+/// blessed from (two files named alike would overwrite each other's goldens without a word).
 fn another_files_folder(case: &Case) -> Option<String> {
     if is_canonical(case) {
         return None;
@@ -43,7 +43,8 @@ fn another_files_folder(case: &Case) -> Option<String> {
         (Ok(a), Ok(b)) => a == b,
         _ => false,
     };
-    (!same && recorded.is_file()).then(|| {
+    let still_named_so = scene_name_of(&recorded).is_some_and(|name| name == case.name());
+    (!same && still_named_so).then(|| {
         format!(
             "{} is named `{}`, as is {}, whose goldens golden/{}/ holds (its blessed.toml \
              records that file): its goldens would be written over them. Give this file a name \
@@ -80,6 +81,18 @@ pub fn refusal_for(name: &str, argument: &str) -> Option<String> {
             canonical.display()
         )
     })
+}
+
+/// The name of the scene in the file at `path`, as a load would give it (its `name`, or its
+/// stem), read without loading its assets; None where the file cannot be read as TOML.
+fn scene_name_of(path: &std::path::Path) -> Option<String> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let table: toml::Table = toml::from_str(&text).ok()?;
+    match table.get("name") {
+        Some(toml::Value::String(name)) => Some(name.clone()),
+        Some(_) => None,
+        None => Some(path.file_stem()?.to_str()?.to_owned()),
+    }
 }
 
 /// Whether `case` is the scene of scenes/ named like it (not a scene file elsewhere).

@@ -72,13 +72,26 @@ pub enum GoldenError {
 #[derive(Debug)]
 pub struct SceneLock {
     scene: String,
-    _file: std::fs::File,
+    /// The locked file; None for a dry run's ([`GoldenStore::dry_run_lock`]), which writes
+    /// nothing.
+    file: Option<std::fs::File>,
 }
 
 impl SceneLock {
     /// The scene whose folder is held.
     pub fn scene(&self) -> &str {
         &self.scene
+    }
+
+    /// Refuses a write under a dry run's lock (which holds nothing).
+    fn writable(&self, store: &GoldenStore) -> Result<(), GoldenError> {
+        match self.file {
+            Some(_) => Ok(()),
+            None => Err(GoldenError::Record {
+                path: store.root.join(&self.scene),
+                message: "a dry run writes nothing (its lock holds no file)".to_owned(),
+            }),
+        }
     }
 }
 
@@ -343,8 +356,17 @@ impl GoldenStore {
         }
         Ok(SceneLock {
             scene: scene.to_owned(),
-            _file: file,
+            file: Some(file),
         })
+    }
+
+    /// The lock a dry run holds for `scene`: none at all, as it writes nothing (taking a real
+    /// one would make the folder of a scene that has none yet, and leave it behind).
+    pub fn dry_run_lock(&self, scene: &str) -> SceneLock {
+        SceneLock {
+            scene: scene.to_owned(),
+            file: None,
+        }
     }
 
     /// Writes `image` as the golden of the locked scene's `pass` and records the bless with
@@ -364,6 +386,7 @@ impl GoldenStore {
             reason,
             scene_file,
         } = provenance;
+        lock.writable(self)?;
         let scene = lock.scene();
         if let Some(values) = image.as_f32() {
             let count = values.iter().filter(|v| !v.is_finite()).count();
@@ -405,6 +428,7 @@ impl GoldenStore {
     /// Drops the record of `pass` (a name as blessed.toml has it) from the locked scene's
     /// blessed.toml: a record whose golden is gone (`harness bless --prune`).
     pub fn forget(&self, lock: &SceneLock, pass: &str) -> Result<(), GoldenError> {
+        lock.writable(self)?;
         let mut records = self.records(lock.scene())?;
         if records.remove(pass).is_some() {
             self.write_records(lock, records, None)?;

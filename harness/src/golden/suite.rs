@@ -379,6 +379,11 @@ pub struct PassCheck {
     /// The rule's per-pixel criterion, which scales the review page's false-colour diff.
     #[serde(default)]
     pub criterion: Option<crate::golden::tolerance::PixelCriterion>,
+    /// The SHA-256 of the golden file a failing pass was compared with (None where it passed
+    /// or had none): an accept reads it to tell whether the golden changed since, by content,
+    /// which a checkout on another machine, newer than the check, keeps.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub golden_digest: Option<String>,
 }
 
 /// How to name the scene file at `path` on the command line: its file stem when it lives in
@@ -517,13 +522,17 @@ pub fn check_pass(
         let dir = artifacts_dir(failures, scene, backend.name());
         artifacts = write_artifacts(&dir, pass, actual, golden_image.as_ref());
     }
+    let golden_path = store.path(scene, pass, eight_bit);
     PassCheck {
         scene: scene.to_owned(),
         scene_argument: case.argument(),
         pass,
         backend,
+        golden_digest: (!outcome.passed())
+            .then(|| crate::golden::scene_inputs::file_digest(&golden_path))
+            .flatten(),
         outcome,
-        golden_path: store.path(scene, pass, eight_bit),
+        golden_path,
         artifacts,
         criterion: case.rules.get(&pass).and_then(Rule::pixel_criterion),
     }

@@ -174,14 +174,26 @@ fn after_the_check(
     );
     assert_ne!(snapshot(golden), before);
 
-    // The final golden rewritten after that check: accepting the check's final is refused.
+    // The final golden only touched after that check (a checkout newer than the check, as on
+    // another machine): not a change. Rewritten: accepting the check's final is refused.
+    let final_png = golden.join("arrow/final.png");
     let future = std::time::SystemTime::now() + std::time::Duration::from_secs(60);
-    std::fs::File::options()
-        .write(true)
-        .open(golden.join("arrow/final.png"))
-        .unwrap()
-        .set_modified(future)
-        .unwrap();
+    let touch = || {
+        std::fs::File::options()
+            .write(true)
+            .open(&final_png)
+            .unwrap()
+            .set_modified(future)
+            .unwrap();
+    };
+    touch();
+    let (code, stdout) = accept("final", true, false);
+    assert!(
+        code == Some(0) && stdout.contains("arrow/final: CHANGED vs old golden"),
+        "{stdout}"
+    );
+    common::cli::darken(&final_png, 1);
+    touch();
     let (code, stdout) = accept("final", true, false);
     assert_eq!(code, Some(1), "{stdout}");
     assert!(

@@ -148,8 +148,9 @@ fn an_unavailable_backend_names_the_variable_that_redirected_its_loader() {
     );
 }
 
-/// A dry run of a new scene's bless says what it would write and leaves nothing behind, not
-/// even the folder its lock was taken in (which `bless --prune` would then call an orphan).
+/// A dry run of a new scene's bless (or of accepting a check of it) says what it would write and
+/// leaves nothing behind, not even a folder to lock (which `bless --prune` would call an
+/// orphan).
 #[test]
 fn a_dry_run_bless_of_a_new_scene_leaves_no_folder() {
     if !common::gl_available() {
@@ -169,6 +170,26 @@ fn a_dry_run_bless_of_a_new_scene_leaves_no_folder() {
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(output.status.success(), "{stdout}");
     assert!(stdout.contains("would be written (dry run)"), "{stdout}");
+    assert!(!root.path().join("golden/fresh").exists());
+    // Nor does a dry run of accepting what a check of it kept.
+    let out = root.path().join("out");
+    let run = |args: &[&str]| {
+        common::harness_command()
+            .args(args)
+            .arg("--out")
+            .arg(&out)
+            .env("HARNESS_ROOT", root.path())
+            .output()
+            .unwrap()
+    };
+    let checked = run(&["check", "--scene", "fresh", "--backend", "gl", "--no-speed"]);
+    assert_eq!(checked.status.code(), Some(1));
+    let accepted = run(&["bless", "--from-last-check", "--dry-run", "--no-speed"]);
+    let stdout = String::from_utf8_lossy(&accepted.stdout);
+    assert!(
+        accepted.status.success() && stdout.contains("(dry run)"),
+        "{stdout}"
+    );
     assert!(!root.path().join("golden/fresh").exists());
 }
 
@@ -207,4 +228,9 @@ fn a_scene_file_named_like_another_files_blessed_scene_is_refused() {
     );
     let after = super::cli_bless::snapshot(&golden);
     assert!(super::cli_bless::changed_files(&golden, &before, &after).is_empty());
+    // Renamed, the first file no longer holds the folder: the second may bless into it.
+    std::fs::write(&first, format!("name = \"elsewhere\"\n{corner}")).unwrap();
+    let blessed = bless(&second);
+    let stderr = String::from_utf8_lossy(&blessed.stderr);
+    assert!(blessed.status.success(), "{stderr}");
 }

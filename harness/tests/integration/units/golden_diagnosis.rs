@@ -89,6 +89,7 @@ fn check(pass: TargetId, backend: BackendKind, passed: bool) -> PassCheck {
         golden_path: Default::default(),
         artifacts: Default::default(),
         criterion: None,
+        golden_digest: None,
     }
 }
 
