@@ -19,6 +19,7 @@ pub mod reference;
 pub mod report;
 pub mod review;
 pub mod test_scenes;
+pub mod url;
 
 /// Order statistics (one nearest-rank rule), shared with the engine's tests.
 pub use engine::stats;

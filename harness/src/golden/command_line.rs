@@ -121,7 +121,6 @@ fn workspace() -> String {
         .unwrap_or_default()
 }
 
-/// `word` as one word of a POSIX shell: as it is when it needs no quoting, else single-quoted.
 /// `--scene SCENE` for a printed command, quoted for a POSIX shell; `--scene=SCENE` where the
 /// scene begins with `-` (a file `-x.toml` in scenes/), which would otherwise read as a flag.
 pub fn scene_flag(scene: &str) -> String {
@@ -132,6 +131,7 @@ pub fn scene_flag(scene: &str) -> String {
     }
 }
 
+/// `word` as one word of a POSIX shell: as it is when it needs no quoting, else single-quoted.
 fn shell_quote(word: &str) -> String {
     let plain = !word.is_empty()
         && word

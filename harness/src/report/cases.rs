@@ -312,7 +312,7 @@ fn viewer(
 /// A link to a file the run wrote: relative to the page when it lies under `page_dir`.
 fn file_link(path: &Path, page_dir: Option<&Path>) -> String {
     match page_dir.and_then(|dir| path.strip_prefix(dir).ok()) {
-        Some(relative) => relative.display().to_string(),
-        None => format!("file://{}", path.display()),
+        Some(relative) => crate::url::encoded(relative),
+        None => format!("file://{}", crate::url::encoded(path)),
     }
 }

@@ -193,7 +193,7 @@ impl Review {
     /// without the token, as the page's links carry none: the same files are on this machine's
     /// disk, and the Host check keeps other sites' pages from reading them.
     fn failure_file(&self, url_path: &str) -> tiny_http::ResponseBox {
-        let Some(relative) = percent_decoded(url_path.trim_start_matches('/')) else {
+        let Some(relative) = crate::url::decoded(url_path.trim_start_matches('/')) else {
             return not_found();
         };
         let relative = std::path::Path::new(&relative);
@@ -441,23 +441,4 @@ fn not_found() -> tiny_http::ResponseBox {
     tiny_http::Response::from_string("not found\n")
         .with_status_code(404)
         .boxed()
-}
-
-/// `text` with its `%XX` escapes decoded (a URL's path), or None where one is malformed or the
-/// result is not UTF-8.
-fn percent_decoded(text: &str) -> Option<String> {
-    let bytes = text.as_bytes();
-    let mut decoded = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        if bytes[i] == b'%' {
-            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
-            decoded.push(u8::from_str_radix(hex, 16).ok()?);
-            i += 3;
-        } else {
-            decoded.push(bytes[i]);
-            i += 1;
-        }
-    }
-    String::from_utf8(decoded).ok()
 }

@@ -40,3 +40,4 @@ mod reference_ibl;
 mod reference_lighting;
 mod reference_shadows;
 mod root;
+mod url;
