@@ -283,7 +283,13 @@ pub(crate) fn merge(shards: &[PathBuf], out: &Path, options: &Options) -> anyhow
         eprintln!("error: {why}; nothing joined");
         return Ok(ExitCode::from(2));
     }
-    let (run, outputs) = harness::golden::merge::merge(shards, out)?;
+    let (run, outputs) = match harness::golden::merge::merge(shards, out) {
+        Err(e @ harness::golden::merge::MergeError::OutIsShard { .. }) => {
+            eprintln!("error: {e}; nothing joined");
+            return Ok(ExitCode::from(2));
+        }
+        other => other?,
+    };
     let store = harness::golden::GoldenStore::workspace();
     let failures = out.join("failures");
     finish(

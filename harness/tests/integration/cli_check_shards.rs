@@ -181,7 +181,7 @@ fn refuses_overlapping_shards(run: Run, arrow: &std::path::Path, again: &std::pa
     assert!(text.contains("given twice"), "{text}");
     let before = std::fs::read(arrow.join("last-check.json")).unwrap();
     let (code, text) = run(&["report", "--merge", twice[0], "--out", twice[0]]);
-    assert_eq!(code, Some(1), "{text}");
+    assert_eq!(code, Some(2), "{text}");
     assert!(text.contains("is one of the shards"), "{text}");
     assert_eq!(
         std::fs::read(arrow.join("last-check.json")).unwrap(),
