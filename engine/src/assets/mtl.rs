@@ -112,6 +112,8 @@ pub(super) fn parse_mtl_bytes(path: &Path, bytes: &[u8]) -> Result<ParsedMtl, As
     let (bytes, encoding) = super::text::utf8_bytes(path, bytes);
     let mut warnings: Vec<String> = encoding.into_iter().collect();
     let mut current: Option<ParsedMaterial> = None;
+    // Each material name with the line that first defined it.
+    let mut defined: Vec<(String, usize)> = Vec::new();
     let mut text = LossyLines::default();
     // Logged at debug level only: callers report the returned list (see `obj::warn`).
     let mut warn = |msg: String| {
@@ -145,6 +147,14 @@ pub(super) fn parse_mtl_bytes(path: &Path, bytes: &[u8]) -> Result<ParsedMtl, As
                 ));
                 current = Some(ParsedMaterial::default());
                 continue;
+            }
+            match defined.iter().find(|(name, _)| name == rest) {
+                Some((_, first)) => warn(format!(
+                    "{}:{lineno}: `newmtl {rest}` again (first at line {first}): two materials \
+                     of one name, which a `usemtl {rest}` cannot tell apart; rename one",
+                    path.display()
+                )),
+                None => defined.push((rest.to_string(), lineno)),
             }
             current = Some(ParsedMaterial {
                 name: rest.to_string(),
@@ -397,6 +407,21 @@ mod tests {
         assert_eq!(parse_map_args("-bm 0.5"), (None, vec![]));
         assert_eq!(parse_map_args(""), (None, vec![]));
         assert_eq!(parse_map_args("-weird.png"), (Some("-weird.png"), vec![]));
+    }
+
+    /// Two `newmtl` of one name warn, naming both lines; distinct names do not.
+    #[test]
+    fn a_material_named_twice_warns() {
+        let src = b"newmtl wood\nKd 0.5\nnewmtl iron\nnewmtl wood\nKd 0.2\n";
+        let mtl = parse_mtl_bytes(Path::new("dir/x.mtl"), src).unwrap();
+        assert_eq!(mtl.materials.len(), 3);
+        assert_eq!(
+            mtl.warnings,
+            [
+                "dir/x.mtl:4: `newmtl wood` again (first at line 1): two materials of one name, \
+              which a `usemtl wood` cannot tell apart; rename one"
+            ]
+        );
     }
 
     #[test]

@@ -224,10 +224,16 @@ const RESULT_ENV_PREFIXES: &[&str] = &[
 /// for `gl` (which does not use it). A variable set for one backend is no change of another's
 /// driver (a `gl` fingerprint that named VK_DRIVER_FILES read as a driver change).
 fn reaches_only_others(kind: BackendKind, name: &str) -> bool {
-    let vulkan = ["VK_", "LVP_"];
-    let gl = ["LIBGL_", "__EGL_VENDOR_LIBRARY", "EGL_PLATFORM"];
+    let vulkan = ["VK_", "LVP_", "MESA_VK_"];
+    let gl = [
+        "LIBGL_",
+        "__EGL_VENDOR_LIBRARY",
+        "EGL_PLATFORM",
+        "MESA_GL",
+        "MESA_LOADER_DRIVER_OVERRIDE",
+    ];
     let others: &[&str] = match kind {
-        BackendKind::Gl => &["VK_", "LVP_", "WGPU_"],
+        BackendKind::Gl => &["VK_", "LVP_", "MESA_VK_", "WGPU_"],
         BackendKind::WgpuGl => &vulkan,
         BackendKind::WgpuVulkan => &gl,
     };
@@ -527,6 +533,10 @@ mod tests {
             ("__EGL_VENDOR_LIBRARY_FILENAMES", &[Gl, WgpuGl]),
             ("LIBGL_DRIVERS_PATH", &[Gl, WgpuGl]),
             ("WGPU_BACKEND", &[WgpuGl, WgpuVulkan]),
+            ("MESA_VK_WSI_DEBUG", &[WgpuVulkan]),
+            ("MESA_GL_VERSION_OVERRIDE", &[Gl, WgpuGl]),
+            ("MESA_GLSL_CACHE_DISABLE", &[Gl, WgpuGl]),
+            ("MESA_SHADER_CACHE_DISABLE", &[Gl, WgpuGl, WgpuVulkan]),
             ("LP_NUM_THREADS", &[Gl, WgpuGl, WgpuVulkan]),
             ("GALLIUM_OVERRIDE_CPU_CAPS", &[Gl, WgpuGl, WgpuVulkan]),
         ] {

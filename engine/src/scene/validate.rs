@@ -203,19 +203,23 @@ fn check_object(object: &Object, texture_count: usize) -> Result<(), String> {
 /// without a word. 1e18 leaves a margin of 18 for the sums.
 pub const MAX_REACH: f64 = 1e18;
 
-/// An object's vertices, placed by its transform, lie within [`MAX_REACH`] of the camera.
+/// An object's mesh bounds, placed by its transform as the renderer places it (relative to the
+/// camera), lie within [`MAX_REACH`] of the camera: the eight corners bound every vertex.
 fn check_reach(object: &Object, camera: DVec3) -> Result<(), String> {
-    let t = &object.transform;
-    let far = object
-        .mesh
-        .vertices
-        .iter()
-        .map(|v| {
-            let local = DVec3::from(v.position.map(f64::from)) * t.scale;
-            (t.translation + t.rotation * local - camera)
-                .abs()
-                .max_element()
-        })
+    let model = object.transform.relative_to(camera);
+    let (min, max) = (object.mesh.bounds.min, object.mesh.bounds.max);
+    let corner = |i: usize| {
+        let pick = |axis: usize| {
+            f64::from(if i >> axis & 1 == 0 {
+                min[axis]
+            } else {
+                max[axis]
+            })
+        };
+        model.transform_point3(DVec3::new(pick(0), pick(1), pick(2)))
+    };
+    let far = (0..8)
+        .map(|i| corner(i).abs().max_element())
         .fold(0.0f64, f64::max);
     if far > MAX_REACH {
         return Err(format!(

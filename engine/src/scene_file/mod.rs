@@ -136,6 +136,22 @@ pub fn resolve(name_or_path: &str, scenes_dir: &Path) -> Result<PathBuf, SceneFi
     })
 }
 
+/// Scene files directly in `scenes_dir` whose names are not UTF-8, which no command line can
+/// name as a scene ([`canonical_scenes`] leaves them out): their paths, shown lossily, sorted.
+pub fn unnamed_scene_files(scenes_dir: &Path) -> Vec<String> {
+    let mut paths: Vec<String> = std::fs::read_dir(scenes_dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .filter(|p| p.file_stem().is_some_and(|s| s.to_str().is_none()))
+        .map(|p| p.to_string_lossy().into_owned())
+        .collect();
+    paths.sort();
+    paths
+}
+
 /// Names of the scene files directly in `scenes_dir`, sorted.
 pub fn canonical_scenes(scenes_dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(scenes_dir)
@@ -153,6 +169,27 @@ pub fn canonical_scenes(scenes_dir: &Path) -> Vec<String> {
     names
 }
 
+/// A scene file that is not UTF-8 (TOML's encoding), refused where its first such byte is.
+fn not_utf8(path: &Path, error: &std::string::FromUtf8Error) -> SceneFileError {
+    let bytes = error.as_bytes();
+    let at = error.utf8_error().valid_up_to();
+    let before = &bytes[..at];
+    let line_start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |i| i + 1);
+    SceneFileError::Parse {
+        path: path.to_owned(),
+        line: before.iter().filter(|&&b| b == b'\n').count() + 1,
+        column: at - line_start + 1,
+        message: format!(
+            "byte 0x{:02x} is not UTF-8: a scene file is TOML, which must be UTF-8 (a file saved \
+             as UTF-16 or Latin-1 reads like this; save it as UTF-8)",
+            bytes[at]
+        ),
+    }
+}
+
 /// Reads, parses and resolves a scene file, loading every asset it names within the default
 /// [`assets::Limits`].
 pub fn load(path: &Path) -> Result<LoadedScene, SceneFileError> {
@@ -165,10 +202,11 @@ pub fn load_with_limits(
     path: &Path,
     limits: assets::Limits,
 ) -> Result<LoadedScene, SceneFileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneFileError::Io {
+    let bytes = std::fs::read(path).map_err(|source| SceneFileError::Io {
         path: path.to_owned(),
         source,
     })?;
+    let text = String::from_utf8(bytes).map_err(|e| not_utf8(path, &e))?;
     let file = parse(path, &text)?;
     Resolver::new(path, limits).resolve(file)
 }

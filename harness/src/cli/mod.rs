@@ -123,9 +123,13 @@ fn print_load_warnings(loaded: &engine::scene_file::LoadedScene) {
     }
 }
 
-/// The scenes asked for, or every canonical scene.
+/// The scenes asked for, or every canonical scene (saying which files of scenes/ no name can
+/// reach).
 fn scenes_or_canonical(scenes: &[String]) -> Vec<String> {
     if scenes.is_empty() {
+        for path in engine::scene_file::unnamed_scene_files(&harness::scenes_dir()) {
+            eprintln!("warning: {path} is left out: its name is not UTF-8 (rename it)");
+        }
         engine::scene_file::canonical_scenes(&harness::scenes_dir())
     } else {
         // A scene named twice is checked once (its failure folder would be cleared and
