@@ -253,31 +253,25 @@ pub fn kept_output(
         }));
     }
     let image = read_output(actual).map_err(|e| NotKept::Unusable(format!("{name}: {e}")))?;
-    let expected = case.target(check.pass).map(|t| (t.width, t.height));
-    if expected != Some((image.width, image.height))
-        || crate::golden::is_eight_bit(&image) != case.is_eight_bit(check.pass)
-    {
+    // Size and kind, as a message says them ("512x512 8-bit").
+    let shape = |(width, height): (u32, u32), eight_bit: bool| {
+        format!(
+            "{width}x{height} {}",
+            if eight_bit { "8-bit" } else { "float" }
+        )
+    };
+    let kept = shape(
+        (image.width, image.height),
+        crate::golden::is_eight_bit(&image),
+    );
+    let rendered = case
+        .target(check.pass)
+        .map(|t| shape((t.width, t.height), case.is_eight_bit(check.pass)));
+    if rendered.as_ref() != Some(&kept) {
         return Err(NotKept::Unusable(format!(
-            "{name}: {} is {}x{} {}, where the pass renders {}",
+            "{name}: {} is {kept}, where the pass renders {}",
             actual.display(),
-            image.width,
-            image.height,
-            if crate::golden::is_eight_bit(&image) {
-                "8-bit"
-            } else {
-                "float"
-            },
-            case.target(check.pass)
-                .map_or("nothing".to_owned(), |t| format!(
-                    "{}x{} {}",
-                    t.width,
-                    t.height,
-                    if case.is_eight_bit(check.pass) {
-                        "8-bit"
-                    } else {
-                        "float"
-                    }
-                ))
+            rendered.as_deref().unwrap_or("nothing")
         )));
     }
     Ok(image)

@@ -190,8 +190,9 @@ impl Review {
 
     /// A file the page links under `failures/` (the check's kept outputs, goldens and
     /// differences), read from the check's folder; anything outside it is not found. Served
-    /// without the token, as the page's links carry none: the same files are on this machine's
-    /// disk, and the Host check keeps other sites' pages from reading them.
+    /// without the token, as the page's links carry none: they are this machine's render
+    /// outputs, on its disk; the Host check refuses a request naming another host (a rebound
+    /// name), though another site's page could still show one as an image it cannot read.
     fn failure_file(&self, url_path: &str) -> tiny_http::ResponseBox {
         let Some(relative) = crate::url::decoded(url_path.trim_start_matches('/')) else {
             return not_found();
@@ -437,6 +438,7 @@ fn token() -> std::io::Result<String> {
     Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())
 }
 
+/// The answer to what the server does not serve.
 fn not_found() -> tiny_http::ResponseBox {
     tiny_http::Response::from_string("not found\n")
         .with_status_code(404)

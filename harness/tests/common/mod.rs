@@ -76,6 +76,15 @@ pub fn temp_workspace() -> tempfile::TempDir {
     root
 }
 
+/// Brightens the corner scene of the workspace at `root` (exposure 1.0 to 1.7): a change every
+/// pass from the light on shows, in the smallest canonical scene (256x256).
+pub fn brighten_corner(root: &std::path::Path) {
+    let scene = root.join("scenes/corner.toml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(text.contains("exposure = 1.0\n"), "{text}");
+    std::fs::write(&scene, text.replace("exposure = 1.0\n", "exposure = 1.7\n")).unwrap();
+}
+
 /// The `harness` binary as a command that shares this workspace's IBL cache, also when the test
 /// points HARNESS_ROOT at a temporary copy (the maps depend only on the environment image, the
 /// IBL settings and the precompute's code; the cache itself is tested in

@@ -467,10 +467,7 @@ fn an_accept_with_a_kept_output_missing_or_misfit_writes_none_of_the_scene() {
         return;
     }
     let root = common::temp_workspace();
-    let scene = root.path().join("scenes/corner.toml");
-    let text = std::fs::read_to_string(&scene).unwrap();
-    assert!(text.contains("exposure = 1.0\n"), "{text}");
-    std::fs::write(&scene, text.replace("exposure = 1.0\n", "exposure = 1.7\n")).unwrap();
+    common::brighten_corner(root.path());
     let out = root.path().join("out");
     let run = |args: &[&str]| {
         common::harness_command()
