@@ -112,6 +112,10 @@ pub struct CheckRun {
     /// a scene that has changed since.
     #[serde(default)]
     pub inputs: Vec<crate::golden::scene_inputs::SceneInputs>,
+    /// The workspace's commit, when it is a git tree: shards of different commits are not one
+    /// run (`report --merge` refuses them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub commit: Option<String>,
 }
 
 impl CheckRun {
@@ -417,6 +421,7 @@ pub fn run_with(
             cross,
             timings,
             speed: Default::default(),
+            commit: crate::golden::speed::history::commit(),
         },
         outputs,
     )

@@ -39,6 +39,21 @@ pub enum MergeError {
         /// What went wrong.
         message: String,
     },
+    /// Two shards checked different commits: their goldens and scenes need not be the same.
+    #[error(
+        "{first} checked commit {first_commit} and {second} checked {second_commit}: shards of \
+         one run check one commit"
+    )]
+    Commits {
+        /// One shard.
+        first: PathBuf,
+        /// Its commit.
+        first_commit: String,
+        /// The other.
+        second: PathBuf,
+        /// Its commit.
+        second_commit: String,
+    },
     /// Two shards checked the same scene on the same backend.
     #[error("{scene} on {backend} is in two shards ({first} and {second}): shard by scene")]
     Overlap {
@@ -67,6 +82,8 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<(CheckRun, Outputs), Merg
         });
     }
     let mut merged = CheckRun::default();
+    // The first shard that names its commit, and the commit.
+    let mut committed: Option<(PathBuf, String)> = None;
     let mut owner: Vec<(String, String, PathBuf)> = Vec::new();
     let mut disputed: Vec<engine::backend::BackendKind> = Vec::new();
     for (i, dir) in shards.iter().enumerate() {
@@ -83,6 +100,20 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<(CheckRun, Outputs), Merg
         };
         let bytes = std::fs::read(&path).map_err(|e| error(e.to_string()))?;
         let mut run: CheckRun = serde_json::from_slice(&bytes).map_err(|e| error(e.to_string()))?;
+        if let Some(commit) = &run.commit {
+            match &committed {
+                Some((first, first_commit)) if first_commit != commit => {
+                    return Err(MergeError::Commits {
+                        first: first.clone(),
+                        first_commit: first_commit.clone(),
+                        second: dir.clone(),
+                        second_commit: commit.clone(),
+                    });
+                }
+                Some(_) => {}
+                None => committed = Some((dir.clone(), commit.clone())),
+            }
+        }
         for r in &mut run.results {
             let key = (r.scene.clone(), r.backend.name().to_owned());
             match owner.iter().find(|(s, b, _)| (s, b) == (&key.0, &key.1)) {
@@ -155,6 +186,7 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<(CheckRun, Outputs), Merg
     for backend in disputed {
         merged.speed.recorded_as.remove(&backend);
     }
+    merged.commit = committed.map(|(_, commit)| commit);
     for r in &mut merged.results {
         gather(&mut r.artifacts, out)?;
     }
@@ -175,23 +207,32 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<(CheckRun, Outputs), Merg
     Ok((merged, outputs))
 }
 
-/// Copies the files of `artifacts` (each as `<shard>/failures/<scene>/<backend>/<file>`) to the
-/// same place under `out`, and points them there.
-fn gather(artifacts: &mut Artifacts, out: &Path) -> Result<(), MergeError> {
-    for path in [
+/// The files of `artifacts` that a check wrote.
+fn files_mut(artifacts: &mut Artifacts) -> impl Iterator<Item = &mut PathBuf> {
+    [
         &mut artifacts.actual,
         &mut artifacts.golden,
         &mut artifacts.diff,
     ]
     .into_iter()
     .flatten()
-    {
-        let parts: Vec<_> = path.iter().collect();
-        if parts.len() < 3 || !path.exists() {
+}
+
+/// Where `path`, a check's `<out>/failures/<scene>/<backend>/<file>`, lies under `dir`'s
+/// `failures/` (its last three parts); None for a shorter path.
+fn under_failures(path: &Path, dir: &Path) -> Option<PathBuf> {
+    let parts: Vec<_> = path.iter().collect();
+    let tail: PathBuf = parts.get(parts.len().checked_sub(3)?..)?.iter().collect();
+    Some(dir.join("failures").join(tail))
+}
+
+/// Copies the files of `artifacts` to the same place under `out` (see [`under_failures`]), and
+/// points them there.
+fn gather(artifacts: &mut Artifacts, out: &Path) -> Result<(), MergeError> {
+    for path in files_mut(artifacts) {
+        let Some(to) = under_failures(path, out).filter(|_| path.exists()) else {
             continue;
-        }
-        let tail: PathBuf = parts[parts.len() - 3..].iter().collect();
-        let to = out.join("failures").join(tail);
+        };
         let copy = || -> std::io::Result<()> {
             if let Some(dir) = to.parent() {
                 std::fs::create_dir_all(dir)?;
@@ -209,25 +250,12 @@ fn gather(artifacts: &mut Artifacts, out: &Path) -> Result<(), MergeError> {
 }
 
 /// Points `artifacts` recorded in another place (another machine's job, a folder since moved)
-/// at the copies under `dir`, the folder `check --out` wrote them to as it is here: each path is
-/// looked up as `<dir>/failures/<scene>/<backend>/<file>` (its last three parts), and kept as
-/// recorded where there is no such copy.
+/// at the copies under `dir`, the folder `check --out` wrote them to as it is here (see
+/// [`under_failures`]), keeping each as recorded where there is no such copy.
 pub(crate) fn rebase(artifacts: &mut Artifacts, dir: &Path) {
-    for path in [
-        &mut artifacts.actual,
-        &mut artifacts.golden,
-        &mut artifacts.diff,
-    ]
-    .into_iter()
-    .flatten()
-    {
-        let parts: Vec<_> = path.iter().collect();
-        if parts.len() >= 3 {
-            let tail: PathBuf = parts[parts.len() - 3..].iter().collect();
-            let here = dir.join("failures").join(tail);
-            if here.exists() {
-                *path = here;
-            }
+    for path in files_mut(artifacts) {
+        if let Some(here) = under_failures(path, dir).filter(|here| here.exists()) {
+            *path = here;
         }
     }
 }

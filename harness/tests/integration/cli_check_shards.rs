@@ -211,15 +211,9 @@ fn a_downloaded_check_is_accepted_in_another_checkout() {
     if !common::gl_available() {
         return;
     }
-    let change = |root: &std::path::Path| {
-        let scene = root.join("scenes/corner.toml");
-        let text = std::fs::read_to_string(&scene).unwrap();
-        assert!(text.contains("exposure = 1.0\n"), "{text}");
-        std::fs::write(&scene, text.replace("exposure = 1.0\n", "exposure = 1.7\n")).unwrap();
-    };
     let (job, mine) = (common::temp_workspace(), common::temp_workspace());
-    change(job.path());
-    change(mine.path());
+    common::brighten_corner(job.path());
+    common::brighten_corner(mine.path());
     let job_out = job.path().join("out");
     let checked = common::harness_command()
         .args([
@@ -242,19 +236,22 @@ fn a_downloaded_check_is_accepted_in_another_checkout() {
     let recorded = std::fs::read_to_string(download.join("last-check.json")).unwrap();
     assert!(recorded.contains(&job_out.display().to_string()));
     let job_goldens = super::cli_bless::snapshot(&job.path().join("golden"));
-    let accepted = common::harness_command()
-        .args([
-            "bless",
-            "--from-last-check",
-            "--no-speed",
-            "--backend",
-            "gl",
-        ])
-        .arg("--out")
-        .arg(&download)
-        .env("HARNESS_ROOT", mine.path())
-        .output()
-        .unwrap();
+    let accept = || {
+        common::harness_command()
+            .args([
+                "bless",
+                "--from-last-check",
+                "--no-speed",
+                "--backend",
+                "gl",
+            ])
+            .arg("--out")
+            .arg(&download)
+            .env("HARNESS_ROOT", mine.path())
+            .output()
+            .unwrap()
+    };
+    let accepted = accept();
     let stdout = String::from_utf8_lossy(&accepted.stdout);
     let stderr = String::from_utf8_lossy(&accepted.stderr);
     assert!(accepted.status.success(), "{stdout}{stderr}");
@@ -264,19 +261,42 @@ fn a_downloaded_check_is_accepted_in_another_checkout() {
     let changed = super::cli_bless::changed_files(job.path(), &job_goldens, &after);
     assert!(changed.is_empty(), "{changed:?}");
     // Accepted again: this checkout's goldens are the ones rewritten since the check.
-    let again = common::harness_command()
-        .args([
-            "bless",
-            "--from-last-check",
-            "--no-speed",
-            "--backend",
-            "gl",
-        ])
-        .arg("--out")
-        .arg(&download)
-        .env("HARNESS_ROOT", mine.path())
-        .output()
-        .unwrap();
+    let again = accept();
     let stdout = String::from_utf8_lossy(&again.stdout);
     assert!(stdout.contains("already accepted"), "{stdout}");
+}
+
+/// Shards that checked different commits are not one run: joining them is refused, naming both;
+/// shards of one commit (or that name none, outside a git tree) join, keeping it.
+#[test]
+fn shards_of_different_commits_are_not_joined() {
+    use harness::golden::check::CheckRun;
+    use harness::golden::merge::{merge, MergeError};
+    let dir = tempfile::tempdir().unwrap();
+    let shard = |name: &str, commit: Option<&str>| {
+        let path = dir.path().join(name);
+        std::fs::create_dir_all(&path).unwrap();
+        let run = CheckRun {
+            commit: commit.map(str::to_owned),
+            ..CheckRun::default()
+        };
+        std::fs::write(
+            path.join("last-check.json"),
+            serde_json::to_vec(&run).unwrap(),
+        )
+        .unwrap();
+        path
+    };
+    let (a, b) = (shard("a", Some("1111")), shard("b", Some("2222")));
+    let (same, none) = (shard("same", Some("1111")), shard("none", None));
+    let out = dir.path().join("joined");
+    let error = merge(&[a.clone(), none.clone(), b], &out).err().unwrap();
+    assert!(
+        matches!(error, MergeError::Commits { .. })
+            && error.to_string().contains("checked commit 1111")
+            && error.to_string().contains("checked 2222"),
+        "{error}"
+    );
+    let (joined, _) = merge(&[a, none, same], &out).unwrap();
+    assert_eq!(joined.commit.as_deref(), Some("1111"));
 }
