@@ -314,6 +314,8 @@ fn main() -> ExitCode {
         .init();
     let args = Cli::parse_from(with_default_command(std::env::args_os().collect()));
     harness::use_ibl_cache();
+    // A precompute can take from a second to minutes (large or many-sample settings): said.
+    engine::ibl::set_build_notice(Some(|what| eprintln!("{what} ...")));
     let command = args.command.unwrap_or_else(Command::default_check);
     let result = match command {
         Command::Backends { json } => cli::info::backends(json),

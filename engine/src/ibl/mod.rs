@@ -188,6 +188,15 @@ pub enum MapsSource {
     Memory,
 }
 
+/// Told before maps are built (not found in memory or the disk cache): what is built. A program
+/// that can take a while to answer says so with it (`harness` prints it); none by default.
+static BUILD_NOTICE: std::sync::RwLock<Option<fn(&str)>> = std::sync::RwLock::new(None);
+
+/// Sets what [`prepare`] tells before it builds maps (None: nothing).
+pub fn set_build_notice(notice: Option<fn(&str)>) {
+    *BUILD_NOTICE.write().unwrap_or_else(|e| e.into_inner()) = notice;
+}
+
 /// The maps for an environment and settings: from this process's memory, else from the disk
 /// cache set with [`cache::set_directory`], else built (and then stored in both). A disk cache
 /// that cannot be written (full disk, read-only folder) is a warning naming the file, not an
@@ -219,6 +228,18 @@ pub fn prepare(
                 },
             );
         }
+    }
+    if let Some(notice) = *BUILD_NOTICE.read().unwrap_or_else(|e| e.into_inner()) {
+        notice(&format!(
+            "precomputing the IBL maps of {} ({}x{}; specular {}x{} from {} samples per texel; \
+             not cached yet)",
+            image.label,
+            image.width,
+            image.height,
+            settings.specular_size,
+            settings.specular_size,
+            settings.specular_samples
+        ));
     }
     let maps = Arc::new(build(image, settings));
     let seconds = start.elapsed().as_secs_f64();

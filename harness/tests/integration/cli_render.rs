@@ -1,6 +1,6 @@
-//! `harness render`: load warnings printed once, unknown passes refused before rendering, and
-//! every pass of a scene file written; and what other commands refuse before any work (an
-//! unknown pass or scene, a flag that does nothing without another).
+//! `harness render`: load warnings printed once, unknown passes refused before rendering, every
+//! pass of a scene file written, and an IBL precompute said; and what other commands refuse
+//! before any work (an unknown pass or scene, a flag that does nothing without another).
 
 use crate::common;
 use std::path::Path;
@@ -285,4 +285,47 @@ fn speed_commands_name_an_unknown_scene_once() {
     let (code, _, stderr) = harness(&["check", "--no-speed", "--debug-unspecialised-lighting"]);
     assert_eq!(code, 2, "{stderr}");
     assert!(stderr.contains("cannot be used with"), "{stderr}");
+}
+
+/// An IBL precompute the cache does not hold says so before it runs (with large settings it
+/// takes minutes, and the command would print nothing meanwhile); once cached, nothing is said.
+#[test]
+fn an_ibl_precompute_that_is_not_cached_says_so() {
+    if !common::gl_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // A small sky and small maps: the precompute takes a moment.
+    let sky = Path::new(env!("CARGO_MANIFEST_DIR")).join("../engine/tests/fixtures/sky.hdr");
+    std::fs::copy(sky, dir.path().join("sky.hdr")).unwrap();
+    let scene = dir.path().join("sky.toml");
+    let text = "[camera]\nposition = [0, 1, 3]\ntarget = [0, 0, 0]\n\n[quality]\nwidth = 64\n\
+                height = 64\n\n[quality.ibl]\nsource_size = 16\nspecular_size = 8\n\
+                specular_samples = 16\nirradiance_size = 8\n\n[environment]\n\
+                path = \"sky.hdr\"\n\n[[objects]]\nmesh = \"builtin:sphere\"\n";
+    std::fs::write(&scene, text).unwrap();
+    let cache = dir.path().join("ibl-cache");
+    let render = || {
+        common::harness_command()
+            .args(["render", "--backend", "gl", "--scene"])
+            .arg(&scene)
+            .arg("--out")
+            .arg(dir.path().join("final.png"))
+            .env("HARNESS_IBL_CACHE", &cache)
+            .output()
+            .unwrap()
+    };
+    let first = render();
+    let stderr = String::from_utf8_lossy(&first.stderr);
+    assert!(first.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("precomputing the IBL maps of ") && stderr.contains("not cached yet) ..."),
+        "{stderr}"
+    );
+    let second = render();
+    let stderr = String::from_utf8_lossy(&second.stderr);
+    assert!(
+        second.status.success() && !stderr.contains("precomputing"),
+        "{stderr}"
+    );
 }
