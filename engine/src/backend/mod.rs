@@ -224,8 +224,8 @@ const RESULT_ENV_PREFIXES: &[&str] = &[
 /// for `gl` (which does not use it). A variable set for one backend is no change of another's
 /// driver (a `gl` fingerprint that named VK_DRIVER_FILES read as a driver change).
 fn reaches_only_others(kind: BackendKind, name: &str) -> bool {
-    let vulkan = ["VK_", "LVP_", "MESA_VK_"];
-    let gl = [
+    const VULKAN_ONLY: [&str; 3] = ["VK_", "LVP_", "MESA_VK_"];
+    const GL_ONLY: [&str; 5] = [
         "LIBGL_",
         "__EGL_VENDOR_LIBRARY",
         "EGL_PLATFORM",
@@ -233,11 +233,11 @@ fn reaches_only_others(kind: BackendKind, name: &str) -> bool {
         "MESA_LOADER_DRIVER_OVERRIDE",
     ];
     let others: &[&str] = match kind {
-        BackendKind::Gl => &["VK_", "LVP_", "MESA_VK_", "WGPU_"],
-        BackendKind::WgpuGl => &vulkan,
-        BackendKind::WgpuVulkan => &gl,
+        BackendKind::Gl | BackendKind::WgpuGl => &VULKAN_ONLY,
+        BackendKind::WgpuVulkan => &GL_ONLY,
     };
     others.iter().any(|p| name.starts_with(p))
+        || (kind == BackendKind::Gl && name.starts_with("WGPU_"))
 }
 
 fn result_env(kind: BackendKind) -> BTreeMap<String, String> {

@@ -81,7 +81,7 @@ fn check_output_and_camera(scene: &Scene) -> Result<(), String> {
     }
     if !(q.exposure.is_finite() && q.exposure > 0.0) {
         let beyond = if q.exposure.is_infinite() {
-            " (a number beyond f32's range, about 3.4e38, reads as inf)"
+            BEYOND_F32
         } else {
             ""
         };
@@ -242,17 +242,16 @@ fn check_light(i: usize, light: &Light) -> Result<(), String> {
     Ok(())
 }
 
+/// Why a scene value read as an f32 is infinite: a number written beyond its range reads so.
+const BEYOND_F32: &str = " (a number beyond f32's range, about 3.4e38, reads as inf)";
+
 /// The first of a light's values that is out of range, named as in the scene file with the
 /// value read.
 fn light_value_problem(light: &Light) -> Option<String> {
     // Colors and scalars are f32: a number written beyond its range reads as infinite.
     let f32_value = |name: &str, value: f32| {
         (!value.is_finite()).then(|| {
-            let beyond = if value.is_nan() {
-                ""
-            } else {
-                " (a number beyond f32's range, about 3.4e38, reads as inf)"
-            };
+            let beyond = if value.is_nan() { "" } else { BEYOND_F32 };
             format!("{name} must be a finite number, not {value}{beyond}")
         })
     };

@@ -126,7 +126,7 @@ pub fn resolve(name_or_path: &str, scenes_dir: &Path) -> Result<PathBuf, SceneFi
     let candidate = scenes_dir.join(format!("{name_or_path}.toml"));
     // There but no file (a folder, a link to nothing): loading it says why, where "no scene"
     // beside a list that names it would contradict itself.
-    if candidate.is_file() || std::fs::symlink_metadata(&candidate).is_ok() {
+    if std::fs::symlink_metadata(&candidate).is_ok() {
         return Ok(candidate);
     }
     Err(SceneFileError::UnknownScene {

@@ -117,18 +117,16 @@ fn check_out_path(
 ) -> anyhow::Result<()> {
     use engine::backend::TextureFormat;
     // A folder on the way that is a file (`README.md/x.png`): refused before rendering, as a
-    // missing one is made when the images are written.
-    // (`out` itself is checked too where it is used as a folder.)
-    let on_the_way = out.and_then(|o| {
-        let skip = usize::from(names_a_file(o));
-        o.ancestors().skip(skip).find(|a| a.is_file())
+    // missing one is made when the images are written (`out` itself too where it is a folder).
+    let unwritable = out.and_then(|o| {
+        if names_a_file(o) {
+            super::preflight::file_problem("--out", o)
+        } else {
+            super::preflight::folder_problem("--out", o)
+        }
     });
-    if let Some(file) = on_the_way {
-        anyhow::bail!(
-            "--out {}: {} is a file, not a folder",
-            out.unwrap_or(file).display(),
-            file.display()
-        );
+    if let Some(why) = unwritable {
+        anyhow::bail!("{why}");
     }
     let Some(extension) = out.filter(|o| names_a_file(o)).and_then(|o| o.extension()) else {
         return Ok(());

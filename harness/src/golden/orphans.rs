@@ -231,10 +231,6 @@ pub fn prune(
             _ => None,
         };
         for orphan in orphans.iter().filter(|o| o.scene.as_deref() == scene) {
-            if !orphan.kind.prunable() {
-                lines.push(format!("kept: {orphan}"));
-                continue;
-            }
             let remove_error = |e: std::io::Error| GoldenError::Record {
                 path: orphan.path.clone(),
                 message: format!("cannot remove: {e}"),
@@ -258,10 +254,8 @@ pub fn prune(
                     }
                     lines.push(format!("{} {}", verb, orphan.path.display()));
                 }
-                OrphanKind::PassGone
-                | OrphanKind::Unrecorded
-                | OrphanKind::Stray
-                | OrphanKind::RecordsLost { .. } => {
+                OrphanKind::RecordsLost { .. } => lines.push(format!("kept: {orphan}")),
+                OrphanKind::PassGone | OrphanKind::Unrecorded | OrphanKind::Stray => {
                     if !dry_run {
                         if orphan.path.is_dir() {
                             std::fs::remove_dir_all(&orphan.path).map_err(remove_error)?;
